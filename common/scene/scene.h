@@ -1,0 +1,73 @@
+// The render-ready scene every renderer reads: flat world-space vertex and triangle arrays
+// with material ids, the grouping of triangles into objects (glTF mesh primitives, needed by
+// object partitioning), materials, textures, lights and cameras. Built by gltf_loader.cpp.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "common/scene/camera.h"
+#include "common/scene/light.h"
+#include "common/scene/material.h"
+#include "common/scene/texture.h"
+
+namespace pr::scene {
+
+struct Bounds {
+  glm::vec3 min{std::numeric_limits<float>::infinity()};
+  glm::vec3 max{-std::numeric_limits<float>::infinity()};
+  void extend(glm::vec3 p) { min = glm::min(min, p); max = glm::max(max, p); }
+  void extend(const Bounds& b) { min = glm::min(min, b.min); max = glm::max(max, b.max); }
+  bool empty() const { return min.x > max.x; }
+  glm::vec3 extent() const { return empty() ? glm::vec3(0.0f) : max - min; }
+  glm::vec3 center() const { return 0.5f * (min + max); }
+};
+
+// Three vertex indices (counter-clockwise seen from the front, after any mirroring fix) and a
+// material id into Scene::materials.
+struct Triangle {
+  uint32_t v[3];
+  uint32_t material;
+};
+
+// One drawn glTF mesh primitive (one node instance of it): a contiguous triangle range.
+struct Object {
+  std::string name;  // "node/mesh#primitive"
+  int node = -1, mesh = -1, primitive = -1;
+  uint32_t firstTriangle = 0;
+  uint32_t triangleCount = 0;
+  Bounds bounds;
+};
+
+struct Scene {
+  std::filesystem::path source;  // the file it was loaded from (empty when built in code)
+
+  // Vertices, world space. normals are unit length (generated, area-weighted, when absent);
+  // uvs is UV set 0 (zero when absent); colors is COLOR_0, empty when no primitive has it.
+  std::vector<glm::vec3> positions;
+  std::vector<glm::vec3> normals;
+  std::vector<glm::vec2> uvs;
+  std::vector<glm::vec4> colors;
+
+  std::vector<Triangle> triangles;
+  std::vector<Object> objects;
+  std::vector<Material> materials;  // always at least one: the glTF default material is last
+  std::vector<Texture> textures;
+  std::vector<PunctualLight> lights;
+  std::vector<AreaLight> areaLights;  // emissive triangles
+  std::vector<Camera> cameras;        // the file's cameras in node order; may be empty
+
+  Bounds bounds;
+  std::vector<std::string> extensionsUsed;  // as listed by the file
+  std::vector<std::string> warnings;        // optional content that was skipped or ignored
+
+  // Bytes held by the arrays above (the render-ready layout), textures included.
+  size_t memoryBytes() const;
+};
+
+}  // namespace pr::scene

@@ -1,0 +1,11 @@
+// The subcommands of the parrender program. Each cmd_*.cpp adds one subcommand to the app:
+// its options, its --help text and the callback that runs it. main.cpp calls them all.
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace pr::cli {
+
+// One declaration per subcommand, each defined in its cmd_*.cpp.
+
+}  // namespace pr::cli

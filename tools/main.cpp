@@ -1,0 +1,37 @@
+// parrender: the program. Parses the command line (CLI11) and runs one subcommand.
+// Exit status: 0 success, 2 bad input (option, file, scene content), 1 any other failure.
+#include <cstdio>
+#include <exception>
+
+#include <CLI/CLI.hpp>
+
+#include "common/util/error.h"
+#include "tools/commands.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"parrender: a parallel software renderer (sort-first/middle/last rasterizers, "
+               "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "parrender 0.1.0");
+  // One line per subcommand (tools/commands.h).
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForAllHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::CallForVersion& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    app.exit(e);  // prints the message and usage hint
+    return pr::kExitBadInput;
+  } catch (const pr::InputError& e) {
+    std::fprintf(stderr, "parrender: error: %s\n", e.what());
+    return pr::kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parrender: failed: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Installs every Debian package parrender needs to build, test and benchmark.
+# Idempotent: when everything is present it only checks and returns (no apt traffic).
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config
+  libtinygltf-dev nlohmann-json3-dev libstb-dev  # glTF loading and writing
+  libglm-dev                                     # vector math
+  libopenimageio-dev                             # EXR / PNG images
+  libcli11-dev                                   # command-line parsing
+  doctest-dev                                    # unit tests
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "setup: all ${#packages[@]} packages present"
+  exit 0
+fi
+
+echo "setup: installing ${missing[*]}"
+if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
