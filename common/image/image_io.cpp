@@ -1,0 +1,127 @@
+// Image files through OpenImageIO (see image_io.h): EXR for linear radiance, PNG for viewing.
+// Called once per render on the main thread after the PEs have finished, and by `compare`.
+#include "common/image/image_io.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdint>
+#include <string>
+#include <system_error>
+#include <unistd.h>
+
+namespace pr::image {
+namespace {
+
+namespace fs = std::filesystem;
+
+enum class Format { Exr, Png };
+
+std::string lowerExtension(const fs::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+Format formatOf(const fs::path& path) {
+  std::string ext = lowerExtension(path);
+  if (ext == ".exr") return Format::Exr;
+  if (ext == ".png") return Format::Png;
+  throw InputError("image file '" + path.string() + "': unsupported extension '" + path.extension().string() +
+                   "' (expected .exr or .png)");
+}
+
+// Removes the temporary file unless the write got as far as the rename.
+struct TempFile {
+  fs::path path;
+  bool keep = false;
+  ~TempFile() {
+    if (keep) return;
+    std::error_code ignored;
+    fs::remove(path, ignored);
+  }
+};
+
+}  // namespace
+
+void writeImage(const fs::path& path, const Image& image, const WriteOptions& options) {
+  const Format format = formatOf(path);
+  if (image.empty() || image.width <= 0 || image.height <= 0)
+    throw InputError("image file '" + path.string() + "': nothing to write (empty image)");
+  PR_CHECK(image.pixels.size() == static_cast<size_t>(image.width) * static_cast<size_t>(image.height),
+           "pixel count does not match width * height");
+
+  // The temporary name keeps the directory (so the rename is atomic) but not the extension,
+  // so the format is named explicitly below rather than guessed from the file name.
+  fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  std::string tempName = path.filename().string();
+  tempName.insert(tempName.begin(), '.');
+  tempName += ".tmp";
+  tempName += std::to_string(::getpid());
+  TempFile temp{dir / tempName};
+
+  const char* formatName = format == Format::Exr ? "openexr" : "png";
+  auto out = OIIO::ImageOutput::create(formatName);
+  PR_CHECK(out != nullptr, std::string("OpenImageIO has no writer for ") + formatName);
+
+  const size_t count = image.pixels.size();
+  bool ok = false;
+  if (format == Format::Exr) {
+    OIIO::ImageSpec spec(image.width, image.height, 3, options.exrHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+    spec.attribute("compression", "zip");
+    // glm::vec3 is three packed floats, so the pixel array is the interleaved RGB buffer.
+    static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
+    ok = out->open(temp.path.string(), spec) &&
+         out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) && out->close();
+  } else {
+    std::vector<uint8_t> bytes(count * 3);
+    for (size_t i = 0; i < count; ++i)
+      for (int c = 0; c < 3; ++c) bytes[3 * i + c] = toDisplay8(image.pixels[i][c], options.display);
+    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+    spec.attribute("oiio:ColorSpace", "sRGB");
+    ok = out->open(temp.path.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) &&
+         out->close();
+  }
+  if (!ok) {
+    std::string why = out->geterror();
+    out.reset();  // closes the file before the temporary is removed
+    throw InputError("cannot write image file '" + path.string() + "'" + (why.empty() ? "" : ": " + why));
+  }
+  out.reset();
+
+  std::error_code ec;
+  fs::rename(temp.path, path, ec);
+  if (ec) throw InputError("cannot write image file '" + path.string() + "': " + ec.message());
+  temp.keep = true;
+}
+
+Image readImage(const fs::path& path) {
+  const Format format = formatOf(path);
+  if (!fs::is_regular_file(path)) throw InputError("image file '" + path.string() + "' does not exist");
+
+  auto in = OIIO::ImageInput::open(path.string());
+  if (!in) throw InputError("cannot read image file '" + path.string() + "': " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  const int channels = spec.nchannels;
+  if (spec.width <= 0 || spec.height <= 0 || channels < 1)
+    throw InputError("image file '" + path.string() + "' has no pixels");
+
+  std::vector<float> data(static_cast<size_t>(spec.width) * spec.height * channels);
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw InputError("cannot read image file '" + path.string() + "': " + in->geterror());
+  in->close();
+
+  Image image(spec.width, spec.height);
+  // Channels: 1 or 2 (grey, grey+alpha) replicate the first; 3+ take R, G, B and drop the rest.
+  const bool grey = channels < 3;
+  for (size_t i = 0; i < image.size(); ++i) {
+    const float* p = &data[i * channels];
+    glm::vec3 v = grey ? glm::vec3(p[0]) : glm::vec3(p[0], p[1], p[2]);
+    if (format == Format::Png) v = glm::vec3(srgbDecode(v.x), srgbDecode(v.y), srgbDecode(v.z));
+    image.pixels[i] = v;
+  }
+  return image;
+}
+
+}  // namespace pr::image
