@@ -1,0 +1,65 @@
+// RegionFramebuffer: colour, depth key (depth + primitive order) and triangle index for one
+// screen rectangle (a tile, a strip, or the whole screen). Region owners rasterize into their
+// own; sort-last PEs hold a full-screen one each; resolveInto() composites them into the image.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "raster/region.h"
+#include "raster/stages/depth_resolve.h"
+
+namespace pr::raster {
+
+// Marks a pixel whose triangle index is unknown (empty, or composited from another buffer).
+inline constexpr uint32_t kNoTriangle = 0xffffffffu;
+
+class RegionFramebuffer {
+ public:
+  RegionFramebuffer() = default;
+  explicit RegionFramebuffer(const Rect& rect);
+
+  // Back to the cleared state: key kClearKey (no fragment), no triangle, background colour 0.
+  void clear();
+
+  const Rect& rect() const { return rect_; }
+  int width() const { return rect_.width(); }
+  int height() const { return rect_.height(); }
+
+  // Index of screen pixel (x, y), which must lie inside rect().
+  size_t index(int x, int y) const {
+    return static_cast<size_t>(y - rect_.y0) * static_cast<size_t>(rect_.width()) +
+           static_cast<size_t>(x - rect_.x0);
+  }
+
+  // Per-pixel arrays, row-major over rect(). key: fragmentKey() of the visible fragment.
+  // triangle: index of that fragment's ScreenTriangle in the list that was rasterized into this
+  // buffer (valid only in the buffer that rasterized it). colour: linear radiance after shading.
+  uint64_t* keys() { return key_.data(); }
+  const uint64_t* keys() const { return key_.data(); }
+  uint32_t* triangles() { return triangle_.data(); }
+  const uint32_t* triangles() const { return triangle_.data(); }
+  glm::vec3* colours() { return colour_.data(); }
+  const glm::vec3* colours() const { return colour_.data(); }
+
+  uint64_t key(int x, int y) const { return key_[index(x, y)]; }
+  uint32_t triangle(int x, int y) const { return triangle_[index(x, y)]; }
+  const glm::vec3& colour(int x, int y) const { return colour_[index(x, y)]; }
+
+  // Number of pixels holding a fragment.
+  size_t coveredPixels() const;
+  size_t memoryBytes() const;
+
+ private:
+  Rect rect_;
+  std::vector<uint64_t> key_;
+  std::vector<uint32_t> triangle_;
+  std::vector<glm::vec3> colour_;
+};
+
+// True when both cover the same rectangle and hold bit-identical keys and colours.
+bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
+
+}  // namespace pr::raster

@@ -1,0 +1,31 @@
+// Screen regions: the rectangles that region owners rasterize (tiles or strips). Every raster
+// pipeline splits the screen with these functions; sort-first and sort-middle send primitives
+// to the owners of the regions they overlap, sort-last composites by region.
+#pragma once
+
+#include <vector>
+
+namespace pr::raster {
+
+// A pixel rectangle, half-open: [x0, x1) x [y0, y1); row 0 is the top of the picture.
+struct Rect {
+  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
+
+  int width() const { return x1 - x0; }
+  int height() const { return y1 - y0; }
+  bool empty() const { return x1 <= x0 || y1 <= y0; }
+  long long area() const { return empty() ? 0 : static_cast<long long>(width()) * height(); }
+  bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
+  bool operator==(const Rect&) const = default;
+};
+
+Rect intersect(const Rect& a, const Rect& b);
+bool overlaps(const Rect& a, const Rect& b);
+
+// Square tiles of tileSizePx (the last row and column may be smaller), in row-major order.
+std::vector<Rect> tileRegions(int width, int height, int tileSizePx);
+
+// count horizontal strips of (nearly) equal height, top to bottom; count is clamped to height.
+std::vector<Rect> stripRegions(int width, int height, int count);
+
+}  // namespace pr::raster

@@ -1,0 +1,264 @@
+// Geometry stage: transform, near-plane (and, rarely, guard-band) clipping in homogeneous
+// space, snapping to 24.8 fixed point and back-face culling. Runs on whichever PE holds a
+// triangle batch (sort-middle, sort-last) or on a region owner (sort-first); it reads the scene
+// (replicated, read-only) and writes only its output vector.
+#include "raster/stages/geometry.h"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+#include "common/util/error.h"
+#include "raster/stages/depth_resolve.h"
+
+namespace pr::raster {
+
+namespace {
+
+// A polygon vertex during clipping: everything here is affine in world space, so the
+// intersection with a clip plane is a linear interpolation of all of it.
+struct ClipVertex {
+  glm::vec4 clip;
+  float viewDepth;
+  glm::vec2 bary;
+};
+
+enum Plane : int { kNear, kLeft, kRight, kBottom, kTop, kPlaneCount };
+
+// Signed distances (>= 0 inside) to the clip planes.
+float planeDistance(const FrameView& view, const ClipVertex& v, int plane) {
+  switch (plane) {
+    // Perspective: w is the view-axis distance, so the near plane is w = znear. Orthographic:
+    // w = 1 and the near plane is the view-axis distance znear.
+    case kNear: return (view.perspective ? v.clip.w : v.viewDepth) - view.znear;
+    case kLeft: return v.clip.x + view.guardX * v.clip.w;
+    case kRight: return view.guardX * v.clip.w - v.clip.x;
+    case kBottom: return v.clip.y + view.guardY * v.clip.w;
+    case kTop: return view.guardY * v.clip.w - v.clip.y;
+  }
+  return 0.0f;
+}
+
+// The point where edge (in, out) crosses the plane. Always interpolated from the inside vertex
+// towards the outside one, so the two triangles sharing an edge produce the very same vertex
+// (no cracks along clipped shared edges). The result is then put exactly on the plane: far
+// outside vertices (w = -1e6 behind the camera) would otherwise leave rounding errors larger
+// than znear and a vertex with w <= 0.
+ClipVertex intersectEdge(const FrameView& view, const ClipVertex& in, float dIn, const ClipVertex& out,
+                         float dOut, int plane) {
+  float t = dIn / (dIn - dOut);
+  ClipVertex v;
+  v.clip = in.clip + t * (out.clip - in.clip);
+  v.viewDepth = in.viewDepth + t * (out.viewDepth - in.viewDepth);
+  v.bary = in.bary + t * (out.bary - in.bary);
+  switch (plane) {
+    case kNear:
+      if (view.perspective) v.clip.w = view.znear;
+      else v.viewDepth = view.znear;
+      break;
+    case kLeft: v.clip.x = -view.guardX * v.clip.w; break;
+    case kRight: v.clip.x = view.guardX * v.clip.w; break;
+    case kBottom: v.clip.y = -view.guardY * v.clip.w; break;
+    case kTop: v.clip.y = view.guardY * v.clip.w; break;
+  }
+  return v;
+}
+
+// Sutherland-Hodgman against one plane; n vertices in, the count out.
+int clipPolygon(const FrameView& view, const ClipVertex* in, int n, ClipVertex* out, int plane) {
+  int m = 0;
+  for (int i = 0; i < n; ++i) {
+    const ClipVertex& a = in[i];
+    const ClipVertex& b = in[(i + 1) % n];
+    float da = planeDistance(view, a, plane);
+    float db = planeDistance(view, b, plane);
+    if (da >= 0.0f) out[m++] = a;
+    if ((da >= 0.0f) != (db >= 0.0f)) {
+      out[m++] = da >= 0.0f ? intersectEdge(view, a, da, b, db, plane) : intersectEdge(view, b, db, a, da, plane);
+    }
+  }
+  return m;
+}
+
+// Kept out of line so every vertex is transformed by the same instruction sequence: a vertex
+// shared by two triangles must snap to the same fixed-point position (watertightness).
+[[gnu::noinline]] ClipVertex transformVertex(const FrameView& view, glm::vec3 p, glm::vec2 bary) {
+  glm::vec4 hp(p, 1.0f);
+  return ClipVertex{view.viewProjection * hp, glm::dot(view.viewDepthRow, hp), bary};
+}
+
+struct SnappedVertex {
+  int32_t x, y;
+  float depth, invW;
+  glm::vec2 bary;
+};
+
+// Perspective division and viewport transform, snapped to 24.8 fixed point (round to nearest).
+// Clipping guarantees w > 0 and |x/w| <= guardX; the clamp only absorbs rounding at the guard.
+[[gnu::noinline]] SnappedVertex snapVertex(const FrameView& view, const ClipVertex& v) {
+  constexpr double kLimit = (kGuardBandPx + kMaxImageSidePx) * kSubpixelScale;
+  double invW = 1.0 / double(v.clip.w);
+  double sx = (0.5 + 0.5 * double(v.clip.x) * invW) * view.width * kSubpixelScale;
+  double sy = (0.5 - 0.5 * double(v.clip.y) * invW) * view.height * kSubpixelScale;
+  SnappedVertex s;
+  s.x = static_cast<int32_t>(std::nearbyint(std::clamp(sx, -kLimit, kLimit)));
+  s.y = static_cast<int32_t>(std::nearbyint(std::clamp(sy, -kLimit, kLimit)));
+  s.invW = static_cast<float>(invW);
+  s.depth = view.perspective ? -s.invW : v.viewDepth;
+  s.bary = v.bary;
+  return s;
+}
+
+// Twice the signed area of a snapped triangle; positive for a front face. (CCW in NDC with y
+// up is clockwise on the y-down screen; this is the edge function of setup.h at the third vertex.)
+int64_t signedArea2(const SnappedVertex& a, const SnappedVertex& b, const SnappedVertex& c) {
+  return int64_t(c.y - b.y) * int64_t(a.x - b.x) - int64_t(c.x - b.x) * int64_t(a.y - b.y);
+}
+
+uint32_t outcode(const FrameView& view, const ClipVertex& v, bool guard) {
+  uint32_t code = 0;
+  if (planeDistance(view, v, kNear) < 0.0f) code |= 1u << kNear;
+  float gx = guard ? view.guardX : 1.0f;
+  float gy = guard ? view.guardY : 1.0f;
+  if (v.clip.x < -gx * v.clip.w) code |= 1u << kLeft;
+  if (v.clip.x > gx * v.clip.w) code |= 1u << kRight;
+  if (v.clip.y < -gy * v.clip.w) code |= 1u << kBottom;
+  if (v.clip.y > gy * v.clip.w) code |= 1u << kTop;
+  return code;
+}
+
+}  // namespace
+
+GeometryCounters& GeometryCounters::operator+=(const GeometryCounters& o) {
+  trianglesIn += o.trianglesIn;
+  culledOutside += o.culledOutside;
+  culledBackFace += o.culledBackFace;
+  culledDegenerate += o.culledDegenerate;
+  clipped += o.clipped;
+  screenTrianglesOut += o.screenTrianglesOut;
+  return *this;
+}
+
+FrameView makeFrameView(const scene::Camera& camera, int width, int height) {
+  if (width < 1 || width > kMaxImageSidePx || height < 1 || height > kMaxImageSidePx) {
+    throw InputError("image size " + std::to_string(width) + "x" + std::to_string(height) +
+                     " is outside [1, " + std::to_string(kMaxImageSidePx) + "] per side");
+  }
+  FrameView view;
+  view.width = width;
+  view.height = height;
+  glm::mat4 v = camera.view();
+  view.viewProjection = camera.projectionMatrix(float(width) / float(height)) * v;
+  // Row 2 of the view matrix gives z_view; the camera looks down -z.
+  view.viewDepthRow = -glm::vec4(v[0][2], v[1][2], v[2][2], v[3][2]);
+  // A non-positive znear would put the near plane through the eye (w = 0): clamp to a tiny
+  // positive distance, which keeps 1/w finite.
+  view.znear = std::max(camera.znear, 1e-20f);
+  view.perspective = camera.projection == scene::Projection::Perspective;
+  view.eye = camera.position();
+  view.forward = -glm::normalize(glm::vec3(camera.cameraToWorld[2]));
+  // |x_ndc| <= 2G/W keeps the screen x within G pixels of the screen centre.
+  view.guardX = float(2.0 * kGuardBandPx / width);
+  view.guardY = float(2.0 * kGuardBandPx / height);
+  return view;
+}
+
+int processTriangle(const scene::Scene& scene, const FrameView& view, uint32_t index,
+                    ScreenTriangle* out, GeometryCounters* counters) {
+  GeometryCounters local;
+  GeometryCounters& c = counters ? *counters : local;
+  ++c.trianglesIn;
+  const scene::Triangle& tri = scene.triangles[index];
+
+  ClipVertex poly[2][kMaxPolygonVertices];
+  poly[0][0] = transformVertex(view, scene.positions[tri.v[0]], glm::vec2(0.0f, 0.0f));
+  poly[0][1] = transformVertex(view, scene.positions[tri.v[1]], glm::vec2(1.0f, 0.0f));
+  poly[0][2] = transformVertex(view, scene.positions[tri.v[2]], glm::vec2(0.0f, 1.0f));
+  int n = 3;
+
+  // Trivial reject: all three outside one viewport or near plane (the triangle is the convex
+  // hull of its clip-space vertices, so it cannot reach into the frustum).
+  uint32_t viewport[3], guard[3];
+  for (int k = 0; k < 3; ++k) {
+    viewport[k] = outcode(view, poly[0][k], false);
+    guard[k] = outcode(view, poly[0][k], true);
+  }
+  if (viewport[0] & viewport[1] & viewport[2]) {
+    ++c.culledOutside;
+    return 0;
+  }
+
+  // Clip only against the planes some vertex violates: the near plane first, so that w > 0
+  // holds before the guard planes (which pass through the eye) are tested.
+  uint32_t clipMask = guard[0] | guard[1] | guard[2];
+  int cur = 0;
+  if (clipMask) {
+    ++c.clipped;
+    for (int plane = 0; plane < kPlaneCount && n >= 3; ++plane) {
+      if (!(clipMask & (1u << plane))) continue;
+      n = clipPolygon(view, poly[cur], n, poly[cur ^ 1], plane);
+      cur ^= 1;
+    }
+    if (n < 3) {
+      ++c.culledOutside;
+      return 0;
+    }
+  }
+  PR_DCHECK(n <= kMaxPolygonVertices, "clipped polygon too large");
+
+  SnappedVertex s[kMaxPolygonVertices];
+  for (int k = 0; k < n; ++k) s[k] = snapVertex(view, poly[cur][k]);
+
+  // Facing of the whole (convex) polygon, from its snapped area: the sum of its fan.
+  int64_t area2 = 0;
+  for (int k = 1; k + 1 < n; ++k) area2 += signedArea2(s[0], s[k], s[k + 1]);
+  if (area2 == 0) {
+    ++c.culledDegenerate;
+    return 0;
+  }
+  bool backFacing = area2 < 0;
+  if (backFacing) {
+    if (!scene.materials[tri.material].doubleSided) {
+      ++c.culledBackFace;
+      return 0;
+    }
+    // Seen from behind: reverse the winding so every piece has positive area.
+    std::reverse(s + 1, s + n);
+  }
+
+  int count = 0;
+  for (int k = 1; k + 1 < n; ++k) {
+    // A piece whose snapped area is zero covers no sample; one flipped by snapping (a sliver
+    // at a clip vertex) is dropped rather than drawn inside-out.
+    if (signedArea2(s[0], s[k], s[k + 1]) <= 0) continue;
+    ScreenTriangle& t = out[count++];
+    const SnappedVertex* v[3] = {&s[0], &s[k], &s[k + 1]};
+    for (int j = 0; j < 3; ++j) {
+      t.x[j] = v[j]->x;
+      t.y[j] = v[j]->y;
+      t.depth[j] = v[j]->depth;
+      t.invW[j] = v[j]->invW;
+      t.bary[j] = v[j]->bary;
+    }
+    t.primitive = index;
+    t.sub = static_cast<uint8_t>(k - 1);
+    t.backFacing = backFacing ? 1 : 0;
+  }
+  if (count == 0) ++c.culledDegenerate;
+  c.screenTrianglesOut += static_cast<uint64_t>(count);
+  return count;
+}
+
+void processTriangles(const scene::Scene& scene, const FrameView& view, uint32_t first, uint32_t count,
+                      std::vector<ScreenTriangle>& out, GeometryCounters* counters) {
+  PR_CHECK(uint64_t(first) + count <= scene.triangles.size(), "triangle batch outside the scene");
+  PR_CHECK(scene.triangles.size() <= kMaxPrimitives,
+           "scene has more triangles than the depth key can order");
+  ScreenTriangle pieces[kMaxSubTriangles];
+  for (uint32_t i = first; i < first + count; ++i) {
+    int n = processTriangle(scene, view, i, pieces, counters);
+    out.insert(out.end(), pieces, pieces + n);
+  }
+}
+
+}  // namespace pr::raster

@@ -1,0 +1,72 @@
+// Shading stage, the last stage of every pipeline (deferred: after all triangles of a region
+// are rasterized, each visible pixel is shaded once from the triangle that won its depth test).
+// Perspective-correct attributes, base-colour / metallic-roughness / emissive textures through
+// Texture::sample (bilinear, the sampler's wrap modes), the scene's punctual lights with
+// Lambert plus a GGX glossy lobe, emission; no shadows. Runs on the PE owning the framebuffer.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <glm/glm.hpp>
+
+#include "common/scene/light.h"
+#include "common/scene/scene.h"
+#include "raster/stages/geometry.h"
+
+namespace pr::raster {
+
+class RegionFramebuffer;
+
+// Attributes of the scene surface seen through one pixel sample.
+struct SurfacePoint {
+  glm::vec3 position{0.0f};  // world space
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};  // unit; flipped towards the viewer on double-sided back faces
+  glm::vec2 uv{0.0f};
+  glm::vec4 colour{1.0f};    // COLOR_0, 1 when the scene has none
+  uint32_t material = 0;
+};
+
+// Barycentrics (b0, b1, b2) of the scene triangle at the sample of pixel (x, y), interpolated
+// perspective-correctly from the screen triangle: b = sum_k w_k bary_k / sum_k w_k with
+// w_k = E_k / w_k (E_k the exact edge values, clip-space w_k), the hyperbolic interpolation of
+// Heckbert & Moreton. Depends only on (tri, x, y).
+glm::vec3 sceneBarycentrics(const ScreenTriangle& tri, int x, int y);
+
+// The surface point of the scene triangle at those barycentrics.
+SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm::vec3 barycentrics);
+
+// Lights, view and scene for shading one frame.
+struct ShadingContext {
+  const scene::Scene* scene = nullptr;
+  FrameView view;
+  // The scene's punctual lights; when it has none, one directional headlight along the view
+  // direction of pi lux, so that a white Lambertian surface facing the camera has radiance 1
+  // (a scene lit only by emission or with no lights is still visible). usesHeadlight says so.
+  std::vector<scene::PunctualLight> lights;
+  bool usesHeadlight = false;
+};
+
+ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view);
+
+// BRDF value f_r(V, L) for the metallic-roughness model (glTF 2.0, Appendix B): Lambert
+// (1 - metallic) * base / pi plus the Cook-Torrance lobe D G F / (4 NdotL NdotV) with the GGX
+// distribution (alpha = roughness^2), Schlick-GGX geometry (k = alpha/2) and Schlick Fresnel
+// (F0 = mix(0.04, base, metallic)). N, V, L are unit vectors.
+glm::vec3 evalBrdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L);
+
+// Outgoing radiance towards the camera: emission + sum over lights of f_r * E * cos(theta).
+glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& point);
+
+struct ShadeCounters {
+  uint64_t pixelsShaded = 0;
+  ShadeCounters& operator+=(const ShadeCounters& o) { pixelsShaded += o.pixelsShaded; return *this; }
+};
+
+// Shades every covered pixel of fb from tris[fb.triangle(x, y)] (the list it was rasterized
+// from) and writes its colour. Uncovered pixels keep the background colour 0.
+void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+                 ShadeCounters* counters = nullptr);
+
+}  // namespace pr::raster
