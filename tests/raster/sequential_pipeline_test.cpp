@@ -33,7 +33,9 @@ scene::Scene busyScene() {
   glow.emissiveFactor = glm::vec3(2.0f, 2.0f, 1.0f);
   scene::Material checker = s.materials[0];
   checker.baseColorTexture.texture = 0;
-  s.materials.insert(s.materials.end(), {red, metal, glow, checker});
+  scene::Material green = red;
+  green.baseColorFactor = glm::vec4(0.1f, 0.9f, 0.1f, 1.0f);
+  s.materials.insert(s.materials.end(), {red, metal, glow, checker, green});
 
   scene::Texture tex;
   tex.width = tex.height = 4;
@@ -62,10 +64,11 @@ scene::Scene busyScene() {
     glm::vec3 a = centre + 1.5f * glm::vec3(u(rng), u(rng), u(rng));
     glm::vec3 b = centre + 1.5f * glm::vec3(u(rng), u(rng), u(rng));
     glm::vec3 c = centre + 1.5f * glm::vec3(u(rng), u(rng), u(rng));
-    uint32_t material = static_cast<uint32_t>(i % 4);
-    test::addTriangle(s, a, b, c, material);
-    // Every 10th triangle twice, with another material: same fragments, same depths.
-    if (i % 10 == 0) test::addTriangle(s, a, b, c, (material + 1) % 4);
+    // Every 10th triangle twice, red then green (both double-sided): same fragments, same
+    // depths, different colours.
+    bool duplicated = i % 10 == 0;
+    test::addTriangle(s, a, b, c, duplicated ? 1 : static_cast<uint32_t>(i % 4));
+    if (duplicated) test::addTriangle(s, a, b, c, 5);
   }
   s.uvs.resize(s.positions.size(), glm::vec2(0.25f));
   scene::PunctualLight point, spot, sun;
@@ -96,6 +99,15 @@ TEST_CASE("SequentialPipeline: region splits composite to the full-frame image b
   CHECK(stats.geometry.clipped > 0);
   CHECK(stats.geometry.culledBackFace > 0);
   CHECK(full.coveredPixels() > size_t(kW) * kH / 2);
+  // Exact depth ties are visible: pixels won by the first of a duplicated pair.
+  int ties = 0;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      uint32_t p = keyPrimitive(full.key(x, y));
+      ties += keyCovered(full.key(x, y)) && p + 1 < s.triangles.size() && s.triangles[p + 1].material == 5;
+    }
+  }
+  CHECK(ties > 20);
   for (int tile : {1, 5, 8, 16, 64}) {
     SequentialOptions options;
     options.regions = tileRegions(kW, kH, tile);
