@@ -1,0 +1,46 @@
+// The bundled scenes `parrender generate` can write: one line each (name, description, what
+// --size means and its range, whether --seed is used) and the function that builds it. The
+// table feeds --help, argument validation and scenes/README.md.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "tools/scenegen/gltf_builder.h"
+
+namespace pr::scenegen {
+
+struct SceneParams {
+  int size = 0;       // meaning per scene: SceneEntry::sizeMeaning
+  uint64_t seed = 0;  // used only where SceneEntry::usesSeed
+};
+
+struct SceneEntry {
+  std::string_view name;
+  std::string_view description;  // one line for --help
+  std::string_view sizeMeaning;  // what --size sets
+  int defaultSize = 0, minSize = 0, maxSize = 0;
+  bool usesSeed = false;
+  uint64_t defaultSeed = 0;
+  void (*build)(GltfBuilder& builder, const SceneParams& params) = nullptr;
+};
+
+const std::vector<SceneEntry>& sceneRegistry();
+
+// The entry called `name`; pr::InputError listing the known names otherwise.
+const SceneEntry& findScene(std::string_view name);
+
+// Builds scene `name`: checks the size range (InputError naming it), then runs the builder.
+// The asset's generator string records the scene, size and seed, so the file says how to
+// regenerate it.
+GltfBuilder generateScene(const SceneEntry& scene, const SceneParams& params);
+
+// The builders, one per file (cornell.cpp, landscape.cpp, hotspot.cpp).
+void buildCornell(GltfBuilder& builder, const SceneParams& params);
+void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params);
+void buildLandscape(GltfBuilder& builder, const SceneParams& params);
+void buildHotspot(GltfBuilder& builder, const SceneParams& params);
+
+}  // namespace pr::scenegen
