@@ -1,0 +1,113 @@
+// Channel<T>: typed message passing between PEs (one mailbox per PE), the only path for a PDI
+// or result to move between PEs. Every send is counted at the sender — messages and bytes per
+// sender->receiver pair and per stage — so the counts are the communication volume
+// (shared/DESIGN.md rule 1). With a handler the channel drives a message-driven phase: the
+// runtime runs the handler on the receiving PE and detects termination (termination.h).
+#pragma once
+
+#include <chrono>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/parallel/runtime.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+
+template <class T>
+class Channel : public ChannelBase {
+ public:
+  using Handler = std::function<void(Pe&, T&&)>;
+
+  // Without a handler, messages wait in the mailboxes until the receiver takes them
+  // (tryReceive inside a later task, or drain between stages).
+  Channel(Runtime& runtime, std::string name, Handler handler = {})
+      : runtime_(runtime), name_(std::move(name)), handler_(std::move(handler)) {
+    for (int p = 0; p < runtime_.pes(); ++p) boxes_.push_back(std::make_unique<Mailbox>());
+    if (handler_) runtime_.attach(this);
+  }
+  ~Channel() override {
+    if (handler_) runtime_.detach(this);
+  }
+  Channel(const Channel&) = delete;
+  Channel& operator=(const Channel&) = delete;
+
+  const std::string& name() const { return name_; }
+
+  // Called by PE `from` inside a task or handler. bytes is the message's size on a wire
+  // (defaults to sizeof(T); pass the real payload size for variable-length messages).
+  void send(Pe& from, int to, T message, std::size_t bytes = sizeof(T)) {
+    PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name_ + "': destination PE out of range");
+    const auto t0 = std::chrono::steady_clock::now();
+    runtime_.countMessage(from.id(), to, bytes);
+    if (handler_) runtime_.outstanding().add();  // before the receiver can see it
+    {
+      std::lock_guard lock(boxes_[to]->mutex);
+      boxes_[to]->queue.push_back(std::move(message));
+      boxes_[to]->size.store(boxes_[to]->queue.size(), std::memory_order_release);
+    }
+    runtime_.ring(to);
+    from.counters().commSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  // One copy to every other PE, counted once per receiving PE.
+  void broadcast(Pe& from, const T& message, std::size_t bytes = sizeof(T)) {
+    for (int p = 0; p < runtime_.pes(); ++p)
+      if (p != from.id()) send(from, p, message, bytes);
+  }
+
+  // Inside a task on PE `me`: takes one waiting message, if any.
+  bool tryReceive(Pe& me, T& out) {
+    PR_CHECK(!handler_, "Channel '" + name_ + "' has a handler; its messages are delivered to it");
+    return pop(me.id(), out);
+  }
+
+  // Between stages, on the controlling thread: every message waiting for pe, in arrival order.
+  std::vector<T> drain(int pe) {
+    std::lock_guard lock(boxes_[pe]->mutex);
+    std::vector<T> all(std::make_move_iterator(boxes_[pe]->queue.begin()),
+                       std::make_move_iterator(boxes_[pe]->queue.end()));
+    boxes_[pe]->queue.clear();
+    boxes_[pe]->size.store(0, std::memory_order_release);
+    return all;
+  }
+
+  bool pending(int pe) const override { return boxes_[pe]->size.load(std::memory_order_acquire) > 0; }
+
+  bool handleOne(Pe& pe) override {
+    T message;
+    if (!pop(pe.id(), message)) return false;
+    handler_(pe, std::move(message));
+    return true;
+  }
+
+ private:
+  struct Mailbox {
+    std::mutex mutex;
+    std::deque<T> queue;
+    std::atomic<std::size_t> size{0};  // lets an idle PE poll without taking the lock
+  };
+
+  bool pop(int pe, T& out) {
+    Mailbox& box = *boxes_[pe];
+    if (box.size.load(std::memory_order_acquire) == 0) return false;
+    std::lock_guard lock(box.mutex);
+    if (box.queue.empty()) return false;
+    out = std::move(box.queue.front());
+    box.queue.pop_front();
+    box.size.store(box.queue.size(), std::memory_order_release);
+    return true;
+  }
+
+  Runtime& runtime_;
+  std::string name_;
+  Handler handler_;
+  std::vector<std::unique_ptr<Mailbox>> boxes_;
+};
+
+}  // namespace pr::par

@@ -1,0 +1,231 @@
+// Derived figures (shared/STYLE.md §4: measured in one place, derived here only). Inputs are
+// RunRecords from runtime.cpp or simulator.cpp; outputs feed JSON, tables and reports.
+#include "common/parallel/metrics.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numeric>
+
+#include "common/util/error.h"
+
+namespace pr::par {
+
+Spread spreadOf(const std::vector<double>& values) {
+  if (values.empty()) return {};
+  Spread s{values[0], 0.0, values[0]};
+  for (double v : values) s.min = std::min(s.min, v), s.max = std::max(s.max, v), s.mean += v;
+  s.mean /= static_cast<double>(values.size());
+  return s;
+}
+
+double loadImbalance(const std::vector<double>& busy) {
+  const Spread s = spreadOf(busy);
+  return s.mean > 0.0 ? s.max / s.mean - 1.0 : 0.0;
+}
+
+const std::vector<PeFigure>& peFigures() {
+  static const std::vector<PeFigure> kFigures = {
+      {"busySeconds", [](const PeStageRecord& r) { return r.busySeconds; }},
+      {"idleSeconds", [](const PeStageRecord& r) { return r.idleSeconds; }},
+      {"syncWaitSeconds", [](const PeStageRecord& r) { return r.syncWaitSeconds; }},
+      {"commSeconds", [](const PeStageRecord& r) { return r.commSeconds; }},
+      {"tasks", [](const PeStageRecord& r) { return double(r.tasks); }},
+      {"messagesHandled", [](const PeStageRecord& r) { return double(r.messagesHandled); }},
+      {"messagesSent", [](const PeStageRecord& r) { return double(r.messagesSent); }},
+      {"bytesSent", [](const PeStageRecord& r) { return double(r.bytesSent); }},
+      {"messagesReceived", [](const PeStageRecord& r) { return double(r.messagesReceived); }},
+      {"bytesReceived", [](const PeStageRecord& r) { return double(r.bytesReceived); }},
+      {"schedulingMessages", [](const PeStageRecord& r) { return double(r.schedulingMessages); }},
+      {"schedulingBytes", [](const PeStageRecord& r) { return double(r.schedulingBytes); }},
+      {"broadcastBytesReceived", [](const PeStageRecord& r) { return double(r.broadcastBytesReceived); }},
+      {"cacheHits", [](const PeStageRecord& r) { return double(r.cacheHits); }},
+      {"cacheMisses", [](const PeStageRecord& r) { return double(r.cacheMisses); }},
+      {"prefetches", [](const PeStageRecord& r) { return double(r.prefetches); }},
+  };
+  return kFigures;
+}
+
+const Spread& StageSummary::figure(const std::string& figureName) const {
+  const auto& all = peFigures();
+  for (std::size_t i = 0; i < all.size(); ++i)
+    if (figureName == all[i].name) return figures.at(i);
+  PR_CHECK(false, "unknown per-PE figure " + figureName);
+  return figures.front();
+}
+
+namespace {
+
+StageSummary summarizePes(const std::string& name, const std::string& schedule, double wall,
+                          const std::vector<PeStageRecord>& pes) {
+  StageSummary s;
+  s.name = name;
+  s.schedule = schedule;
+  s.wallSeconds = wall;
+  std::vector<double> values(pes.size()), busy(pes.size());
+  for (const PeFigure& f : peFigures()) {
+    for (std::size_t p = 0; p < pes.size(); ++p) values[p] = f.get(pes[p]);
+    s.figures.push_back(spreadOf(values));
+  }
+  double busySum = 0.0, commSum = 0.0;
+  for (std::size_t p = 0; p < pes.size(); ++p) {
+    const PeStageRecord& r = pes[p];
+    busy[p] = r.busySeconds;
+    busySum += r.busySeconds;
+    commSum += r.commSeconds;
+    s.syncWaitSeconds += r.syncWaitSeconds;
+    s.tasks += r.tasks;
+    s.messages += r.messagesSent;
+    s.bytes += r.bytesSent;
+    s.schedulingMessages += r.schedulingMessages;
+    s.schedulingBytes += r.schedulingBytes;
+  }
+  s.imbalance = loadImbalance(busy);
+  s.efficiency = wall > 0.0 && !pes.empty() ? busySum / (wall * pes.size()) : 0.0;
+  s.computeToComm = commSum > 0.0 ? (busySum - commSum) / commSum : -1.0;
+  return s;
+}
+
+}  // namespace
+
+std::vector<PeStageRecord> peTotals(const RunRecord& record) {
+  std::vector<PeStageRecord> totals(record.pes);
+  for (const StageRecord& stage : record.stages) {
+    for (std::size_t p = 0; p < stage.pes.size() && p < totals.size(); ++p) {
+      const PeStageRecord& r = stage.pes[p];
+      PeStageRecord& t = totals[p];
+      t.busySeconds += r.busySeconds;
+      t.idleSeconds += r.idleSeconds;
+      t.syncWaitSeconds += r.syncWaitSeconds;
+      t.commSeconds += r.commSeconds;
+      t.tasks += r.tasks;
+      t.messagesHandled += r.messagesHandled;
+      t.messagesSent += r.messagesSent;
+      t.bytesSent += r.bytesSent;
+      t.messagesReceived += r.messagesReceived;
+      t.bytesReceived += r.bytesReceived;
+      t.schedulingMessages += r.schedulingMessages;
+      t.schedulingBytes += r.schedulingBytes;
+      t.broadcastsReceived += r.broadcastsReceived;
+      t.broadcastBytesReceived += r.broadcastBytesReceived;
+      t.cacheHits += r.cacheHits;
+      t.cacheMisses += r.cacheMisses;
+      t.prefetches += r.prefetches;
+    }
+  }
+  return totals;
+}
+
+RunSummary summarize(const RunRecord& record) {
+  RunSummary summary;
+  summary.pes = record.pes;
+  summary.wallSeconds = record.wallSeconds;
+  double stageWall = 0.0;
+  for (const StageRecord& stage : record.stages) {
+    summary.stages.push_back(summarizePes(stage.name, stage.schedule, stage.wallSeconds, stage.pes));
+    stageWall += stage.wallSeconds;
+  }
+  // Efficiency of the whole run over the time spent in stages; the controller's serial code
+  // between stages is not PE time.
+  summary.total = summarizePes("total", record.schedule, stageWall, peTotals(record));
+  return summary;
+}
+
+namespace {
+
+std::string number(double v) {
+  char buffer[32];
+  const double a = std::abs(v);
+  if (a != 0.0 && (a < 1e-3 || a >= 1e7))
+    std::snprintf(buffer, sizeof buffer, "%.3g", v);
+  else if (v == std::floor(v) && a < 1e7)
+    std::snprintf(buffer, sizeof buffer, "%.0f", v);
+  else
+    std::snprintf(buffer, sizeof buffer, "%.4f", v);
+  return buffer;
+}
+
+}  // namespace
+
+std::string formatSummary(const RunSummary& summary) {
+  std::string out;
+  char line[512];
+  std::snprintf(line, sizeof line, "P = %d, wall %.6f s\n", summary.pes, summary.wallSeconds);
+  out += line;
+  std::snprintf(line, sizeof line, "%-14s %-14s %10s %9s %8s %11s %9s %10s %12s\n", "stage", "schedule", "wall s",
+                "imbalance", "effic.", "sync wait s", "tasks", "messages", "bytes");
+  out += line;
+  auto row = [&](const StageSummary& s) {
+    std::snprintf(line, sizeof line, "%-14s %-14s %10.6f %9.4f %8.4f %11.6f %9llu %10llu %12llu\n", s.name.c_str(),
+                  s.schedule.c_str(), s.wallSeconds, s.imbalance, s.efficiency, s.syncWaitSeconds,
+                  (unsigned long long)s.tasks, (unsigned long long)s.messages, (unsigned long long)s.bytes);
+    out += line;
+  };
+  for (const StageSummary& s : summary.stages) row(s);
+  row(summary.total);
+  out += "per-PE figures over the run (min / mean / max):\n";
+  const auto& figures = peFigures();
+  for (std::size_t i = 0; i < figures.size(); ++i) {
+    const Spread& s = summary.total.figures[i];
+    std::snprintf(line, sizeof line, "  %-24s %14s %14s %14s\n", figures[i].name, number(s.min).c_str(),
+                  number(s.mean).c_str(), number(s.max).c_str());
+    out += line;
+  }
+  if (summary.total.computeToComm >= 0.0) {
+    std::snprintf(line, sizeof line, "computation-to-communication ratio: %.1f\n", summary.total.computeToComm);
+    out += line;
+  }
+  return out;
+}
+
+ScalingTable scalingTable(std::vector<ScalingPoint> points, double serialSeconds) {
+  std::sort(points.begin(), points.end(), [](const ScalingPoint& a, const ScalingPoint& b) { return a.pes < b.pes; });
+  if (points.empty() || points.front().pes != 1)
+    throw InputError("speed-up needs a run at P = 1 (T1)");
+  const double t1 = points.front().seconds;
+  ScalingTable table;
+  double best = std::numeric_limits<double>::infinity();
+  for (const ScalingPoint& pt : points) {
+    ScalingRow row;
+    row.pes = pt.pes;
+    row.seconds = pt.seconds;
+    row.speedup = pt.seconds > 0.0 ? t1 / pt.seconds : 0.0;
+    row.speedupSerial = serialSeconds > 0.0 && pt.seconds > 0.0 ? serialSeconds / pt.seconds : 0.0;
+    row.efficiency = row.speedup / pt.pes;
+    // Karp & Flatt (1990): e = (1/S - 1/P) / (1 - 1/P), undefined at P = 1.
+    row.karpFlatt = pt.pes > 1 && row.speedup > 0.0
+                        ? (1.0 / row.speedup - 1.0 / pt.pes) / (1.0 - 1.0 / pt.pes)
+                        : std::numeric_limits<double>::quiet_NaN();
+    if (pt.seconds < best) best = pt.seconds, table.bestPes = pt.pes;
+    table.rows.push_back(row);
+  }
+  for (const ScalingRow& row : table.rows) {
+    if (row.seconds <= best * (1.0 + kSaturationTolerance)) {
+      table.saturationPes = row.pes;
+      break;
+    }
+  }
+  return table;
+}
+
+std::string formatScaling(const ScalingTable& table) {
+  std::string out;
+  char line[256];
+  std::snprintf(line, sizeof line, "%6s %14s %10s %10s %10s %11s\n", "P", "time s", "T1/Tn", "Ts/Tn", "effic.",
+                "Karp-Flatt");
+  out += line;
+  for (const ScalingRow& r : table.rows) {
+    const std::string ts = r.speedupSerial > 0.0 ? number(r.speedupSerial) : "-";
+    const std::string kf = std::isnan(r.karpFlatt) ? "-" : number(r.karpFlatt);
+    std::snprintf(line, sizeof line, "%6d %14.6f %10.3f %10s %10.4f %11s\n", r.pes, r.seconds, r.speedup, ts.c_str(),
+                  r.efficiency, kf.c_str());
+    out += line;
+  }
+  std::snprintf(line, sizeof line, "best P measured: %d; adding PEs beyond P = %d gains less than %.0f%%\n",
+                table.bestPes, table.saturationPes, kSaturationTolerance * 100.0);
+  out += line;
+  return out;
+}
+
+}  // namespace pr::par

@@ -1,0 +1,82 @@
+// Metrics: the only code that turns RunRecords (measured or simulated) into figures — min/mean/
+// max over PEs of every per-PE figure, load imbalance, efficiency, time at synchronisation
+// points, computation-to-communication ratio — and runs at several P into speed-up, efficiency
+// and the Karp-Flatt serial fraction. Reports, JSON, the CLI and tests all read these.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/parallel/run_record.h"
+
+namespace pr::par {
+
+struct Spread {
+  double min = 0.0, mean = 0.0, max = 0.0;
+};
+Spread spreadOf(const std::vector<double>& values);
+
+// max(busy) / mean(busy) - 1 (shared/DESIGN.md); 0 for no work at all.
+double loadImbalance(const std::vector<double>& busySeconds);
+
+// The per-PE figures, by their JSON/C++ name, in a fixed order.
+struct PeFigure {
+  const char* name;
+  double (*get)(const PeStageRecord&);
+};
+const std::vector<PeFigure>& peFigures();
+
+struct StageSummary {
+  std::string name;      // "total" for the whole run
+  std::string schedule;
+  double wallSeconds = 0.0;
+  std::vector<Spread> figures;  // one per peFigures() entry
+  double imbalance = 0.0;
+  double efficiency = 0.0;       // sum(busy) / (P * wall)
+  double syncWaitSeconds = 0.0;  // summed over PEs
+  // sum(busy - comm) / sum(comm), the seed's computation-to-communication ratio; < 0 when no
+  // time was spent communicating (no messages).
+  double computeToComm = -1.0;
+  std::uint64_t tasks = 0, messages = 0, bytes = 0, schedulingMessages = 0, schedulingBytes = 0;
+
+  const Spread& figure(const std::string& name) const;
+};
+
+struct RunSummary {
+  int pes = 1;
+  double wallSeconds = 0.0;
+  std::vector<StageSummary> stages;
+  StageSummary total;  // per-PE figures summed over stages first
+};
+
+// Per-PE totals over all stages.
+std::vector<PeStageRecord> peTotals(const RunRecord& record);
+RunSummary summarize(const RunRecord& record);
+// A readable table: one row per stage and a total row; figures as min/mean/max.
+std::string formatSummary(const RunSummary& summary);
+
+// ---- runs at several P ----
+struct ScalingPoint {
+  int pes = 1;
+  double seconds = 0.0;  // wall time (measured) or makespan (simulated)
+};
+struct ScalingRow {
+  int pes = 1;
+  double seconds = 0.0;
+  double speedup = 0.0;        // T1 / Tn
+  double speedupSerial = 0.0;  // Ts / Tn, 0 when Ts is not known
+  double efficiency = 0.0;     // speedup / P
+  double karpFlatt = 0.0;      // (1/S - 1/P) / (1 - 1/P), the serial fraction Amdahl's law implies; NaN at P = 1
+};
+// Beyond saturationPes adding PEs buys less than this fraction of the best time.
+inline constexpr double kSaturationTolerance = 0.05;
+struct ScalingTable {
+  std::vector<ScalingRow> rows;  // by increasing P
+  int bestPes = 1;               // the P with the lowest time
+  int saturationPes = 1;         // the smallest P within kSaturationTolerance of the best time
+};
+// Needs a point at P = 1 (T1); throws pr::InputError otherwise. serialSeconds = Ts, or 0.
+ScalingTable scalingTable(std::vector<ScalingPoint> points, double serialSeconds = 0.0);
+std::string formatScaling(const ScalingTable& table);
+
+}  // namespace pr::par

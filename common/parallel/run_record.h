@@ -1,0 +1,88 @@
+// RunRecord: everything the runtime measured in one run — per PE and per stage busy/idle time,
+// task counts, messages and bytes per sender->receiver pair, cache hits and misses, and the
+// timeline of task spans. Filled by runtime.cpp (or simulator.cpp); metrics.cpp derives every
+// figure from it; run_record_json.cpp writes it as JSON and as a Chrome trace.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "common/parallel/task.h"
+
+namespace pr::par {
+
+// One PE in one stage. busy = inside tasks and message handlers; idle = stage wall - busy;
+// syncWaitSeconds = the part of idle after the PE's last piece of work until the stage ended
+// (waiting at the end-of-stage synchronisation point).
+struct PeStageRecord {
+  double busySeconds = 0.0;
+  double idleSeconds = 0.0;
+  double syncWaitSeconds = 0.0;
+  double commSeconds = 0.0;  // inside Channel send/receive, part of busy
+  std::uint64_t tasks = 0;
+  std::uint64_t messagesHandled = 0;
+  std::uint64_t messagesSent = 0, bytesSent = 0;
+  std::uint64_t messagesReceived = 0, bytesReceived = 0;
+  // Task requests and task packets between this PE and the controller or a neighbour.
+  std::uint64_t schedulingMessages = 0, schedulingBytes = 0;
+  // Replicated read-only data received (scene, photon map), counted once per receiving PE.
+  std::uint64_t broadcastsReceived = 0, broadcastBytesReceived = 0;
+  std::uint64_t cacheHits = 0, cacheMisses = 0, prefetches = 0;
+};
+
+// Messages and bytes from one PE to another within a stage (only non-zero pairs are kept).
+struct Traffic {
+  int from = 0, to = 0;
+  std::uint64_t messages = 0, bytes = 0;
+};
+
+struct StageRecord {
+  std::string name;
+  std::string schedule;
+  int grain = 1;
+  double startSeconds = 0.0;  // since the runtime started
+  double wallSeconds = 0.0;
+  std::vector<PeStageRecord> pes;
+  std::vector<Traffic> traffic;
+  std::vector<TaskInfo> tasks;  // the stage's TaskSet (cost estimates, positions)
+};
+
+// One task (or, with task = kMessageSpan, one message handler) on one PE.
+inline constexpr TaskId kMessageSpan = -1;
+struct TaskSpan {
+  int pe = 0;
+  int stage = 0;  // index into RunRecord::stages
+  TaskId task = 0;
+  double start = 0.0, end = 0.0;  // seconds since the runtime started
+  std::uint32_t messagesSent = 0;  // data messages the task sent, for the simulator
+  std::uint64_t bytesSent = 0;
+};
+
+struct RunRecord {
+  int pes = 1;
+  std::string schedule;
+  int grain = 1;
+  double wallSeconds = 0.0;  // first stage start to last stage end
+  std::vector<StageRecord> stages;
+  std::vector<TaskSpan> timeline;
+  std::string error;  // the error that ended the run, empty when it completed
+};
+
+// Measured cost of every task of stage `stage` (sum of its spans), for an unbalanced
+// data-driven split or a hot-spots order in a later run: the "profile recorded by an earlier run".
+std::vector<double> taskCostProfile(const RunRecord& record, int stage);
+
+// JSON (run_record_json.cpp). write* throw pr::InputError when the file cannot be written;
+// readRunRecord throws pr::InputError naming the file and the missing or malformed key.
+std::string toJsonText(const RunRecord& record);
+void writeRunRecord(const RunRecord& record, const std::filesystem::path& file);
+RunRecord readRunRecord(const std::filesystem::path& file);
+RunRecord runRecordFromJsonText(const std::string& text, const std::string& origin);
+// Chrome trace-event format ("X" complete events, one track per PE), for Perfetto or
+// chrome://tracing.
+void writeChromeTrace(const RunRecord& record, const std::filesystem::path& file);
+std::string toChromeTraceText(const RunRecord& record);
+
+}  // namespace pr::par

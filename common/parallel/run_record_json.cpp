@@ -1,0 +1,235 @@
+// RunRecord as JSON (--metrics FILE) and as a Chrome trace (--trace FILE), and back from JSON
+// for `parrender simulate`. Keys are the C++ field names (shared/STYLE.md §2). The derived
+// "summary" block is written from metrics.cpp for readers; it is ignored when reading.
+// Timeline spans are compact arrays [pe, stage, task, start, end, messagesSent, bytesSent].
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "common/parallel/metrics.h"
+#include "common/parallel/run_record.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+
+using nlohmann::json;
+
+std::vector<double> taskCostProfile(const RunRecord& record, int stage) {
+  PR_CHECK(stage >= 0 && stage < static_cast<int>(record.stages.size()), "taskCostProfile: no such stage");
+  std::vector<double> costs(record.stages[stage].tasks.size(), 0.0);
+  for (const TaskSpan& span : record.timeline)
+    if (span.stage == stage && span.task >= 0 && span.task < static_cast<TaskId>(costs.size()))
+      costs[span.task] += span.end - span.start;
+  return costs;
+}
+
+namespace {
+
+json spreadJson(const Spread& s) { return {{"min", s.min}, {"mean", s.mean}, {"max", s.max}}; }
+
+json summaryJson(const StageSummary& s) {
+  json j = {{"wallSeconds", s.wallSeconds},     {"imbalance", s.imbalance},
+            {"efficiency", s.efficiency},       {"syncWaitSeconds", s.syncWaitSeconds},
+            {"tasks", s.tasks},                 {"messages", s.messages},
+            {"bytes", s.bytes},                 {"schedulingMessages", s.schedulingMessages},
+            {"schedulingBytes", s.schedulingBytes}};
+  j["computeToComm"] = s.computeToComm >= 0.0 ? json(s.computeToComm) : json(nullptr);
+  json perPe = json::object();
+  const auto& figures = peFigures();
+  for (std::size_t i = 0; i < figures.size(); ++i) perPe[figures[i].name] = spreadJson(s.figures[i]);
+  j["perPe"] = perPe;
+  return j;
+}
+
+json peJson(const PeStageRecord& r) {
+  return {{"busySeconds", r.busySeconds},
+          {"idleSeconds", r.idleSeconds},
+          {"syncWaitSeconds", r.syncWaitSeconds},
+          {"commSeconds", r.commSeconds},
+          {"tasks", r.tasks},
+          {"messagesHandled", r.messagesHandled},
+          {"messagesSent", r.messagesSent},
+          {"bytesSent", r.bytesSent},
+          {"messagesReceived", r.messagesReceived},
+          {"bytesReceived", r.bytesReceived},
+          {"schedulingMessages", r.schedulingMessages},
+          {"schedulingBytes", r.schedulingBytes},
+          {"broadcastsReceived", r.broadcastsReceived},
+          {"broadcastBytesReceived", r.broadcastBytesReceived},
+          {"cacheHits", r.cacheHits},
+          {"cacheMisses", r.cacheMisses},
+          {"prefetches", r.prefetches}};
+}
+
+json toJson(const RunRecord& record) {
+  json j;
+  j["pes"] = record.pes;
+  j["schedule"] = record.schedule;
+  j["grain"] = record.grain;
+  j["wallSeconds"] = record.wallSeconds;
+  j["error"] = record.error;
+  const RunSummary summary = summarize(record);
+  j["summary"] = summaryJson(summary.total);
+  json stages = json::array();
+  for (std::size_t i = 0; i < record.stages.size(); ++i) {
+    const StageRecord& s = record.stages[i];
+    json js = {{"name", s.name},
+               {"schedule", s.schedule},
+               {"grain", s.grain},
+               {"startSeconds", s.startSeconds},
+               {"wallSeconds", s.wallSeconds},
+               {"summary", summaryJson(summary.stages[i])}};
+    json pes = json::array();
+    for (const PeStageRecord& r : s.pes) pes.push_back(peJson(r));
+    js["pes"] = pes;
+    json traffic = json::array();
+    for (const Traffic& t : s.traffic)
+      traffic.push_back({{"from", t.from}, {"to", t.to}, {"messages", t.messages}, {"bytes", t.bytes}});
+    js["traffic"] = traffic;
+    json tasks = json::array();
+    for (const TaskInfo& t : s.tasks) tasks.push_back({t.costEstimate, t.x, t.y});
+    js["tasks"] = tasks;  // [costEstimate, x, y]
+    stages.push_back(js);
+  }
+  j["stages"] = stages;
+  json timeline = json::array();
+  for (const TaskSpan& t : record.timeline)
+    timeline.push_back({t.pe, t.stage, t.task, t.start, t.end, t.messagesSent, t.bytesSent});
+  j["timeline"] = timeline;
+  return j;
+}
+
+void writeText(const std::string& text, const std::filesystem::path& file, const char* what) {
+  std::ofstream out(file);
+  if (!out) throw InputError(std::string("cannot write ") + what + " file '" + file.string() + "'");
+  out << text;
+  if (!out) throw InputError(std::string("error writing ") + what + " file '" + file.string() + "'");
+}
+
+// Reads key from object j, or throws InputError naming origin, where and key.
+template <class T>
+T field(const json& j, const char* key, const std::string& origin, const std::string& where) {
+  auto it = j.find(key);
+  if (it == j.end()) throw InputError(origin + ": " + where + " has no \"" + key + "\"");
+  try {
+    return it->get<T>();
+  } catch (const json::exception&) {
+    throw InputError(origin + ": " + where + " \"" + key + "\" has the wrong type");
+  }
+}
+
+}  // namespace
+
+std::string toJsonText(const RunRecord& record) { return toJson(record).dump(1) + "\n"; }
+
+void writeRunRecord(const RunRecord& record, const std::filesystem::path& file) {
+  writeText(toJsonText(record), file, "metrics");
+}
+
+RunRecord runRecordFromJsonText(const std::string& text, const std::string& origin) {
+  json j;
+  try {
+    j = json::parse(text);
+  } catch (const json::parse_error& e) {
+    throw InputError(origin + ": not valid JSON (" + e.what() + ")");
+  }
+  if (!j.is_object()) throw InputError(origin + ": expected a run record (a JSON object)");
+  RunRecord record;
+  record.pes = field<int>(j, "pes", origin, "run record");
+  if (record.pes < 1) throw InputError(origin + ": \"pes\" must be at least 1");
+  record.schedule = j.value("schedule", std::string());
+  record.grain = j.value("grain", 1);
+  record.wallSeconds = j.value("wallSeconds", 0.0);
+  record.error = j.value("error", std::string());
+  const json stages = field<json>(j, "stages", origin, "run record");
+  if (!stages.is_array()) throw InputError(origin + ": \"stages\" must be an array");
+  for (std::size_t i = 0; i < stages.size(); ++i) {
+    const json& js = stages[i];
+    const std::string where = "stage " + std::to_string(i);
+    StageRecord s;
+    s.name = field<std::string>(js, "name", origin, where);
+    s.schedule = js.value("schedule", std::string());
+    s.grain = js.value("grain", 1);
+    s.startSeconds = js.value("startSeconds", 0.0);
+    s.wallSeconds = field<double>(js, "wallSeconds", origin, where);
+    for (const json& jp : js.value("pes", json::array())) {
+      PeStageRecord r;
+      r.busySeconds = jp.value("busySeconds", 0.0);
+      r.idleSeconds = jp.value("idleSeconds", 0.0);
+      r.syncWaitSeconds = jp.value("syncWaitSeconds", 0.0);
+      r.commSeconds = jp.value("commSeconds", 0.0);
+      r.tasks = jp.value("tasks", std::uint64_t{0});
+      r.messagesHandled = jp.value("messagesHandled", std::uint64_t{0});
+      r.messagesSent = jp.value("messagesSent", std::uint64_t{0});
+      r.bytesSent = jp.value("bytesSent", std::uint64_t{0});
+      r.messagesReceived = jp.value("messagesReceived", std::uint64_t{0});
+      r.bytesReceived = jp.value("bytesReceived", std::uint64_t{0});
+      r.schedulingMessages = jp.value("schedulingMessages", std::uint64_t{0});
+      r.schedulingBytes = jp.value("schedulingBytes", std::uint64_t{0});
+      r.broadcastsReceived = jp.value("broadcastsReceived", std::uint64_t{0});
+      r.broadcastBytesReceived = jp.value("broadcastBytesReceived", std::uint64_t{0});
+      r.cacheHits = jp.value("cacheHits", std::uint64_t{0});
+      r.cacheMisses = jp.value("cacheMisses", std::uint64_t{0});
+      r.prefetches = jp.value("prefetches", std::uint64_t{0});
+      s.pes.push_back(r);
+    }
+    for (const json& jt : js.value("traffic", json::array()))
+      s.traffic.push_back({jt.value("from", 0), jt.value("to", 0), jt.value("messages", std::uint64_t{0}),
+                           jt.value("bytes", std::uint64_t{0})});
+    const json tasks = field<json>(js, "tasks", origin, where);
+    for (const json& jt : tasks) {
+      if (!jt.is_array() || jt.size() != 3 || !jt[0].is_number())
+        throw InputError(origin + ": " + where + " \"tasks\" entries must be [costEstimate, x, y]");
+      s.tasks.push_back({jt[0].get<double>(), jt[1].get<float>(), jt[2].get<float>()});
+    }
+    record.stages.push_back(std::move(s));
+  }
+  const json timeline = field<json>(j, "timeline", origin, "run record");
+  for (const json& jt : timeline) {
+    if (!jt.is_array() || jt.size() != 7)
+      throw InputError(origin + ": \"timeline\" entries must be [pe, stage, task, start, end, messagesSent, bytesSent]");
+    TaskSpan span{jt[0].get<int>(), jt[1].get<int>(), jt[2].get<TaskId>(), jt[3].get<double>(),
+                  jt[4].get<double>(), jt[5].get<std::uint32_t>(), jt[6].get<std::uint64_t>()};
+    if (span.stage < 0 || span.stage >= static_cast<int>(record.stages.size()) || span.pe < 0 ||
+        span.pe >= record.pes || span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
+      throw InputError(origin + ": \"timeline\" span names a PE, stage or task the record does not have");
+    record.timeline.push_back(span);
+  }
+  return record;
+}
+
+RunRecord readRunRecord(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError("cannot read metrics file '" + file.string() + "'");
+  std::stringstream text;
+  text << in.rdbuf();
+  return runRecordFromJsonText(text.str(), "metrics file '" + file.string() + "'");
+}
+
+std::string toChromeTraceText(const RunRecord& record) {
+  json events = json::array();
+  for (int p = 0; p < record.pes; ++p)
+    events.push_back({{"name", "thread_name"}, {"ph", "M"}, {"pid", 0}, {"tid", p},
+                      {"args", {{"name", "PE " + std::to_string(p)}}}});
+  for (const TaskSpan& t : record.timeline) {
+    const std::string stage = t.stage < static_cast<int>(record.stages.size()) ? record.stages[t.stage].name : "?";
+    events.push_back({{"name", t.task == kMessageSpan ? "message" : "task " + std::to_string(t.task)},
+                      {"cat", stage},
+                      {"ph", "X"},
+                      {"pid", 0},
+                      {"tid", t.pe},
+                      {"ts", t.start * 1e6},  // microseconds, as the format requires
+                      {"dur", (t.end - t.start) * 1e6},
+                      {"args", {{"stage", stage}, {"task", t.task}, {"messagesSent", t.messagesSent}, {"bytesSent", t.bytesSent}}}});
+  }
+  json j = {{"traceEvents", events}, {"displayTimeUnit", "ms"}};
+  return j.dump() + "\n";
+}
+
+void writeChromeTrace(const RunRecord& record, const std::filesystem::path& file) {
+  writeText(toChromeTraceText(record), file, "trace");
+}
+
+}  // namespace pr::par

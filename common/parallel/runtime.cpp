@@ -1,0 +1,276 @@
+// The thread engine: one std::thread per PE for each stage, a Scheduler shared by all of them,
+// counters per PE, and the end-of-stage bookkeeping that turns counters into a StageRecord.
+// Sits between the renderers' stages and metrics.cpp (seed chapter 3, task management).
+#include "common/parallel/runtime.h"
+
+#include <algorithm>
+#include <condition_variable>
+#include <thread>
+
+#include "common/util/error.h"
+
+namespace pr::par {
+
+// Where an idle PE blocks until a message arrives for it or the stage ends. `rung` is set
+// under the mutex after every enqueue, so a message sent between the PE's last poll and its
+// wait is never missed.
+struct Runtime::Doorbell {
+  std::mutex mutex;
+  std::condition_variable cv;
+  bool rung = false;
+};
+
+Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(std::chrono::steady_clock::now()) {
+  if (options_.pes < 1 || options_.pes > 4096)
+    throw InputError("number of PEs must be in [1, 4096], got " + std::to_string(options_.pes));
+  if (options_.params.grain < 1)
+    throw InputError("grain must be at least 1 task, got " + std::to_string(options_.params.grain));
+  options_.params.pes = options_.pes;
+  schedule_ = makeScheduler(options_.schedule);
+  const int p = options_.pes;
+  counters_ = std::vector<PeCounters>(p);
+  pairMessages_ = std::vector<std::atomic<std::uint64_t>>(static_cast<std::size_t>(p) * p);
+  pairBytes_ = std::vector<std::atomic<std::uint64_t>>(static_cast<std::size_t>(p) * p);
+  for (int i = 0; i < p; ++i) bells_.push_back(std::make_unique<Doorbell>());
+  spans_.resize(p);
+  record_.pes = p;
+  record_.schedule = options_.schedule;
+  record_.grain = options_.params.grain;
+}
+
+Runtime::~Runtime() = default;
+
+void Runtime::runStage(std::string_view name, const TaskSet& tasks, const TaskFn& work) {
+  runStage(name, tasks, *schedule_, work);
+}
+
+void Runtime::recordBroadcast(std::size_t bytesPerPe) {
+  PR_CHECK(!inStage_, "recordBroadcast is called between stages");
+  pendingBroadcasts_ += 1;
+  pendingBroadcastBytes_ += bytesPerPe;
+}
+
+void Runtime::attach(ChannelBase* channel) {
+  PR_CHECK(!inStage_, "channels with handlers are created between stages");
+  channels_.push_back(channel);
+}
+
+void Runtime::detach(ChannelBase* channel) {
+  PR_CHECK(!inStage_, "channels with handlers are destroyed between stages");
+  channels_.erase(std::remove(channels_.begin(), channels_.end(), channel), channels_.end());
+}
+
+void Runtime::countMessage(int from, int to, std::size_t bytes) {
+  PR_CHECK(inStage_, "messages are sent by PEs inside a stage");
+  if (from == to) return;  // not a transfer between PEs
+  const std::size_t pair = static_cast<std::size_t>(from) * options_.pes + to;
+  pairMessages_[pair].fetch_add(1, std::memory_order_relaxed);
+  pairBytes_[pair].fetch_add(bytes, std::memory_order_relaxed);
+  counters_[from].messagesSent.fetch_add(1, std::memory_order_relaxed);
+  counters_[from].bytesSent.fetch_add(bytes, std::memory_order_relaxed);
+  counters_[to].messagesReceived.fetch_add(1, std::memory_order_relaxed);
+  counters_[to].bytesReceived.fetch_add(bytes, std::memory_order_relaxed);
+}
+
+void Runtime::ring(int pe) {
+  Doorbell& bell = *bells_[pe];
+  {
+    std::lock_guard lock(bell.mutex);
+    bell.rung = true;
+  }
+  bell.cv.notify_one();
+}
+
+void Runtime::ringAll() {
+  for (int p = 0; p < options_.pes; ++p) ring(p);
+}
+
+void Runtime::fail(int p, const std::string& stage, TaskId task, std::exception_ptr error) {
+  {
+    std::lock_guard lock(errorMutex_);
+    if (!error_) {
+      error_ = error;
+      std::string what = "unknown exception";
+      try {
+        std::rethrow_exception(error);
+      } catch (const std::exception& e) {
+        what = e.what();
+      } catch (...) {
+      }
+      record_.error = "stage '" + stage + "', PE " + std::to_string(p) +
+                      (task == kMessageSpan ? ", message handler" : ", task " + std::to_string(task)) + ": " + what;
+    }
+  }
+  abort_.store(true, std::memory_order_release);
+  ringAll();
+}
+
+void Runtime::waitForWork(int p) {
+  Doorbell& bell = *bells_[p];
+  std::unique_lock lock(bell.mutex);
+  bell.cv.wait(lock, [&] { return bell.rung || outstanding_.finished() || abort_.load(std::memory_order_acquire); });
+  bell.rung = false;
+}
+
+// Handles every message waiting for pe in the handled channels; true when it handled any.
+bool Runtime::handleMessages(Pe& pe, std::vector<TaskSpan>& spans) {
+  bool any = false;
+  PeCounters& c = pe.counters();
+  for (ChannelBase* channel : channels_) {
+    while (channel->pending(pe.id()) && !abort_.load(std::memory_order_relaxed)) {
+      const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
+      const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
+      const double t0 = now();
+      if (!channel->handleOne(pe)) break;
+      const double t1 = now();
+      c.busySeconds += t1 - t0;
+      c.lastWorkEnd = t1;
+      c.messagesHandled.fetch_add(1, std::memory_order_relaxed);
+      if (options_.recordTimeline)
+        spans.push_back({pe.id(), pe.stage(), kMessageSpan, t0, t1,
+                         static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
+                         c.bytesSent.load(std::memory_order_relaxed) - b0});
+      any = true;
+      if (outstanding_.done()) ringAll();
+    }
+  }
+  return any;
+}
+
+// The loop of one PE for one stage: messages first (they unblock other PEs), then the next
+// task(s) from the scheduler, then wait until a message arrives or the stage's work is done.
+void Runtime::peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name) {
+  PeCounters& c = counters_[p];
+  Pe pe(*this, p, options_.pes, stage, name, c);
+  std::vector<TaskSpan>& spans = spans_[p];
+  Grab grab;
+  bool tasksLeft = true;
+  TaskId current = kMessageSpan;
+  try {
+    while (!abort_.load(std::memory_order_acquire)) {
+      current = kMessageSpan;
+      if (handleMessages(pe, spans)) continue;
+      if (tasksLeft) {
+        scheduler.next(p, now(), grab);
+        if (grab.tasks.empty()) {
+          tasksLeft = false;
+          continue;
+        }
+        if (grab.from != p && grab.packets + grab.requests > 0) {
+          c.schedulingMessages.fetch_add(grab.requests + grab.packets, std::memory_order_relaxed);
+          c.schedulingBytes.fetch_add(grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes +
+                                          grab.moved * kTaskEntryBytes,
+                                      std::memory_order_relaxed);
+        }
+        for (TaskId id : grab.tasks) {
+          if (abort_.load(std::memory_order_relaxed)) break;
+          current = id;
+          const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
+          const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
+          const double t0 = now();
+          work(pe, id);
+          const double t1 = now();
+          c.busySeconds += t1 - t0;
+          c.lastWorkEnd = t1;
+          c.tasks.fetch_add(1, std::memory_order_relaxed);
+          if (options_.recordTimeline)
+            spans.push_back({p, stage, id, t0, t1,
+                             static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
+                             c.bytesSent.load(std::memory_order_relaxed) - b0});
+          scheduler.finished(p, id, t1 - t0);
+          if (outstanding_.done()) ringAll();
+          current = kMessageSpan;
+          handleMessages(pe, spans);
+        }
+        continue;
+      }
+      if (outstanding_.finished()) break;
+      waitForWork(p);
+    }
+  } catch (...) {
+    fail(p, name, current, std::current_exception());
+  }
+}
+
+void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work) {
+  PR_CHECK(!inStage_, "runStage is called by the controlling thread, not from inside a stage");
+  const int pes = options_.pes;
+  const std::string name(nameView);
+  const int stage = static_cast<int>(record_.stages.size());
+
+  // Reset the live state; no PE thread exists at this point.
+  for (PeCounters& c : counters_) {
+    for (auto* a : {&c.tasks, &c.messagesHandled, &c.messagesSent, &c.bytesSent, &c.messagesReceived,
+                    &c.bytesReceived, &c.schedulingMessages, &c.schedulingBytes, &c.cacheHits, &c.cacheMisses,
+                    &c.prefetches})
+      a->store(0, std::memory_order_relaxed);
+    c.busySeconds = c.commSeconds = 0.0;
+  }
+  for (auto& a : pairMessages_) a.store(0, std::memory_order_relaxed);
+  for (auto& a : pairBytes_) a.store(0, std::memory_order_relaxed);
+  for (auto& bell : bells_) bell->rung = false;
+  for (auto& s : spans_) s.clear();
+  abort_.store(false);
+  error_ = nullptr;
+  outstanding_.reset(static_cast<std::int64_t>(tasks.size()));
+  ScheduleParams params = options_.params;
+  params.pes = pes;
+  scheduler.reset(tasks, params);
+
+  inStage_ = true;
+  const double start = now();
+  for (PeCounters& c : counters_) c.lastWorkEnd = start;
+  {
+    std::vector<std::thread> threads;
+    threads.reserve(pes);
+    for (int p = 0; p < pes; ++p)
+      threads.emplace_back([&, p] { peLoop(p, scheduler, work, stage, name); });
+    for (std::thread& t : threads) t.join();
+  }
+  const double end = now();
+  inStage_ = false;
+
+  // The StageRecord: idle = wall - busy; the wait at the closing barrier is the time after the
+  // PE's last piece of work.
+  StageRecord sr;
+  sr.name = name;
+  sr.schedule = std::string(scheduler.name());
+  sr.grain = params.grain;
+  sr.startSeconds = start;
+  sr.wallSeconds = end - start;
+  sr.tasks = tasks.tasks;
+  sr.pes.resize(pes);
+  for (int p = 0; p < pes; ++p) {
+    const PeCounters& c = counters_[p];
+    PeStageRecord& r = sr.pes[p];
+    r.busySeconds = c.busySeconds;
+    r.idleSeconds = std::max(0.0, sr.wallSeconds - c.busySeconds);
+    r.syncWaitSeconds = std::max(0.0, end - std::max(c.lastWorkEnd, start));
+    r.commSeconds = c.commSeconds;
+    r.tasks = c.tasks.load();
+    r.messagesHandled = c.messagesHandled.load();
+    r.messagesSent = c.messagesSent.load();
+    r.bytesSent = c.bytesSent.load();
+    r.messagesReceived = c.messagesReceived.load();
+    r.bytesReceived = c.bytesReceived.load();
+    r.schedulingMessages = c.schedulingMessages.load();
+    r.schedulingBytes = c.schedulingBytes.load();
+    r.broadcastsReceived = pendingBroadcasts_;
+    r.broadcastBytesReceived = pendingBroadcastBytes_;
+    r.cacheHits = c.cacheHits.load();
+    r.cacheMisses = c.cacheMisses.load();
+    r.prefetches = c.prefetches.load();
+    for (int q = 0; q < pes; ++q) {
+      const std::size_t pair = static_cast<std::size_t>(p) * pes + q;
+      if (pairMessages_[pair].load() > 0) sr.traffic.push_back({p, q, pairMessages_[pair].load(), pairBytes_[pair].load()});
+    }
+  }
+  pendingBroadcasts_ = pendingBroadcastBytes_ = 0;
+  record_.stages.push_back(std::move(sr));
+  for (auto& s : spans_) record_.timeline.insert(record_.timeline.end(), s.begin(), s.end());
+  record_.wallSeconds = end - record_.stages.front().startSeconds;
+
+  if (error_) std::rethrow_exception(error_);
+}
+
+}  // namespace pr::par

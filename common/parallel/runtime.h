@@ -1,0 +1,129 @@
+// Runtime: P processing elements on threads, the system controller that hands out tasks
+// through a Scheduler, and the measurements (busy/idle per PE and stage, task spans, message
+// counts) that every renderer's run record is made of. The heart of common/parallel; every
+// renderer runs on it (seed chapters 2-4, shared/DESIGN.md "Parallel runtime").
+//
+// How a renderer uses it
+// ----------------------
+// A stage is a TaskSet (one task per PDI: tile, primitive batch, ray batch) plus a work
+// function called as work(pe, taskId) on the PE the schedule chose. PEs talk only through
+// Channels; a Channel constructed with a handler makes the stage message-driven: the stage
+// ends when every task has run and every message (and the messages its handler sent) has been
+// handled (termination.h). The runtime, not the algorithm, times tasks and handlers.
+//
+//   par::Runtime rt(8, "spiral", scheduleOptions.params);   // or from --schedule/--grain
+//   par::Channel<RayBatch> rays(rt, "rays", [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
+//   rt.recordBroadcast(sceneBytes);                         // the scene, replicated on every PE
+//   rt.runStage("trace", par::TaskSet::grid(tilesX, tilesY), [&](par::Pe& pe, par::TaskId t) {
+//     for (RayBatch& b : primaryRays(t)) rays.send(pe, ownerOf(b), std::move(b), b.bytes());
+//   });
+//   par::writeRunRecord(rt.record(), "run.json");           // per-PE busy/idle, traffic, timeline
+//
+// An exception thrown by a task or handler stops every PE at its next task boundary and is
+// rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
+// P may exceed the core count: idle PEs block on a condition variable, they do not spin.
+#pragma once
+
+#include <chrono>
+#include <cstddef>
+#include <exception>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/parallel/pe.h"
+#include "common/parallel/run_record.h"
+#include "common/parallel/schedulers/scheduler.h"
+#include "common/parallel/task.h"
+#include "common/parallel/termination.h"
+
+namespace pr::par {
+
+struct RuntimeOptions {
+  int pes = 1;
+  std::string schedule = "demand";  // registry name (schedulers/registry.cpp)
+  ScheduleParams params;            // params.pes is set from pes
+  bool recordTimeline = true;       // keep one TaskSpan per task and handled message
+};
+
+// A mailbox set the runtime polls on behalf of a PE (implemented by Channel<T>).
+class ChannelBase {
+ public:
+  virtual ~ChannelBase() = default;
+  virtual bool pending(int pe) const = 0;
+  // Pops one message for pe and runs the handler on it; false when there was none.
+  virtual bool handleOne(Pe& pe) = 0;
+};
+
+class Runtime {
+ public:
+  using TaskFn = std::function<void(Pe&, TaskId)>;
+
+  // Throws pr::InputError for pes outside [1, 4096] or an unknown schedule.
+  explicit Runtime(RuntimeOptions options);
+  Runtime(int pes, std::string schedule = "demand", ScheduleParams params = ScheduleParams())
+      : Runtime(RuntimeOptions{pes, std::move(schedule), params, true}) {}
+  ~Runtime();
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  int pes() const { return options_.pes; }
+  const RuntimeOptions& options() const { return options_; }
+
+  // Runs one stage on all PEs and returns when it is over (a barrier). Called by the
+  // renderer's controlling thread, never from inside a task. The first overload uses the
+  // runtime's schedule (options().schedule).
+  void runStage(std::string_view name, const TaskSet& tasks, const TaskFn& work);
+  void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work);
+
+  // Replicated read-only data (scene, photon map) of bytesPerPe, sent once to every PE:
+  // counted as one broadcast message per receiving PE in the next stage run.
+  void recordBroadcast(std::size_t bytesPerPe);
+
+  const RunRecord& record() const { return record_; }
+  // Seconds since the runtime was created (steady clock).
+  double now() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
+  }
+
+  // ---- for Channel and DataManager, on PE threads during a stage ----
+  // Counts one message from pe `from` to pe `to` (nothing for a message to oneself).
+  void countMessage(int from, int to, std::size_t bytes);
+  OutstandingWork& outstanding() { return outstanding_; }
+  void ring(int pe);  // wakes pe if it waits for messages
+  void attach(ChannelBase* channel);
+  void detach(ChannelBase* channel);
+  bool inStage() const { return inStage_; }
+
+ private:
+  struct Doorbell;
+
+  void peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name);
+  bool handleMessages(Pe& pe, std::vector<TaskSpan>& spans);
+  void waitForWork(int p);
+  void ringAll();
+  void fail(int p, const std::string& stage, TaskId task, std::exception_ptr error);
+
+  RuntimeOptions options_;
+  std::unique_ptr<Scheduler> schedule_;
+  std::chrono::steady_clock::time_point epoch_;
+  RunRecord record_;
+
+  std::vector<ChannelBase*> channels_;
+  std::vector<PeCounters> counters_;
+  std::vector<std::atomic<std::uint64_t>> pairMessages_, pairBytes_;  // P x P, row = sender
+  std::vector<std::unique_ptr<Doorbell>> bells_;
+  std::vector<std::vector<TaskSpan>> spans_;
+  OutstandingWork outstanding_;
+  std::atomic<bool> abort_{false};
+  bool inStage_ = false;
+  std::size_t pendingBroadcastBytes_ = 0, pendingBroadcasts_ = 0;
+
+  std::mutex errorMutex_;
+  std::exception_ptr error_;
+};
+
+}  // namespace pr::par

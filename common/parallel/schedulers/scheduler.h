@@ -1,0 +1,109 @@
+// Scheduler: how a PE gets its next task(s) — the computational models and task-management
+// strategies of the seed (chapter 3: data-driven, demand-driven, hybrid, task manager,
+// distributed task management, preferred bias). One implementation per file beside this one,
+// one line each in registry.cpp. The same object is driven by the thread engine (runtime.cpp,
+// real time, PEs calling concurrently) and by the simulator (simulator.cpp, virtual time).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/parallel/task.h"
+
+namespace pr::par {
+
+// The system controller: the source of tasks that do not come from another PE.
+inline constexpr int kController = -1;
+
+// Sizes of the scheduling messages, as a distributed-memory implementation would send them:
+// a request names the PE; a task packet has a header and one task id per task.
+inline constexpr std::size_t kTaskRequestBytes = 16;
+inline constexpr std::size_t kTaskPacketHeaderBytes = 16;
+inline constexpr std::size_t kTaskEntryBytes = sizeof(TaskId);
+
+struct ScheduleParams {
+  int pes = 1;
+  int grain = 1;               // tasks per task packet (--grain)
+  int bufferDepth = 2;         // task-manager local pool, in packets (--buffer-depth)
+  double staticFraction = 0.5; // hybrid: share of tasks split statically (--static-fraction)
+  std::uint64_t seed = 1;      // random order
+};
+
+// The answer to "PE p asks for work". tasks are run now, in order, by the asking PE. The
+// transfer that brought them (requests, packets task packets, moved tasks, from the controller or
+// another PE) is what the runtime counts as scheduling traffic and the simulator charges on
+// the network model; blocking = false means it was requested ahead of need (a task manager
+// refill), so its latency is off the critical path.
+struct Grab {
+  std::vector<TaskId> tasks;  // empty: this PE will get no more tasks in this stage
+  int from = kController;     // kController, the asking PE itself (local pool), or a victim PE
+  int requests = 0;           // request messages sent (none for an unprompted static portion)
+  int packets = 0;
+  std::size_t moved = 0;
+  bool blocking = true;
+
+  void clear() {
+    tasks.clear();
+    from = kController;
+    requests = 0;
+    packets = 0;
+    moved = 0;
+    blocking = true;
+  }
+};
+
+class Scheduler {
+ public:
+  virtual ~Scheduler() = default;
+  virtual std::string_view name() const = 0;  // its registry name
+  // Prepares a stage: computes any static assignment. Called once, before any PE asks, from one
+  // thread. Data-driven assignments are a pure function of (tasks, params), so the thread
+  // engine and the simulator produce the same ones.
+  virtual void reset(const TaskSet& tasks, const ScheduleParams& params) = 0;
+  // PE pe asks for its next task(s) at time now (seconds; real or virtual). Different PEs call
+  // concurrently; implementations synchronise themselves. Each task id is handed out exactly
+  // once per reset. An empty answer is final for that PE.
+  virtual void next(int pe, double now, Grab& out) = 0;
+  // PE pe finished a task it was handed, taking seconds. Same threading as next().
+  virtual void finished(int pe, TaskId task, double seconds) {
+    (void)pe, (void)task, (void)seconds;
+  }
+};
+
+// Registry: name -> factory -> one-line description; feeds --help, validation and reports.
+struct ScheduleInfo {
+  std::string_view name;
+  std::string_view description;
+  std::unique_ptr<Scheduler> (*make)();
+};
+const std::vector<ScheduleInfo>& schedules();
+// Throws pr::InputError naming the unknown schedule and listing the valid ones.
+std::unique_ptr<Scheduler> makeScheduler(std::string_view name);
+bool isSchedule(std::string_view name);
+// "name: description" lines, for --help.
+std::string describeSchedules();
+
+// Factories, one per strategy file.
+std::unique_ptr<Scheduler> makeBalancedDataDriven();
+std::unique_ptr<Scheduler> makeUnbalancedDataDriven();
+std::unique_ptr<Scheduler> makeDemandSerial();
+std::unique_ptr<Scheduler> makeDemandSpiral();
+std::unique_ptr<Scheduler> makeDemandRandom();
+std::unique_ptr<Scheduler> makeDemandHotSpots();
+std::unique_ptr<Scheduler> makeHybrid();
+std::unique_ptr<Scheduler> makeTaskManager();
+std::unique_ptr<Scheduler> makeDistributed();
+std::unique_ptr<Scheduler> makePreferredBias();
+
+// Static splits shared by several strategies (and checked directly by tests).
+// Balanced: contiguous blocks of ids [0, n), the first n mod P PEs one task more (seed 3.2.1).
+std::vector<std::vector<TaskId>> balancedSplit(std::size_t n, int pes);
+// Unbalanced: by cost estimate, longest first to the least-loaded PE (ties: lowest PE), each
+// PE's list then in image order. Balances to within the largest task of total/P (seed 3.2.1).
+std::vector<std::vector<TaskId>> unbalancedSplit(const TaskSet& tasks, int pes);
+
+}  // namespace pr::par

@@ -1,0 +1,219 @@
+// The simulator's event loop (virtual time) and its inputs. Uses the very Scheduler classes of
+// the thread engine (runtime.cpp): one policy, two drivers. Output is a RunRecord for metrics.cpp.
+#include "common/parallel/simulator.h"
+
+#include <algorithm>
+#include <fstream>
+#include <queue>
+#include <sstream>
+
+#include "common/util/error.h"
+
+namespace pr::par {
+
+const std::vector<NetworkModel>& networks() {
+  // Latencies are one-way per message, including the messaging layer's software overhead.
+  static const std::vector<NetworkModel> kNetworks = {
+      {"zero", 0.0, 0.0, "no communication cost (the seed's worked examples)"},
+      {"shared-memory", 0.2e-6, 10e9, "threads of one machine: 0.2 us per message, 10 GB/s"},
+      {"10gbe", 10e-6, 1.25e9, "10 Gbit Ethernet cluster: 10 us per message, 1.25 GB/s"},
+      {"1gbe", 50e-6, 125e6, "1 Gbit Ethernet: 50 us per message, 125 MB/s"},
+      {"100mbit", 1e-3, 12.5e6, "1990s workstation farm, 100 Mbit Ethernet with PVM: 1 ms per message, 12.5 MB/s"},
+  };
+  return kNetworks;
+}
+
+const NetworkModel& networkByName(std::string_view name) {
+  std::string names;
+  for (const NetworkModel& n : networks()) {
+    if (n.name == name) return n;
+    names += names.empty() ? "" : ", ";
+    names += n.name;
+  }
+  throw InputError("unknown network '" + std::string(name) + "' (expected one of: " + names + ")");
+}
+
+std::string describeNetworks() {
+  std::string text;
+  for (const NetworkModel& n : networks()) {
+    text += "  " + std::string(n.name) + std::string(n.name.size() < 15 ? 15 - n.name.size() : 1, ' ');
+    text += std::string(n.description) + "\n";
+  }
+  return text;
+}
+
+Workload workloadFromRecord(const RunRecord& record, const std::string& origin) {
+  Workload w;
+  w.schedule = record.schedule;
+  w.grain = record.grain;
+  w.recordedPes = record.pes;
+  w.recordedWallSeconds = record.wallSeconds;
+  for (std::size_t s = 0; s < record.stages.size(); ++s) {
+    const StageRecord& sr = record.stages[s];
+    SimStage stage;
+    stage.name = sr.name;
+    stage.tasks.tasks = sr.tasks;
+    const std::size_t n = sr.tasks.size();
+    stage.costs.assign(n, 0.0);
+    stage.messages.assign(n, 0);
+    stage.bytes.assign(n, 0);
+    std::vector<char> seen(n, 0);
+    std::size_t seenCount = 0;
+    for (const TaskSpan& span : record.timeline) {
+      if (span.stage != static_cast<int>(s)) continue;
+      if (span.task == kMessageSpan) {
+        w.unmodelledSeconds += span.end - span.start;
+        continue;
+      }
+      stage.costs[span.task] += span.end - span.start;
+      stage.messages[span.task] += span.messagesSent;
+      stage.bytes[span.task] += span.bytesSent;
+      if (!seen[span.task]) seen[span.task] = 1, ++seenCount;
+    }
+    if (seenCount != n)
+      throw InputError(origin + ": stage '" + sr.name + "' has " + std::to_string(n) + " tasks but the timeline has spans for " +
+                       std::to_string(seenCount) + " (record the run with its timeline)");
+    w.stages.push_back(std::move(stage));
+  }
+  if (w.stages.empty()) throw InputError(origin + ": the run record has no stages");
+  return w;
+}
+
+Workload workloadFromCostTable(const std::string& text, const std::string& origin) {
+  Workload w;
+  SimStage stage;
+  stage.name = "costs";
+  std::istringstream in(text);
+  std::string line;
+  int lineNo = 0;
+  while (std::getline(in, line)) {
+    ++lineNo;
+    if (auto hash = line.find('#'); hash != std::string::npos) line.erase(hash);
+    for (char& c : line)
+      if (c == ',' || c == ';' || c == '\t') c = ' ';
+    std::istringstream fields(line);
+    double cost;
+    if (!(fields >> cost)) {
+      if (line.find_first_not_of(" \r") == std::string::npos) continue;
+      throw InputError(origin + ", line " + std::to_string(lineNo) + ": expected a task cost in seconds");
+    }
+    if (!(cost >= 0.0)) throw InputError(origin + ", line " + std::to_string(lineNo) + ": task cost must be >= 0");
+    TaskInfo info{cost, static_cast<float>(stage.tasks.size()), 0.0f};
+    float x, y;
+    if (fields >> x) {
+      if (!(fields >> y)) throw InputError(origin + ", line " + std::to_string(lineNo) + ": position needs x and y");
+      info.x = x, info.y = y;
+    }
+    stage.tasks.tasks.push_back(info);
+    stage.costs.push_back(cost);
+  }
+  if (stage.costs.empty()) throw InputError(origin + ": the cost table has no tasks");
+  stage.messages.assign(stage.costs.size(), 0);
+  stage.bytes.assign(stage.costs.size(), 0);
+  w.stages.push_back(std::move(stage));
+  return w;
+}
+
+Workload readWorkload(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  if (!in) throw InputError("cannot read '" + file.string() + "'");
+  std::stringstream text;
+  text << in.rdbuf();
+  const std::string s = text.str();
+  const auto first = s.find_first_not_of(" \t\r\n");
+  // Built by appending: GCC 12 warns falsely (-Wrestrict) on "'" + string + "'".
+  std::string origin = "'";
+  origin += file.string();
+  origin += '\'';
+  if (first != std::string::npos && s[first] == '{')
+    return workloadFromRecord(runRecordFromJsonText(s, origin), origin);
+  return workloadFromCostTable(s, origin);
+}
+
+RunRecord simulate(const Workload& workload, std::string_view schedule, const SimOptions& options) {
+  auto scheduler = makeScheduler(schedule);
+  return simulate(workload, *scheduler, options);
+}
+
+RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options) {
+  if (options.pes < 1 || options.pes > 65536)
+    throw InputError("simulated PEs must be in [1, 65536], got " + std::to_string(options.pes));
+  const int pes = options.pes;
+  ScheduleParams params = options.params;
+  params.pes = pes;
+  const NetworkModel& net = options.network;
+
+  RunRecord record;
+  record.pes = pes;
+  record.schedule = std::string(scheduler.name());
+  record.grain = params.grain;
+  double stageStart = 0.0;
+  Grab grab;
+  // (virtual time, PE): the PE that is free earliest asks first; ties go to the lower PE id.
+  using Event = std::pair<double, int>;
+
+  for (std::size_t s = 0; s < workload.stages.size(); ++s) {
+    const SimStage& stage = workload.stages[s];
+    PR_CHECK(stage.costs.size() == stage.tasks.size(), "SimStage costs and tasks differ in size");
+    const bool traffic = !stage.messages.empty();
+    scheduler.reset(stage.tasks, params);
+    StageRecord sr;
+    sr.name = stage.name;
+    sr.schedule = record.schedule;
+    sr.grain = params.grain;
+    sr.startSeconds = stageStart;
+    sr.tasks = stage.tasks.tasks;
+    sr.pes.resize(pes);
+    std::vector<double> lastEnd(pes, stageStart);
+
+    std::vector<Event> initial(pes);
+    for (int p = 0; p < pes; ++p) initial[p] = {stageStart, p};
+    std::priority_queue<Event, std::vector<Event>, std::greater<Event>> ready(std::greater<Event>(), std::move(initial));
+    while (!ready.empty()) {
+      auto [t, p] = ready.top();
+      ready.pop();
+      scheduler.next(p, t, grab);
+      if (grab.tasks.empty()) continue;  // this PE is done with the stage
+      PeStageRecord& r = sr.pes[p];
+      const std::uint64_t messages = grab.requests + grab.packets;
+      if (grab.from != p && messages > 0) {
+        const std::uint64_t bytes =
+            grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes;
+        r.schedulingMessages += messages;
+        r.schedulingBytes += bytes;
+        if (grab.blocking) t += net.seconds(messages, bytes);  // idle until the packet arrives
+      }
+      for (TaskId id : grab.tasks) {
+        double d = stage.costs[id];
+        if (traffic && stage.messages[id] > 0) {
+          const double send = net.seconds(stage.messages[id], stage.bytes[id]);
+          d += send;
+          r.commSeconds += send;
+          r.messagesSent += stage.messages[id];
+          r.bytesSent += stage.bytes[id];
+        }
+        if (options.recordTimeline)
+          record.timeline.push_back({p, static_cast<int>(s), id, t, t + d,
+                                     traffic ? stage.messages[id] : 0u, traffic ? stage.bytes[id] : 0u});
+        t += d;
+        r.busySeconds += d;
+        r.tasks += 1;
+        scheduler.finished(p, id, d);
+      }
+      lastEnd[p] = t;
+      ready.push({t, p});
+    }
+    const double end = *std::max_element(lastEnd.begin(), lastEnd.end());
+    sr.wallSeconds = end - stageStart;
+    for (int p = 0; p < pes; ++p) {
+      sr.pes[p].idleSeconds = std::max(0.0, sr.wallSeconds - sr.pes[p].busySeconds);
+      sr.pes[p].syncWaitSeconds = end - lastEnd[p];
+    }
+    record.stages.push_back(std::move(sr));
+    stageStart = end;
+  }
+  record.wallSeconds = stageStart;
+  return record;
+}
+
+}  // namespace pr::par

@@ -1,0 +1,96 @@
+// The thread engine: tasks on P PEs (P above the core count too), errors end the run with the
+// error reported, metric invariants (busy <= wall, task counts sum to the pool), broadcasts.
+#include <doctest/doctest.h>
+
+#include <atomic>
+#include <set>
+#include <stdexcept>
+
+#include "common/parallel/runtime.h"
+#include "common/parallel/spin_work.h"
+#include "common/util/error.h"
+#include "tests/common/parallel/parallel_test_support.h"
+
+using namespace pr::par;
+
+TEST_CASE("Runtime: more PEs than cores all take part, each task runs on one PE") {
+  Runtime rt(16, "balanced");
+  std::vector<std::atomic<int>> ranOn(64);
+  for (auto& r : ranOn) r = -1;
+  rt.runStage("stage", TaskSet::uniform(64), [&](Pe& pe, TaskId id) {
+    CHECK(pe.pes() == 16);
+    ranOn[id] = pe.id();
+  });
+  // Balanced: 4 tasks each, PE p runs 4p..4p+3.
+  for (int id = 0; id < 64; ++id) CHECK(ranOn[id] == id / 4);
+  const StageRecord& s = rt.record().stages[0];
+  for (const PeStageRecord& pe : s.pes) {
+    CHECK(pe.tasks == 4);
+    CHECK(pe.busySeconds <= s.wallSeconds);
+    CHECK(pe.idleSeconds == doctest::Approx(s.wallSeconds - pe.busySeconds));
+  }
+}
+
+TEST_CASE("Runtime: busy time is measured by the runtime around each task") {
+  Runtime rt(2, "balanced");
+  rt.runStage("spin", TaskSet::uniform(4), [](Pe&, TaskId) { spinFor(2e-3); });
+  const RunRecord& r = rt.record();
+  REQUIRE(r.timeline.size() == 4);
+  for (const TaskSpan& span : r.timeline) CHECK(span.end - span.start >= 2e-3);
+  for (const PeStageRecord& pe : r.stages[0].pes) CHECK(pe.busySeconds >= 4e-3);
+  CHECK(r.stages[0].wallSeconds >= 4e-3);
+  CHECK(r.stages[0].schedule == "balanced");
+}
+
+TEST_CASE("Runtime: an exception in a task ends the stage and is rethrown with its type") {
+  for (const ScheduleInfo& info : schedules()) {
+    CAPTURE(info.name);
+    Runtime rt(4, std::string(info.name));
+    std::atomic<int> ran{0};
+    pr::test::runWithTimeout(
+        [&] {
+          CHECK_THROWS_AS(rt.runStage("render", TaskSet::uniform(200),
+                                      [&](Pe&, TaskId id) {
+                                        ran++;
+                                        if (id == 17) throw pr::InputError("bad tile 17");
+                                      }),
+                          pr::InputError);
+        },
+        20.0, "Runtime exception run");
+    CHECK(rt.record().error.find("bad tile 17") != std::string::npos);
+    CHECK(rt.record().error.find("task 17") != std::string::npos);
+    CHECK(rt.record().error.find("'render'") != std::string::npos);
+  }
+}
+
+TEST_CASE("Runtime: a stage after a failed one runs normally") {
+  Runtime rt(3);
+  CHECK_THROWS_AS(rt.runStage("a", TaskSet::uniform(10), [](Pe&, TaskId) { throw std::runtime_error("x"); }),
+                  std::runtime_error);
+  std::atomic<int> count{0};
+  rt.runStage("b", TaskSet::uniform(10), [&](Pe&, TaskId) { count++; });
+  CHECK(count == 10);
+}
+
+TEST_CASE("Runtime: bad options are input errors") {
+  CHECK_THROWS_AS(Runtime(0), pr::InputError);
+  CHECK_THROWS_AS(Runtime(2, "fastest"), pr::InputError);
+  ScheduleParams params;
+  params.grain = 0;
+  CHECK_THROWS_AS(Runtime(2, "demand", params), pr::InputError);
+}
+
+TEST_CASE("Runtime: an empty stage and a broadcast are recorded") {
+  Runtime rt(3);
+  rt.recordBroadcast(1000);
+  rt.runStage("empty", TaskSet{}, [](Pe&, TaskId) {});
+  rt.runStage("next", TaskSet::uniform(3), [](Pe&, TaskId) {});
+  const RunRecord& r = rt.record();
+  REQUIRE(r.stages.size() == 2);
+  for (const PeStageRecord& pe : r.stages[0].pes) {
+    CHECK(pe.broadcastsReceived == 1);
+    CHECK(pe.broadcastBytesReceived == 1000);
+    CHECK(pe.messagesReceived == 0);
+  }
+  for (const PeStageRecord& pe : r.stages[1].pes) CHECK(pe.broadcastsReceived == 0);
+}
