@@ -60,7 +60,7 @@ void buildHotspot(GltfBuilder& b, const SceneParams& params) {
       for (int col = 0; col < kCols; ++col, ++index) {
         const glm::vec3 cell((col - (kCols - 1) / 2.0f) * kSpacing, (row - (kRows - 1) / 2.0f) * kSpacing,
                              (layer - (kLayers - 1) / 2.0f) * kSpacing);
-        // Jitter up to 0.04 per axis and radius in [0.17, 0.21]: spheres never touch, since
+        // Jitter up to 0.04 per axis and radius in [0.17, 0.21]: spheres never overlap, since
         // 2 * (0.21 + 0.04) = 0.5 = the grid spacing.
         const glm::vec3 jitter(rng.uniform() - 0.5f, rng.uniform() - 0.5f, rng.uniform() - 0.5f);
         const float radius = 0.17f + 0.04f * rng.uniform();
