@@ -80,13 +80,6 @@ int clipPolygon(const FrameView& view, const ClipVertex* in, int n, ClipVertex* 
   return m;
 }
 
-// Kept out of line so every vertex is transformed by the same instruction sequence: a vertex
-// shared by two triangles must snap to the same fixed-point position (watertightness).
-[[gnu::noinline]] ClipVertex transformVertex(const FrameView& view, glm::vec3 p, glm::vec2 bary) {
-  glm::vec4 hp(p, 1.0f);
-  return ClipVertex{view.viewProjection * hp, glm::dot(view.viewDepthRow, hp), bary};
-}
-
 struct SnappedVertex {
   int32_t x, y;
   float depth, invW;
@@ -95,22 +88,21 @@ struct SnappedVertex {
 
 // Perspective division and viewport transform, snapped to 24.8 fixed point (round to nearest).
 // Clipping guarantees w > 0 and |x/w| <= guardX; the clamp only absorbs rounding at the guard.
-[[gnu::noinline]] SnappedVertex snapVertex(const FrameView& view, const ClipVertex& v) {
+// Kept out of line so that every vertex, cached or clipped, goes through the same instruction
+// sequence: a vertex shared by two triangles must snap to the same position (watertightness).
+[[gnu::noinline]] void snap(const FrameView& view, glm::vec4 clip, float viewDepth, SnappedVertex& s) {
   constexpr double kLimit = (kGuardBandPx + kMaxImageSidePx) * kSubpixelScale;
-  double invW = 1.0 / double(v.clip.w);
-  double sx = (0.5 + 0.5 * double(v.clip.x) * invW) * view.width * kSubpixelScale;
-  double sy = (0.5 - 0.5 * double(v.clip.y) * invW) * view.height * kSubpixelScale;
-  SnappedVertex s;
+  double invW = 1.0 / double(clip.w);
+  double sx = (0.5 + 0.5 * double(clip.x) * invW) * view.width * kSubpixelScale;
+  double sy = (0.5 - 0.5 * double(clip.y) * invW) * view.height * kSubpixelScale;
   s.x = static_cast<int32_t>(std::nearbyint(std::clamp(sx, -kLimit, kLimit)));
   s.y = static_cast<int32_t>(std::nearbyint(std::clamp(sy, -kLimit, kLimit)));
   s.invW = static_cast<float>(invW);
-  s.depth = view.perspective ? -s.invW : v.viewDepth;
-  s.bary = v.bary;
-  return s;
+  s.depth = view.perspective ? -s.invW : viewDepth;
 }
 
-// Twice the signed area of a snapped triangle; positive for a front face. (CCW in NDC with y
-// up is clockwise on the y-down screen; this is the edge function of setup.h at the third vertex.)
+// Twice the signed area of a snapped triangle, positive for a front face (counter-clockwise
+// as seen on screen): the edge function E_0 of setup.h at the first vertex.
 int64_t signedArea2(const SnappedVertex& a, const SnappedVertex& b, const SnappedVertex& c) {
   return int64_t(c.y - b.y) * int64_t(a.x - b.x) - int64_t(c.x - b.x) * int64_t(a.y - b.y);
 }
@@ -125,6 +117,109 @@ uint32_t outcode(const FrameView& view, const ClipVertex& v, bool guard) {
   if (v.clip.y < -gy * v.clip.w) code |= 1u << kBottom;
   if (v.clip.y > gy * v.clip.w) code |= 1u << kTop;
   return code;
+}
+
+// The vertex stage: one scene vertex transformed, classified against the frustum and the guard
+// band, and snapped when no clipping can move it. Computed once per vertex of a batch.
+struct PreparedVertex {
+  glm::vec4 clip;
+  float viewDepth;
+  uint32_t viewportCode, guardCode;
+  SnappedVertex snapped;  // valid when guardCode == 0
+};
+
+// Out of line for the same reason as snap(): identical transforms for shared vertices.
+[[gnu::noinline]] void prepareVertex(const FrameView& view, glm::vec3 p, PreparedVertex& out) {
+  glm::vec4 hp(p, 1.0f);
+  ClipVertex v{view.viewProjection * hp, glm::dot(view.viewDepthRow, hp), glm::vec2(0.0f)};
+  out.clip = v.clip;
+  out.viewDepth = v.viewDepth;
+  out.viewportCode = outcode(view, v, false);
+  out.guardCode = outcode(view, v, true);
+  if (out.guardCode == 0) snap(view, v.clip, v.viewDepth, out.snapped);
+}
+
+// Triangle assembly from prepared vertices: trivial reject, clipping when a vertex lies
+// behind the near plane or beyond the guard band, facing, fan of screen triangles.
+int assembleTriangle(const scene::Scene& scene, const FrameView& view, uint32_t index, const PreparedVertex* pv[3],
+                     ScreenTriangle* out, GeometryCounters& c) {
+  ++c.trianglesIn;
+  // Trivial reject: all three outside one viewport or near plane (the triangle is the convex
+  // hull of its clip-space vertices, so it cannot reach into the frustum).
+  if (pv[0]->viewportCode & pv[1]->viewportCode & pv[2]->viewportCode) {
+    ++c.culledOutside;
+    return 0;
+  }
+  static constexpr glm::vec2 kCorner[3] = {{0.0f, 0.0f}, {1.0f, 0.0f}, {0.0f, 1.0f}};
+  SnappedVertex s[kMaxPolygonVertices];
+  int n = 3;
+  uint32_t clipMask = pv[0]->guardCode | pv[1]->guardCode | pv[2]->guardCode;
+  if (clipMask == 0) {
+    for (int k = 0; k < 3; ++k) {
+      s[k] = pv[k]->snapped;
+      s[k].bary = kCorner[k];
+    }
+  } else {
+    // Clip only against the planes some vertex violates: the near plane first, so that w > 0
+    // holds before the guard planes (which pass through the eye) are tested.
+    ++c.clipped;
+    ClipVertex poly[2][kMaxPolygonVertices];
+    for (int k = 0; k < 3; ++k) poly[0][k] = ClipVertex{pv[k]->clip, pv[k]->viewDepth, kCorner[k]};
+    int cur = 0;
+    for (int plane = 0; plane < kPlaneCount && n >= 3; ++plane) {
+      if (!(clipMask & (1u << plane))) continue;
+      n = clipPolygon(view, poly[cur], n, poly[cur ^ 1], plane);
+      cur ^= 1;
+    }
+    if (n < 3) {
+      ++c.culledOutside;
+      return 0;
+    }
+    PR_DCHECK(n <= kMaxPolygonVertices, "clipped polygon too large");
+    for (int k = 0; k < n; ++k) {
+      snap(view, poly[cur][k].clip, poly[cur][k].viewDepth, s[k]);
+      s[k].bary = poly[cur][k].bary;
+    }
+  }
+
+  // Facing of the whole (convex) polygon, from its snapped area: the sum of its fan.
+  int64_t area2 = 0;
+  for (int k = 1; k + 1 < n; ++k) area2 += signedArea2(s[0], s[k], s[k + 1]);
+  if (area2 == 0) {
+    ++c.culledDegenerate;
+    return 0;
+  }
+  bool backFacing = area2 < 0;
+  if (backFacing) {
+    if (!scene.materials[scene.triangles[index].material].doubleSided) {
+      ++c.culledBackFace;
+      return 0;
+    }
+    // Seen from behind: reverse the winding so every piece has positive area.
+    std::reverse(s + 1, s + n);
+  }
+
+  int count = 0;
+  for (int k = 1; k + 1 < n; ++k) {
+    // A piece whose snapped area is zero covers no sample; one flipped by snapping (a sliver
+    // at a clip vertex) is dropped rather than drawn inside-out.
+    if (n > 3 && signedArea2(s[0], s[k], s[k + 1]) <= 0) continue;
+    ScreenTriangle& t = out[count++];
+    const SnappedVertex* v[3] = {&s[0], &s[k], &s[k + 1]};
+    for (int j = 0; j < 3; ++j) {
+      t.x[j] = v[j]->x;
+      t.y[j] = v[j]->y;
+      t.depth[j] = v[j]->depth;
+      t.invW[j] = v[j]->invW;
+      t.bary[j] = v[j]->bary;
+    }
+    t.primitive = index;
+    t.sub = static_cast<uint8_t>(k - 1);
+    t.backFacing = backFacing ? 1 : 0;
+  }
+  if (count == 0) ++c.culledDegenerate;
+  c.screenTrianglesOut += static_cast<uint64_t>(count);
+  return count;
 }
 
 }  // namespace
@@ -166,87 +261,10 @@ FrameView makeFrameView(const scene::Camera& camera, int width, int height) {
 int processTriangle(const scene::Scene& scene, const FrameView& view, uint32_t index,
                     ScreenTriangle* out, GeometryCounters* counters) {
   GeometryCounters local;
-  GeometryCounters& c = counters ? *counters : local;
-  ++c.trianglesIn;
-  const scene::Triangle& tri = scene.triangles[index];
-
-  ClipVertex poly[2][kMaxPolygonVertices];
-  poly[0][0] = transformVertex(view, scene.positions[tri.v[0]], glm::vec2(0.0f, 0.0f));
-  poly[0][1] = transformVertex(view, scene.positions[tri.v[1]], glm::vec2(1.0f, 0.0f));
-  poly[0][2] = transformVertex(view, scene.positions[tri.v[2]], glm::vec2(0.0f, 1.0f));
-  int n = 3;
-
-  // Trivial reject: all three outside one viewport or near plane (the triangle is the convex
-  // hull of its clip-space vertices, so it cannot reach into the frustum).
-  uint32_t viewport[3], guard[3];
-  for (int k = 0; k < 3; ++k) {
-    viewport[k] = outcode(view, poly[0][k], false);
-    guard[k] = outcode(view, poly[0][k], true);
-  }
-  if (viewport[0] & viewport[1] & viewport[2]) {
-    ++c.culledOutside;
-    return 0;
-  }
-
-  // Clip only against the planes some vertex violates: the near plane first, so that w > 0
-  // holds before the guard planes (which pass through the eye) are tested.
-  uint32_t clipMask = guard[0] | guard[1] | guard[2];
-  int cur = 0;
-  if (clipMask) {
-    ++c.clipped;
-    for (int plane = 0; plane < kPlaneCount && n >= 3; ++plane) {
-      if (!(clipMask & (1u << plane))) continue;
-      n = clipPolygon(view, poly[cur], n, poly[cur ^ 1], plane);
-      cur ^= 1;
-    }
-    if (n < 3) {
-      ++c.culledOutside;
-      return 0;
-    }
-  }
-  PR_DCHECK(n <= kMaxPolygonVertices, "clipped polygon too large");
-
-  SnappedVertex s[kMaxPolygonVertices];
-  for (int k = 0; k < n; ++k) s[k] = snapVertex(view, poly[cur][k]);
-
-  // Facing of the whole (convex) polygon, from its snapped area: the sum of its fan.
-  int64_t area2 = 0;
-  for (int k = 1; k + 1 < n; ++k) area2 += signedArea2(s[0], s[k], s[k + 1]);
-  if (area2 == 0) {
-    ++c.culledDegenerate;
-    return 0;
-  }
-  bool backFacing = area2 < 0;
-  if (backFacing) {
-    if (!scene.materials[tri.material].doubleSided) {
-      ++c.culledBackFace;
-      return 0;
-    }
-    // Seen from behind: reverse the winding so every piece has positive area.
-    std::reverse(s + 1, s + n);
-  }
-
-  int count = 0;
-  for (int k = 1; k + 1 < n; ++k) {
-    // A piece whose snapped area is zero covers no sample; one flipped by snapping (a sliver
-    // at a clip vertex) is dropped rather than drawn inside-out.
-    if (signedArea2(s[0], s[k], s[k + 1]) <= 0) continue;
-    ScreenTriangle& t = out[count++];
-    const SnappedVertex* v[3] = {&s[0], &s[k], &s[k + 1]};
-    for (int j = 0; j < 3; ++j) {
-      t.x[j] = v[j]->x;
-      t.y[j] = v[j]->y;
-      t.depth[j] = v[j]->depth;
-      t.invW[j] = v[j]->invW;
-      t.bary[j] = v[j]->bary;
-    }
-    t.primitive = index;
-    t.sub = static_cast<uint8_t>(k - 1);
-    t.backFacing = backFacing ? 1 : 0;
-  }
-  if (count == 0) ++c.culledDegenerate;
-  c.screenTrianglesOut += static_cast<uint64_t>(count);
-  return count;
+  PreparedVertex v[3];
+  const PreparedVertex* pv[3] = {&v[0], &v[1], &v[2]};
+  for (int k = 0; k < 3; ++k) prepareVertex(view, scene.positions[scene.triangles[index].v[k]], v[k]);
+  return assembleTriangle(scene, view, index, pv, out, counters ? *counters : local);
 }
 
 void processTriangles(const scene::Scene& scene, const FrameView& view, uint32_t first, uint32_t count,
@@ -254,10 +272,37 @@ void processTriangles(const scene::Scene& scene, const FrameView& view, uint32_t
   PR_CHECK(uint64_t(first) + count <= scene.triangles.size(), "triangle batch outside the scene");
   PR_CHECK(scene.triangles.size() <= kMaxPrimitives,
            "scene has more triangles than the depth key can order");
+  if (count == 0) return;
+  GeometryCounters local;
+  GeometryCounters& c = counters ? *counters : local;
+  const scene::Triangle* tris = scene.triangles.data() + first;
+  // Mesh triangles of a batch reference a compact vertex range: prepare each vertex of the
+  // range once (about 3x fewer transforms than per triangle corner). A scattered batch falls
+  // back to per-corner preparation; both give the same bits (prepareVertex is one function).
+  uint32_t lo = tris[0].v[0], hi = lo;
+  for (uint32_t i = 0; i < count; ++i) {
+    for (uint32_t k : tris[i].v) {
+      lo = std::min(lo, k);
+      hi = std::max(hi, k);
+    }
+  }
   ScreenTriangle pieces[kMaxSubTriangles];
-  for (uint32_t i = first; i < first + count; ++i) {
-    int n = processTriangle(scene, view, i, pieces, counters);
-    out.insert(out.end(), pieces, pieces + n);
+  const uint64_t range = uint64_t(hi) - lo + 1;
+  if (range > 2 * uint64_t(count) + 64) {
+    for (uint32_t i = 0; i < count; ++i) {
+      int n = processTriangle(scene, view, first + i, pieces, &c);
+      for (int k = 0; k < n; ++k) out.push_back(pieces[k]);
+    }
+    return;
+  }
+  // Per-thread scratch: the PE running this batch reuses its own buffer between batches.
+  thread_local std::vector<PreparedVertex> prepared;
+  prepared.resize(range);
+  for (uint64_t k = 0; k < range; ++k) prepareVertex(view, scene.positions[lo + k], prepared[k]);
+  for (uint32_t i = 0; i < count; ++i) {
+    const PreparedVertex* pv[3] = {&prepared[tris[i].v[0] - lo], &prepared[tris[i].v[1] - lo], &prepared[tris[i].v[2] - lo]};
+    int n = assembleTriangle(scene, view, first + i, pv, pieces, c);
+    for (int k = 0; k < n; ++k) out.push_back(pieces[k]);
   }
 }
 

@@ -30,13 +30,19 @@ Rect pixelBounds(const ScreenTriangle& t) {
   return r;
 }
 
-bool setupTriangle(const ScreenTriangle& t, TriangleSetup& s) {
+void edgeFunctions(const ScreenTriangle& t, EdgeFunctions& e) {
   for (int k = 0; k < 3; ++k) {
     int i = (k + 1) % 3, j = (k + 2) % 3;
     // E_k = (y_j - y_i)(X - x_i) - (x_j - x_i)(Y - y_i)
-    s.a[k] = int64_t(t.y[j]) - t.y[i];
-    s.b[k] = -(int64_t(t.x[j]) - t.x[i]);
-    s.c[k] = -(s.a[k] * t.x[i] + s.b[k] * t.y[i]);
+    e.a[k] = int64_t(t.y[j]) - t.y[i];
+    e.b[k] = -(int64_t(t.x[j]) - t.x[i]);
+    e.c[k] = -(e.a[k] * t.x[i] + e.b[k] * t.y[i]);
+  }
+}
+
+bool setupTriangle(const ScreenTriangle& t, TriangleSetup& s) {
+  edgeFunctions(t, s);
+  for (int k = 0; k < 3; ++k) {
     // (a, b) is the inward normal; y grows downwards. Left edge: interior to the right (a > 0).
     // Top edge: horizontal (a == 0) with the interior below (b > 0).
     bool topLeft = s.a[k] > 0 || (s.a[k] == 0 && s.b[k] > 0);

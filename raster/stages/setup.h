@@ -17,8 +17,14 @@ namespace pr::raster {
 // is twice the signed area of (vertex k+1, vertex k+2, sample), positive inside, and
 // E_0 + E_1 + E_2 = area2; E_k / area2 is the screen-space barycentric of vertex k.
 // Magnitudes (geometry.h): |a|, |b| < 2^27.4, |X|, |Y| < 2^26.4, so |E| < 2^55.8: exact.
-struct TriangleSetup {
+struct EdgeFunctions {
   int64_t a[3], b[3], c[3];
+};
+
+// The edge functions alone (what shading needs to recover barycentrics at a pixel).
+void edgeFunctions(const ScreenTriangle& tri, EdgeFunctions& edges);
+
+struct TriangleSetup : EdgeFunctions {
   // Top-left rule: a sample exactly on edge k belongs to the triangle only when the edge is a
   // top edge (horizontal, interior below) or a left edge (interior to its right); bias[k] is 0
   // for those and 1 otherwise, and a sample is covered when E_k - bias[k] >= 0 for all k.
@@ -43,7 +49,7 @@ inline int64_t samplePosition(int i) {
 
 // Unbiased edge value E_k at the sample of pixel (x, y), as the rasterizer computed it
 // incrementally (integer arithmetic is exact, so both agree bit for bit).
-inline int64_t edgeAt(const TriangleSetup& s, int k, int x, int y) {
+inline int64_t edgeAt(const EdgeFunctions& s, int k, int x, int y) {
   return s.a[k] * samplePosition(x) + s.b[k] * samplePosition(y) + s.c[k];
 }
 

@@ -137,16 +137,18 @@ glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N,
   // for smooth surfaces near the highlight centre.
   glm::vec3 NxH = glm::cross(N, H);
   float denom = glm::dot(NxH, NxH) + NdotH * NdotH * alpha2;
-  float D = alpha2 / (kPi * denom * denom);
+  // Schlick-GGX: G = G1(L) G1(V), G1(x) = x / (x (1 - k) + k). The x factors of G cancel the
+  // 1 / (4 NdotL NdotV) of Cook-Torrance, leaving one division for D G / (4 NdotL NdotV).
   float k = 0.5f * alpha;
-  float G = (NdotL / (NdotL * (1.0f - k) + k)) * (NdotV / (NdotV * (1.0f - k) + k));
+  float gl = NdotL * (1.0f - k) + k;
+  float gv = NdotV * (1.0f - k) + k;
+  float specularScale = alpha2 / (4.0f * kPi * denom * denom * gl * gv);
   glm::vec3 F0 = glm::mix(glm::vec3(0.04f), base, metallic);
   float f = 1.0f - VdotH;
   float f5 = f * f * f * f * f;
   glm::vec3 F = F0 + (glm::vec3(1.0f) - F0) * f5;
-  glm::vec3 specular = F * (D * G / (4.0f * NdotL * NdotV));
-  glm::vec3 diffuse = (1.0f - metallic) * base / kPi;
-  return diffuse + specular;
+  glm::vec3 diffuse = ((1.0f - metallic) / kPi) * base;
+  return diffuse + F * specularScale;
 }
 
 glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
@@ -183,7 +185,7 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
   glm::vec3* colours = fb.colours();
   // Neighbouring pixels mostly show the same triangle: keep its setup.
   uint32_t cached = kNoTriangle;
-  TriangleSetup s{};
+  EdgeFunctions s{};
   uint64_t shaded = 0;
   size_t i = 0;
   for (int y = rect.y0; y < rect.y1; ++y) {
@@ -191,7 +193,7 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
       if (!keyCovered(keys[i]) || triangles[i] == kNoTriangle) continue;
       const ScreenTriangle& tri = tris[triangles[i]];
       if (triangles[i] != cached) {
-        setupTriangle(tri, s);
+        edgeFunctions(tri, s);
         cached = triangles[i];
       }
       glm::vec3 b = barycentricsFromEdges(tri, edgeAt(s, 0, x, y), edgeAt(s, 1, x, y), edgeAt(s, 2, x, y));
