@@ -1,0 +1,257 @@
+// Building the BVH: top-down binned surface area heuristic (Wald 2007, "On fast construction
+// of SAH-based bounding volume hierarchies"). Runs once per scene (image-space) or once per PE
+// over that PE's own triangles (object-space, object partitioning), before any ray is traced;
+// it reads only the triangles it is given and writes only the Bvh it fills.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "common/util/error.h"
+#include "raytrace/core/bvh.h"
+
+namespace pr::rt {
+namespace {
+
+// Below this depth the SAH decides; deeper, object-median splits halve the count each level,
+// so the tree stays within the traversal stack (bvh_traverse.cpp) for any input.
+constexpr int kSahDepthLimit = 32;
+constexpr int kMaxBins = 32;
+
+struct Box {
+  glm::vec3 lo{kInfinity};
+  glm::vec3 hi{-kInfinity};
+  void extend(const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
+  void extend(const Box& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  // Half the surface area: the SAH only needs area ratios.
+  float halfArea() const {
+    if (lo.x > hi.x) return 0.0f;
+    const glm::vec3 d = hi - lo;
+    return d.x * d.y + d.y * d.z + d.z * d.x;
+  }
+};
+
+// One triangle during the build: its bounds, their centre (binned), its slot in `leafTris`.
+struct PrimRef {
+  Box box;
+  glm::vec3 centroid;
+  uint32_t slot;
+};
+
+struct Bin {
+  Box box;
+  uint32_t count = 0;
+};
+
+class Builder {
+ public:
+  Builder(const BvhBuildOptions& options, std::vector<PrimRef>& refs,
+          const std::vector<BvhTriangle>& prepared, std::vector<BvhNode>& nodes,
+          std::vector<BvhTriangle>& leafTris, BvhStats& stats)
+      : options_(options), refs_(refs), prepared_(prepared), nodes_(nodes), leafTris_(leafTris),
+        stats_(stats), bins_(std::clamp(options.bins, 2, kMaxBins)) {}
+
+  // Builds the subtree over refs_[begin, end) and returns its node index. Nodes are emitted in
+  // depth-first order: the first child directly follows its parent.
+  uint32_t build(uint32_t begin, uint32_t end, int depth) {
+    stats_.maxDepth = std::max(stats_.maxDepth, depth);
+    Box bounds, centroids;
+    for (uint32_t i = begin; i < end; ++i) {
+      bounds.extend(refs_[i].box);
+      centroids.extend(refs_[i].centroid);
+    }
+    const uint32_t nodeIndex = static_cast<uint32_t>(nodes_.size());
+    nodes_.push_back(BvhNode{bounds.lo, 0, bounds.hi, 0, 0, 0});
+    const uint32_t count = end - begin;
+    if (count == 1) return makeLeaf(nodeIndex, begin, end);
+
+    Split split = depth < kSahDepthLimit ? findSahSplit(begin, end, bounds, centroids) : Split{};
+    const float leafCost = options_.intersectionCost * float(count);
+    if (count <= uint32_t(options_.maxLeafSize) && !(split.valid && split.cost < leafCost))
+      return makeLeaf(nodeIndex, begin, end);
+
+    uint32_t mid = begin;
+    if (split.valid) {
+      const float lo = centroids.lo[split.axis];
+      const float scale = float(bins_) / (centroids.hi[split.axis] - centroids.lo[split.axis]);
+      auto* first = refs_.data() + begin;
+      mid = begin + uint32_t(std::partition(first, refs_.data() + end, [&](const PrimRef& r) {
+                               return binIndex(r.centroid[split.axis], lo, scale) < split.bin;
+                             }) - first);
+    }
+    if (mid == begin || mid == end) {
+      // No usable SAH split (all centres equal, or below the depth limit): object median along
+      // the widest centroid axis, which always makes progress.
+      const glm::vec3 e = centroids.hi - centroids.lo;
+      split.axis = e.x >= e.y ? (e.x >= e.z ? 0 : 2) : (e.y >= e.z ? 1 : 2);
+      mid = begin + count / 2;
+      std::nth_element(refs_.begin() + begin, refs_.begin() + mid, refs_.begin() + end,
+                       [&](const PrimRef& a, const PrimRef& b) {
+                         const float ca = a.centroid[split.axis], cb = b.centroid[split.axis];
+                         return ca < cb || (ca == cb && a.slot < b.slot);
+                       });
+    }
+    build(begin, mid, depth + 1);
+    const uint32_t second = build(mid, end, depth + 1);
+    nodes_[nodeIndex].offset = second;
+    nodes_[nodeIndex].axis = static_cast<uint8_t>(split.axis);
+    return nodeIndex;
+  }
+
+ private:
+  struct Split {
+    bool valid = false;
+    int axis = 0;
+    int bin = 0;  // left side: bins [0, bin)
+    float cost = kInfinity;
+  };
+
+  int binIndex(float c, float lo, float scale) const {
+    return std::clamp(static_cast<int>((c - lo) * scale), 0, bins_ - 1);
+  }
+
+  // SAH cost of a split into L and R (Goldsmith & Salmon 1987; MacDonald & Booth 1990):
+  //   C = Ct + Ci (A(L) N(L) + A(R) N(R)) / A(node)
+  // evaluated at the bins_-1 planes between bins, on all three axes, in one pass over refs.
+  Split findSahSplit(uint32_t begin, uint32_t end, const Box& bounds, const Box& centroids) const {
+    Split best;
+    const float nodeArea = bounds.halfArea();
+    if (!(nodeArea > 0.0f)) return best;  // flat or point node: the median split handles it
+    std::array<std::array<Bin, kMaxBins>, 3> bins{};
+    glm::vec3 scale(0.0f);
+    for (int a = 0; a < 3; ++a) {
+      const float extent = centroids.hi[a] - centroids.lo[a];
+      scale[a] = extent > 0.0f ? float(bins_) / extent : 0.0f;
+    }
+    for (uint32_t i = begin; i < end; ++i) {
+      const PrimRef& r = refs_[i];
+      for (int a = 0; a < 3; ++a) {
+        Bin& bin = bins[a][binIndex(r.centroid[a], centroids.lo[a], scale[a])];
+        bin.count++;
+        bin.box.extend(r.box);
+      }
+    }
+    std::array<float, kMaxBins> rightArea{};
+    std::array<uint32_t, kMaxBins> rightCount{};
+    for (int a = 0; a < 3; ++a) {
+      if (scale[a] == 0.0f) continue;
+      Box acc;
+      uint32_t n = 0;
+      for (int b = bins_ - 1; b > 0; --b) {
+        acc.extend(bins[a][b].box);
+        n += bins[a][b].count;
+        rightArea[b] = acc.halfArea();
+        rightCount[b] = n;
+      }
+      acc = Box{};
+      n = 0;
+      for (int b = 1; b < bins_; ++b) {
+        acc.extend(bins[a][b - 1].box);
+        n += bins[a][b - 1].count;
+        if (n == 0 || rightCount[b] == 0) continue;
+        const float cost = options_.traversalCost +
+            options_.intersectionCost * (acc.halfArea() * float(n) + rightArea[b] * float(rightCount[b])) / nodeArea;
+        if (cost < best.cost) best = Split{true, a, b, cost};
+      }
+    }
+    return best;
+  }
+
+  uint32_t makeLeaf(uint32_t nodeIndex, uint32_t begin, uint32_t end) {
+    BvhNode& node = nodes_[nodeIndex];
+    node.offset = static_cast<uint32_t>(leafTris_.size());
+    node.count = static_cast<uint16_t>(end - begin);
+    for (uint32_t i = begin; i < end; ++i) leafTris_.push_back(prepared_[refs_[i].slot]);
+    stats_.leaves++;
+    return nodeIndex;
+  }
+
+  const BvhBuildOptions& options_;
+  std::vector<PrimRef>& refs_;
+  const std::vector<BvhTriangle>& prepared_;
+  std::vector<BvhNode>& nodes_;
+  std::vector<BvhTriangle>& leafTris_;
+  BvhStats& stats_;
+  int bins_;
+};
+
+bool finite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
+
+// A triangle whose vertices are collinear (or coincide, or are not finite) has no area and
+// must never be hit. Rounding in the edge functions could still report a hit on a collinear
+// triangle, so it is stored with all three vertices equal: then every edge function is exactly
+// 0 (a*b - b*a), det = 0 and the test rejects it (triangle.h).
+BvhTriangle prepareTriangle(std::span<const glm::vec3> positions, const scene::Triangle& tri,
+                            uint32_t index, bool& degenerate) {
+  const glm::vec3 p0 = positions[tri.v[0]], p1 = positions[tri.v[1]], p2 = positions[tri.v[2]];
+  const glm::dvec3 n = glm::cross(glm::dvec3(p1) - glm::dvec3(p0), glm::dvec3(p2) - glm::dvec3(p0));
+  degenerate = !(finite(p0) && finite(p1) && finite(p2)) || (n.x == 0.0 && n.y == 0.0 && n.z == 0.0);
+  if (!degenerate) return BvhTriangle{p0, p1, p2, index};
+  const glm::vec3 anchor = finite(p0) ? p0 : finite(p1) ? p1 : finite(p2) ? p2 : glm::vec3(0.0f);
+  return BvhTriangle{anchor, anchor, anchor, index};
+}
+
+}  // namespace
+
+Bvh::Bvh(const scene::Scene& scene, const BvhBuildOptions& options) {
+  std::vector<uint32_t> all(scene.triangles.size());
+  for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+  build(scene.positions, scene.triangles, all, options);
+}
+
+Bvh::Bvh(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,
+         std::span<const uint32_t> subset, const BvhBuildOptions& options) {
+  build(positions, triangles, subset, options);
+}
+
+void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,
+                std::span<const uint32_t> subset, const BvhBuildOptions& options) {
+  PR_CHECK(options.maxLeafSize >= 1 && options.maxLeafSize <= 0xffff, "maxLeafSize out of range");
+  stats_ = BvhStats{};
+  nodes_.clear();
+  triangles_.clear();
+  magnitude_ = 0.0f;
+  if (subset.empty()) return;
+
+  std::vector<BvhTriangle> prepared(subset.size());
+  std::vector<PrimRef> refs(subset.size());
+  for (size_t i = 0; i < subset.size(); ++i) {
+    const uint32_t index = subset[i];
+    PR_CHECK(index < triangles.size(), "triangle index " + std::to_string(index) + " out of range");
+    const scene::Triangle& tri = triangles[index];
+    for (uint32_t v : tri.v)
+      PR_CHECK(v < positions.size(), "triangle " + std::to_string(index) + " names a missing vertex");
+    bool degenerate = false;
+    prepared[i] = prepareTriangle(positions, tri, index, degenerate);
+    stats_.degenerateTriangles += degenerate ? 1 : 0;
+    PrimRef& ref = refs[i];
+    ref.box.extend(prepared[i].p0);
+    ref.box.extend(prepared[i].p1);
+    ref.box.extend(prepared[i].p2);
+    ref.centroid = 0.5f * (ref.box.lo + ref.box.hi);
+    ref.slot = static_cast<uint32_t>(i);
+    const glm::vec3 m = glm::max(glm::abs(ref.box.lo), glm::abs(ref.box.hi));
+    magnitude_ = std::max({magnitude_, m.x, m.y, m.z});
+  }
+
+  nodes_.reserve(2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
+  triangles_.reserve(subset.size());
+  Builder builder(options, refs, prepared, nodes_, triangles_, stats_);
+  builder.build(0, static_cast<uint32_t>(refs.size()), 0);
+  nodes_.shrink_to_fit();
+
+  stats_.nodes = nodes_.size();
+  stats_.triangles = triangles_.size();
+  stats_.memoryBytes = nodes_.size() * sizeof(BvhNode) + triangles_.size() * sizeof(BvhTriangle);
+}
+
+scene::Bounds Bvh::bounds() const {
+  scene::Bounds b;
+  if (!nodes_.empty()) {
+    b.extend(nodes_[0].boundsMin);
+    b.extend(nodes_[0].boundsMax);
+  }
+  return b;
+}
+
+}  // namespace pr::rt
