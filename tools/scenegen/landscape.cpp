@@ -14,7 +14,7 @@ namespace {
 constexpr float kExtent = 40.0f;           // terrain covers [-20, 20]^2 in x and z
 constexpr float kFeatureFrequency = 0.1f;  // lowest octave: hills about 10 units across
 constexpr int kOctaves = 8;                // finest octave ~0.08 units, about 1.5 cells at size 708
-constexpr float kHeightScale = 4.0f;       // |height| <= 4 * sqrt(2)/2 = 2.83
+constexpr float kHeightScale = 6.0f;       // |height| <= 6 * sqrt(2)/2 = 4.24, below the lens (5.5)
 
 // Lens: a flattened sphere with semi-axes a = 1.5 (horizontal) and c = 0.5 (vertical). Its
 // surfaces have curvature radius R = a^2 / c = 4.5 on the axis; as a thick biconvex lens of
