@@ -2,7 +2,7 @@
 // and size, then primary, shadow and diffuse-bounce rays (Mrays/s) on a generated ~1M-triangle
 // fBm terrain and an ~18k-triangle Cornell-like box, both built in code. Not part of ctest;
 // compare with the Embree anchor figures in shared/ANCHORS.md (same kind of machine).
-//   bench_rays [--res N] [--grid N] [--repeat N]
+//   bench_rays [--res N] [--grid N] [--repeat N] [--leaf N] [--bins N] [--traversal-cost PERCENT]
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -201,12 +201,13 @@ Throughput measure(const std::vector<Ray>& rays, int repeat, Query query) {
   return result;
 }
 
-void runScene(const char* name, const pr::scene::Scene& scene, const Camera& camera, glm::vec3 toSun, int res, int repeat) {
+void runScene(const char* name, const pr::scene::Scene& scene, const Camera& camera, glm::vec3 toSun, int res, int repeat,
+              const pr::rt::BvhBuildOptions& options) {
   std::printf("\n== %s: %zu triangles, %dx%d rays per kind, best of %d passes, 1 thread\n", name,
               scene.triangles.size(), res, res, repeat);
   const auto buildStart = Clock::now();
   const double buildCpuStart = threadCpuSeconds();
-  const Bvh bvh(scene);
+  const Bvh bvh(scene, options);
   const double buildSeconds = threadCpuSeconds() - buildCpuStart, buildWall = secondsSince(buildStart);
   const auto& st = bvh.stats();
   std::printf("BVH build: %.3f s CPU (%.3f s wall)  nodes %zu  leaves %zu  depth %d  %.1f bytes/triangle (%.1f MiB)\n",
@@ -257,6 +258,12 @@ int main(int argc, char** argv) {
   const int res = intArg(argc, argv, "--res", 1024, 16, 8192);
   const int grid = intArg(argc, argv, "--grid", 708, 2, 4096);  // 708^2 * 2 = 1.0M triangles
   const int repeat = intArg(argc, argv, "--repeat", 2, 1, 100);
+  pr::rt::BvhBuildOptions options;
+  options.maxLeafSize = intArg(argc, argv, "--leaf", options.maxLeafSize, 1, 64);
+  options.bins = intArg(argc, argv, "--bins", options.bins, 2, 32);
+  // SAH traversal cost in percent of one triangle test.
+  options.traversalCost = float(intArg(argc, argv, "--traversal-cost", int(options.traversalCost * 100.0f), 1, 1000)) / 100.0f;
+  std::printf("BVH options: leaf <= %d, %d bins, traversal cost %.2f\n", options.maxLeafSize, options.bins, options.traversalCost);
   std::printf("bench_rays: ray tracing core, single-threaded (Embree anchors: shared/ANCHORS.md)\n");
 
   const auto genStart = Clock::now();
@@ -265,10 +272,10 @@ int main(int argc, char** argv) {
   // From the south-west corner, above the hills, looking across: about half the primary
   // rays hit the ground, the rest leave above the horizon (as in the anchor scene).
   runScene("fBm terrain", land, lookAt({-50.0f, -50.0f, 300.0f}, {500.0f, 500.0f, 120.0f}, 60.0f),
-           glm::normalize(glm::vec3(0.4f, 0.3f, 0.6f)), res, repeat);
+           glm::normalize(glm::vec3(0.4f, 0.3f, 0.6f)), res, repeat, options);
 
   const pr::scene::Scene box = cornellBox();
   runScene("Cornell box", box, lookAt({2.775f, 2.775f, 10.5f}, {2.775f, 2.775f, 0.0f}, 40.0f),
-           glm::normalize(glm::vec3(0.1f, 1.0f, 0.2f)), res, repeat);
+           glm::normalize(glm::vec3(0.1f, 1.0f, 0.2f)), res, repeat, options);
   return 0;
 }
