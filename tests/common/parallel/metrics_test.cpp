@@ -1,0 +1,60 @@
+// Metrics: imbalance, efficiency, synchronisation wait, computation-to-communication ratio and
+// the scaling figures (speed-up, efficiency, Karp-Flatt), with analytic expectations.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "common/parallel/metrics.h"
+#include "common/parallel/simulator.h"
+#include "common/util/error.h"
+#include "tests/common/parallel/parallel_test_support.h"
+
+using namespace pr::par;
+
+TEST_CASE("Metrics: imbalance of the seed's balanced split is 21 / 14 - 1") {
+  SimOptions options;
+  options.pes = 3;
+  const RunSummary s = summarize(simulate(pr::test::seedExample(), "balanced", options));
+  // busy 21, 13, 8: mean 14, max 21.
+  CHECK(s.total.imbalance == doctest::Approx(0.5));
+  CHECK(s.total.efficiency == doctest::Approx(42.0 / (3 * 21.0)));
+  // PEs 1 and 2 wait 8 and 13 units at the end of the stage.
+  CHECK(s.total.syncWaitSeconds == doctest::Approx(21.0));
+  CHECK(s.total.figure("busySeconds").min == 8.0);
+  CHECK(s.total.figure("busySeconds").max == 21.0);
+  CHECK(s.total.figure("tasks").mean == 8.0);
+  CHECK(s.total.computeToComm < 0.0);  // nothing was communicated
+  const std::string table = formatSummary(s);
+  CHECK(table.find("imbalance") != std::string::npos);
+  CHECK(table.find("busySeconds") != std::string::npos);
+}
+
+TEST_CASE("Metrics: load imbalance is zero for equal or no work") {
+  CHECK(loadImbalance({2.0, 2.0, 2.0}) == 0.0);
+  CHECK(loadImbalance({0.0, 0.0}) == 0.0);
+  CHECK(loadImbalance({1.0, 3.0}) == doctest::Approx(0.5));
+}
+
+TEST_CASE("Metrics: Amdahl's law gives back its serial fraction through Karp-Flatt") {
+  // T(P) = T1 * (f + (1 - f) / P) with f = 0.1: Karp-Flatt recovers f at every P > 1.
+  std::vector<ScalingPoint> points;
+  for (int p : {1, 2, 4, 8, 16}) points.push_back({p, 100.0 * (0.1 + 0.9 / p)});
+  const ScalingTable t = scalingTable(points, 80.0);
+  REQUIRE(t.rows.size() == 5);
+  CHECK(std::isnan(t.rows[0].karpFlatt));
+  for (std::size_t i = 1; i < t.rows.size(); ++i) CHECK(t.rows[i].karpFlatt == doctest::Approx(0.1));
+  CHECK(t.rows[1].speedup == doctest::Approx(100.0 / 55.0));
+  CHECK(t.rows[1].speedupSerial == doctest::Approx(80.0 / 55.0));
+  CHECK(t.rows[2].efficiency == doctest::Approx(100.0 / 32.5 / 4));
+  CHECK(t.bestPes == 16);
+  // 16 takes 15.625; 8 takes 21.25 (36% more): P = 16 is the first within 5% of the best.
+  CHECK(t.saturationPes == 16);
+  CHECK(formatScaling(t).find("Karp-Flatt") != std::string::npos);
+  CHECK_THROWS_AS(scalingTable({{2, 1.0}}), pr::InputError);
+}
+
+TEST_CASE("Metrics: saturation is where adding PEs stops helping") {
+  const ScalingTable t = scalingTable({{1, 10.0}, {2, 5.0}, {4, 4.0}, {8, 3.9}, {16, 4.2}});
+  CHECK(t.bestPes == 8);
+  CHECK(t.saturationPes == 4);  // 4.0 <= 1.05 * 3.9
+}

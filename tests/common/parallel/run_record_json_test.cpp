@@ -1,0 +1,77 @@
+// RunRecord JSON and Chrome trace output: a record survives the round trip through JSON, and
+// the trace holds one complete event per task span on the PE's track.
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "common/parallel/channel.h"
+#include "common/parallel/run_record.h"
+#include "common/util/error.h"
+
+using namespace pr::par;
+
+namespace {
+
+RunRecord sampleRecord() {
+  Runtime rt(3, "spiral");
+  Channel<int> ch(rt, "c");
+  rt.runStage("tiles", TaskSet::grid(3, 2), [&](Pe& pe, TaskId id) { ch.send(pe, (pe.id() + 1) % 3, int(id), 24); });
+  return rt.record();
+}
+
+}  // namespace
+
+TEST_CASE("RunRecord: JSON round trip keeps every measured field") {
+  const RunRecord a = sampleRecord();
+  const RunRecord b = runRecordFromJsonText(toJsonText(a), "test");
+  CHECK(b.pes == 3);
+  CHECK(b.schedule == "spiral");
+  REQUIRE(b.stages.size() == 1);
+  CHECK(b.stages[0].name == "tiles");
+  CHECK(b.stages[0].tasks.size() == 6);
+  CHECK(b.stages[0].tasks[4].x == a.stages[0].tasks[4].x);
+  REQUIRE(b.timeline.size() == a.timeline.size());
+  for (std::size_t i = 0; i < a.timeline.size(); ++i) {
+    CHECK(b.timeline[i].task == a.timeline[i].task);
+    CHECK(b.timeline[i].start == a.timeline[i].start);
+    CHECK(b.timeline[i].bytesSent == a.timeline[i].bytesSent);
+  }
+  for (int p = 0; p < 3; ++p) {
+    CHECK(b.stages[0].pes[p].busySeconds == a.stages[0].pes[p].busySeconds);
+    CHECK(b.stages[0].pes[p].bytesSent == a.stages[0].pes[p].bytesSent);
+    CHECK(b.stages[0].pes[p].messagesReceived == a.stages[0].pes[p].messagesReceived);
+  }
+  CHECK(b.stages[0].traffic.size() == a.stages[0].traffic.size());
+  const auto j = nlohmann::json::parse(toJsonText(a));
+  CHECK(j["summary"]["perPe"]["busySeconds"].contains("max"));
+  CHECK(j["stages"][0]["summary"].contains("imbalance"));
+}
+
+TEST_CASE("RunRecord: Chrome trace has one complete event per span, in microseconds") {
+  const RunRecord r = sampleRecord();
+  const auto j = nlohmann::json::parse(toChromeTraceText(r));
+  int complete = 0;
+  for (const auto& e : j["traceEvents"]) {
+    if (e["ph"] != "X") continue;
+    ++complete;
+    CHECK(e["dur"].get<double>() >= 0.0);
+    CHECK(e["tid"].get<int>() < 3);
+    CHECK(e["cat"] == "tiles");
+  }
+  CHECK(complete == static_cast<int>(r.timeline.size()));
+}
+
+TEST_CASE("RunRecord: malformed JSON is an input error naming the file and key") {
+  CHECK_THROWS_WITH_AS(runRecordFromJsonText("{\"stages\": []}", "m.json"), "m.json: run record has no \"pes\"",
+                       pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText("not json", "m.json"), pr::InputError);
+  CHECK_THROWS_AS(readRunRecord("/nonexistent/run.json"), pr::InputError);
+  CHECK_THROWS_AS(writeRunRecord(sampleRecord(), "/nonexistent/dir/run.json"), pr::InputError);
+}
+
+TEST_CASE("RunRecord: a cost profile from a recorded run sums each task's spans") {
+  const RunRecord r = sampleRecord();
+  const auto costs = taskCostProfile(r, 0);
+  REQUIRE(costs.size() == 6);
+  for (const TaskSpan& s : r.timeline) CHECK(costs[s.task] == doctest::Approx(s.end - s.start));
+}

@@ -1,0 +1,159 @@
+// parrender simulate: predicts what a recorded run (or a cost table) would do at other P and
+// on other networks, with the same scheduling strategies in virtual time
+// (common/parallel/simulator.h). Prints one row per P: makespan, speed-up, efficiency,
+// imbalance, communication volume, Karp-Flatt serial fraction; then the P beyond which adding
+// PEs stops helping.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common/parallel/metrics.h"
+#include "common/parallel/run_options.h"
+#include "common/parallel/simulator.h"
+#include "common/util/error.h"
+#include "tools/commands.h"
+
+namespace pr::cli {
+namespace {
+
+constexpr int kMaxSimulatedPes = 1024;
+
+// "1,2,4,...,1024": numbers, and "..." continuing the progression of the two numbers before it
+// (geometric when their ratio is a whole number > 1, else arithmetic) up to the number after it.
+std::vector<int> parsePesList(const std::string& text) {
+  std::vector<int> pes;
+  std::vector<std::string> tokens;
+  std::stringstream in(text);
+  for (std::string token; std::getline(in, token, ',');) tokens.push_back(token);
+  auto bad = [&](const std::string& why) { throw InputError("--pes '" + text + "': " + why); };
+  for (std::size_t i = 0; i < tokens.size(); ++i) {
+    const std::string& t = tokens[i];
+    if (t == "...") {
+      if (pes.size() < 2 || i + 1 >= tokens.size()) bad("'...' needs two numbers before it and one after it");
+      const int a = pes[pes.size() - 2], b = pes.back();
+      int limit = 0;
+      try {
+        limit = std::stoi(tokens[i + 1]);
+      } catch (const std::exception&) {
+        bad("'" + tokens[i + 1] + "' is not a number");
+      }
+      if (b <= a) bad("'...' needs an increasing progression");
+      const bool geometric = b % a == 0 && b / a > 1;
+      for (long next = geometric ? long(b) * (b / a) : 2L * b - a; next < limit;
+           next = geometric ? next * (b / a) : next + (b - a))
+        pes.push_back(static_cast<int>(next));
+      continue;
+    }
+    std::size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(t, &used);
+    } catch (const std::exception&) {
+      bad("'" + t + "' is not a number");
+    }
+    if (used != t.size()) bad("'" + t + "' is not a number");
+    if (value < 1 || value > kMaxSimulatedPes) bad("P must be in [1, " + std::to_string(kMaxSimulatedPes) + "], got " + t);
+    pes.push_back(value);
+  }
+  if (pes.empty()) bad("no P given");
+  return pes;
+}
+
+struct SimulateArgs {
+  std::string input;
+  std::string pes = "1,2,4,...,1024";
+  std::string network = "shared-memory";
+  par::ScheduleOptions schedule;
+  bool scheduleGiven = false;
+};
+
+void runSimulate(const SimulateArgs& args) {
+  const par::NetworkModel& network = par::networkByName(args.network);
+  const std::vector<int> pesList = parsePesList(args.pes);
+  const par::Workload workload = par::readWorkload(args.input);
+
+  // The recorded run's schedule and grain unless the command line names others.
+  std::string schedule = args.schedule.schedule;
+  par::ScheduleParams params = args.schedule.params;
+  if (!args.scheduleGiven && !workload.schedule.empty() && par::isSchedule(workload.schedule)) {
+    schedule = workload.schedule;
+    params.grain = workload.grain;
+  }
+  std::size_t tasks = 0;
+  double work = 0.0;
+  for (const par::SimStage& s : workload.stages) {
+    tasks += s.costs.size();
+    for (double c : s.costs) work += c;
+  }
+  if (workload.recordedPes > 0)
+    std::printf("recorded run: P = %d, schedule %s, wall %.6f s; %zu stages, %zu tasks, %.6f s of task work\n",
+                workload.recordedPes, workload.schedule.c_str(), workload.recordedWallSeconds, workload.stages.size(),
+                tasks, work);
+  else
+    std::printf("cost table: %zu tasks, %.6f s of task work\n", tasks, work);
+  if (workload.unmodelledSeconds > 0.0)
+    std::printf("note: %.6f s of message-handler time in the record is not replayed by the simulator\n",
+                workload.unmodelledSeconds);
+  std::printf("schedule %s, grain %d; network %s (%s)\n\n", schedule.c_str(), params.grain,
+              std::string(network.name).c_str(), std::string(network.description).c_str());
+
+  std::vector<par::ScalingPoint> points;
+  std::vector<par::RunSummary> summaries;
+  std::vector<int> all = pesList;
+  if (std::find(all.begin(), all.end(), 1) == all.end()) all.insert(all.begin(), 1);  // T1 for speed-up
+  std::sort(all.begin(), all.end());
+  all.erase(std::unique(all.begin(), all.end()), all.end());
+  for (int p : all) {
+    par::SimOptions options;
+    options.pes = p;
+    options.params = params;
+    options.network = network;
+    const par::RunRecord predicted = par::simulate(workload, schedule, options);
+    points.push_back({p, predicted.wallSeconds});
+    summaries.push_back(par::summarize(predicted));
+  }
+  const par::ScalingTable table = par::scalingTable(points);
+  std::printf("%6s %14s %10s %8s %10s %11s %12s %14s\n", "P", "makespan s", "speed-up", "effic.", "imbalance",
+              "Karp-Flatt", "messages", "bytes");
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    if (std::find(pesList.begin(), pesList.end(), all[i]) == pesList.end()) continue;
+    const par::ScalingRow& row = table.rows[i];
+    const par::StageSummary& total = summaries[i].total;
+    char kf[32] = "-";
+    if (!std::isnan(row.karpFlatt)) std::snprintf(kf, sizeof kf, "%.4f", row.karpFlatt);
+    std::printf("%6d %14.6f %10.3f %8.4f %10.4f %11s %12llu %14llu\n", row.pes, row.seconds, row.speedup,
+                row.efficiency, total.imbalance, kf,
+                (unsigned long long)(total.messages + total.schedulingMessages),
+                (unsigned long long)(total.bytes + total.schedulingBytes));
+  }
+  std::printf("\nbest P: %d (makespan %.6f s); adding PEs beyond P = %d gains less than %.0f%%\n", table.bestPes,
+              points[std::find(all.begin(), all.end(), table.bestPes) - all.begin()].seconds, table.saturationPes,
+              par::kSaturationTolerance * 100.0);
+}
+
+}  // namespace
+
+void addSimulateCommand(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  CLI::App* cmd = app.add_subcommand(
+      "simulate",
+      "predict makespan, speed-up, efficiency, imbalance and traffic at other P and networks, from a run record "
+      "(--metrics JSON) or a cost table (one task cost in seconds per line, optionally 'cost x y')");
+  cmd->add_option("input", args->input, "run record JSON or cost table")->required()->check(CLI::ExistingFile);
+  cmd->add_option("--pes", args->pes, "PE counts to simulate, e.g. 1,2,4,...,1024 (P in [1, 1024])")
+      ->capture_default_str();
+  cmd->add_option("--network", args->network, "communication model:\n" + par::describeNetworks())
+      ->capture_default_str();
+  par::addScheduleOptions(*cmd, args->schedule);
+  cmd->callback([args, cmd] {
+    args->scheduleGiven = cmd->count("--schedule") > 0;
+    runSimulate(*args);
+  });
+}
+
+}  // namespace pr::cli
