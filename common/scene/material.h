@@ -19,6 +19,8 @@ struct TextureRef {
   int texCoord = 0;               // UV set; parrender loads set 0 only
   glm::mat3 uvTransform{1.0f};    // applied to (u, v, 1): offset * rotation * scale
   bool present() const { return texture >= 0; }
+  // The UV at which to sample the texture: uvTransform applied to (u, v, 1).
+  glm::vec2 transformUv(glm::vec2 uv) const;
 };
 
 enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
@@ -51,6 +53,7 @@ struct Material {
   // KHR_materials_anisotropy
   float anisotropyStrength = 0.0f;
   float anisotropyRotation = 0.0f;  // radians
+  TextureRef anisotropyTexture;     // RG = direction, B = strength (KHR_materials_anisotropy)
   // core flags
   bool doubleSided = false;
   AlphaMode alphaMode = AlphaMode::Opaque;

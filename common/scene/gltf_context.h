@@ -1,0 +1,41 @@
+// Shared state of one glTF load (internal to gltf_loader.cpp and its helper files): the
+// tinygltf model, the file name every error message starts with, and warning collection.
+// Not part of the scene API: only the loader's own .cpp files include it.
+#pragma once
+
+#include <set>
+#include <string>
+
+#include <tiny_gltf.h>
+
+#include "common/scene/scene.h"
+#include "common/util/error.h"
+#include "common/util/log.h"
+
+namespace pr::scene::gltf {
+
+struct Context {
+  const tinygltf::Model& model;
+  std::string file;  // as given by the user, so messages name what they typed
+  Scene& scene;
+  std::set<std::string> warned;  // each distinct warning once, however many instances repeat it
+
+  // Bad input: one message naming the file, the element and the problem.
+  [[noreturn]] void fail(const std::string& what) const { throw InputError(file + ": " + what); }
+
+  // Optional content skipped or ignored: printed once and kept in Scene::warnings.
+  void warn(const std::string& what) {
+    if (!warned.insert(what).second) return;
+    scene.warnings.push_back(what);
+    pr::warn(file + ": " + what);
+  }
+};
+
+// "mesh 2 'Box'" (the name only when the file gives one), for messages.
+inline std::string describe(const char* kind, int index, const std::string& name) {
+  std::string s = std::string(kind) + " " + std::to_string(index);
+  if (!name.empty()) s += " '" + name + "'";
+  return s;
+}
+
+}  // namespace pr::scene::gltf

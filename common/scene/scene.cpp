@@ -1,0 +1,22 @@
+// Size of the render-ready scene: what a world-model PE holds, and what a broadcast of the
+// scene ADI costs (counted once per receiving PE by the Channel).
+#include "common/scene/scene.h"
+
+namespace pr::scene {
+
+namespace {
+template <class T>
+size_t bytesOf(const std::vector<T>& v) {
+  return v.size() * sizeof(T);
+}
+}  // namespace
+
+size_t Scene::memoryBytes() const {
+  size_t bytes = bytesOf(positions) + bytesOf(normals) + bytesOf(uvs) + bytesOf(colors) +
+                 bytesOf(triangles) + bytesOf(objects) + bytesOf(materials) + bytesOf(textures) +
+                 bytesOf(lights) + bytesOf(areaLights) + bytesOf(cameras);
+  for (const Texture& t : textures) bytes += t.memoryBytes();
+  return bytes;
+}
+
+}  // namespace pr::scene

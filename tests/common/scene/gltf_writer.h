@@ -1,0 +1,185 @@
+// Test support: writes small glTF files from a test (JSON text with one base64 data: buffer)
+// into a scratch directory, so loader tests state their geometry next to their expectations.
+// Also the catalogue of bad input files shared by the loader and `parrender info` tests.
+#pragma once
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+namespace pr::test {
+
+inline std::string base64(const std::vector<uint8_t>& bytes) {
+  static const char* kAlphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  size_t i = 0;
+  for (; i + 2 < bytes.size(); i += 3) {
+    uint32_t v = uint32_t(bytes[i]) << 16 | uint32_t(bytes[i + 1]) << 8 | bytes[i + 2];
+    for (int s = 18; s >= 0; s -= 6) out += kAlphabet[(v >> s) & 63];
+  }
+  if (size_t rest = bytes.size() - i; rest > 0) {
+    uint32_t v = uint32_t(bytes[i]) << 16 | (rest == 2 ? uint32_t(bytes[i + 1]) << 8 : 0);
+    out += kAlphabet[(v >> 18) & 63];
+    out += kAlphabet[(v >> 12) & 63];
+    out += rest == 2 ? kAlphabet[(v >> 6) & 63] : '=';
+    out += '=';
+  }
+  return out;
+}
+
+// Builds one glTF document: binary data goes into buffer 0 (written as a data: URI),
+// everything else is edited directly in `doc`.
+class GltfWriter {
+ public:
+  nlohmann::json doc = {{"asset", {{"version", "2.0"}}}};
+
+  // Appends raw bytes (4-byte aligned) as a new bufferView; returns its index.
+  int addView(const void* data, size_t bytes, int byteStride = 0) {
+    while (bin_.size() % 4) bin_.push_back(0);
+    nlohmann::json view = {{"buffer", 0}, {"byteOffset", bin_.size()}, {"byteLength", bytes}};
+    if (byteStride) view["byteStride"] = byteStride;
+    const auto* p = static_cast<const uint8_t*>(data);
+    bin_.insert(bin_.end(), p, p + bytes);
+    doc["bufferViews"].push_back(view);
+    return int(doc["bufferViews"].size()) - 1;
+  }
+
+  int addAccessor(int view, int componentType, size_t count, const std::string& type, size_t byteOffset = 0,
+                  bool normalized = false) {
+    nlohmann::json a = {{"componentType", componentType}, {"count", count}, {"type", type}};
+    if (view >= 0) a["bufferView"] = view;
+    if (byteOffset) a["byteOffset"] = byteOffset;
+    if (normalized) a["normalized"] = true;
+    doc["accessors"].push_back(a);
+    return int(doc["accessors"].size()) - 1;
+  }
+
+  int addFloats(const std::vector<float>& values, const std::string& type) {
+    int components = type == "SCALAR" ? 1 : type == "VEC2" ? 2 : type == "VEC3" ? 3 : 4;
+    int view = addView(values.data(), values.size() * sizeof(float));
+    return addAccessor(view, 5126, values.size() / size_t(components), type);
+  }
+
+  int addIndices(const std::vector<uint16_t>& indices) {
+    int view = addView(indices.data(), indices.size() * sizeof(uint16_t));
+    return addAccessor(view, 5123, indices.size(), "SCALAR");
+  }
+
+  // A mesh with one primitive; returns the mesh index.
+  int addMesh(nlohmann::json attributes, int indices = -1, int mode = 4, int material = -1) {
+    nlohmann::json prim = {{"attributes", attributes}, {"mode", mode}};
+    if (indices >= 0) prim["indices"] = indices;
+    if (material >= 0) prim["material"] = material;
+    doc["meshes"].push_back({{"primitives", {prim}}});
+    return int(doc["meshes"].size()) - 1;
+  }
+
+  int addNode(nlohmann::json node) {
+    doc["nodes"].push_back(node);
+    return int(doc["nodes"].size()) - 1;
+  }
+
+  // A scene 0 with the given root nodes.
+  void setRoots(const std::vector<int>& roots) { doc["scenes"] = {{{"nodes", roots}}}; doc["scene"] = 0; }
+
+  std::filesystem::path write(const std::filesystem::path& dir, const std::string& name) {
+    nlohmann::json out = doc;
+    if (!bin_.empty()) {
+      out["buffers"] = {{{"byteLength", bin_.size()},
+                         {"uri", "data:application/octet-stream;base64," + base64(bin_)}}};
+    }
+    auto path = dir / name;
+    std::ofstream(path) << out.dump(1);
+    return path;
+  }
+
+ private:
+  std::vector<uint8_t> bin_;
+};
+
+// One triangle in the z = 0 plane facing +Z: the smallest valid drawable file.
+inline GltfWriter oneTriangle() {
+  GltfWriter w;
+  int pos = w.addFloats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+  int mesh = w.addMesh({{"POSITION", pos}});
+  w.setRoots({w.addNode({{"mesh", mesh}})});
+  return w;
+}
+
+// A bad input file and the words its error message must contain (besides the file name).
+struct BadInput {
+  std::string name;
+  std::filesystem::path path;
+  std::string expected;
+};
+
+// Writes one file per kind of bad input the loader must reject with an InputError.
+inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
+  std::vector<BadInput> bad;
+  bad.push_back({"missing file", dir / "does_not_exist.gltf", "no such file"});
+  {
+    auto path = dir / "malformed.gltf";
+    std::ofstream(path) << "{ \"asset\": { \"version\": \"2.0\" }, \"nodes\": [ {";
+    bad.push_back({"malformed JSON", path, "not a valid glTF"});
+  }
+  {
+    auto path = dir / "truncated.glb";
+    std::ofstream(path, std::ios::binary) << "glTF\x02\x00\x00\x00garbage";
+    bad.push_back({"truncated glb", path, "not a valid glTF binary"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
+    w.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
+    bad.push_back({"unsupported required extension", w.write(dir, "required_ext.gltf"),
+                   "requires extension KHR_draco_mesh_compression"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["meshes"][0]["primitives"][0]["attributes"]["NORMAL"] = 7;
+    bad.push_back({"accessor index out of range", w.write(dir, "accessor_index.gltf"), "accessor 7 is out of range"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["accessors"][0]["count"] = 4;  // 4 VEC3 floats = 48 bytes, the view has 36
+    bad.push_back({"accessor past its bufferView", w.write(dir, "accessor_range.gltf"), "bufferView 0 has 36"});
+  }
+  {
+    GltfWriter w;
+    int pos = w.addFloats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    int idx = w.addIndices({0, 1, 5});
+    w.setRoots({w.addNode({{"mesh", w.addMesh({{"POSITION", pos}}, idx)}})});
+    bad.push_back({"index out of range", w.write(dir, "index_range.gltf"), "index 5 is out of range"});
+  }
+  {
+    GltfWriter w;
+    float nan = std::numeric_limits<float>::quiet_NaN();
+    int pos = w.addFloats({0, 0, 0, 1, nan, 0, 0, 1, 0}, "VEC3");
+    w.setRoots({w.addNode({{"mesh", w.addMesh({{"POSITION", pos}})}})});
+    bad.push_back({"NaN vertex", w.write(dir, "nan_vertex.gltf"), "element 1 is not a finite number"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["images"] = {{{"uri", "missing_texture.png"}}};
+    w.doc["textures"] = {{{"source", 0}}};
+    w.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+    w.doc["meshes"][0]["primitives"][0]["material"] = 0;
+    bad.push_back({"missing texture file", w.write(dir, "missing_texture.gltf"),
+                   "texture file 'missing_texture.png' is missing"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["nodes"][0].erase("mesh");  // a scene whose only node draws nothing
+    bad.push_back({"empty scene", w.write(dir, "empty_scene.gltf"), "contains no triangles"});
+  }
+  return bad;
+}
+
+}  // namespace pr::test
