@@ -15,6 +15,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", "parrender 0.1.0");
   // One line per subcommand (tools/commands.h).
   pr::cli::addGenerateCommand(app);
+  pr::cli::addInfoCommand(app);
   pr::cli::addSimulateCommand(app);
 
   try {
