@@ -118,7 +118,10 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
   return ctx;
 }
 
-glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L) {
+namespace {
+
+// evalBrdf's body, inlined into the per-pixel light loop.
+inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L) {
   float NdotL = std::max(glm::dot(N, L), 0.0f);
   if (NdotL <= 0.0f) return glm::vec3(0.0f);
   // Interpolated normals can face slightly away from the eye at silhouettes; keep NdotV > 0.
@@ -151,6 +154,12 @@ glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N,
   return diffuse + F * specularScale;
 }
 
+}  // namespace
+
+glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L) {
+  return brdf(base, metallic, roughness, N, V, L);
+}
+
 glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
   const scene::Scene& scene = *ctx.scene;
   const scene::Material& m = scene.materials[sp.material];
@@ -172,7 +181,7 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
     if (!incidentLight(light, sp.position, L, E)) continue;
     float NdotL = glm::dot(sp.normal, L);
     if (NdotL <= 0.0f) continue;
-    radiance += evalBrdf(albedo, metallic, roughness, sp.normal, V, L) * E * NdotL;
+    radiance += brdf(albedo, metallic, roughness, sp.normal, V, L) * E * NdotL;
   }
   return radiance;
 }
