@@ -1,0 +1,67 @@
+// DataManager: owner lookup, per-PE LRU cache of remote items, exact hit/miss counts for a
+// known access sequence, prefetch, and the fetch traffic counted in the stage.
+#include <doctest/doctest.h>
+
+#include <string>
+
+#include "common/parallel/data_manager.h"
+
+using namespace pr::par;
+
+TEST_CASE("DataManager: owner lookup by blocks and cyclic") {
+  const OwnerMap blocks = OwnerMap::blocks(10, 3);
+  CHECK(blocks.owner(0) == 0);
+  CHECK(blocks.owner(3) == 0);
+  CHECK(blocks.owner(4) == 1);
+  CHECK(blocks.owner(9) == 2);
+  const OwnerMap cyclic = OwnerMap::cyclic(10, 3);
+  CHECK(cyclic.owner(4) == 1);
+  CHECK(cyclic.owner(9) == 0);
+}
+
+TEST_CASE("DataManager: LRU cache keeps the most recently used items") {
+  DataCache<int> cache(2);
+  cache.insert(1, 10);
+  cache.insert(2, 20);
+  REQUIRE(cache.find(1) != nullptr);  // 1 is now most recent
+  cache.insert(3, 30);                // evicts 2
+  CHECK(cache.find(2) == nullptr);
+  CHECK(*cache.find(1) == 10);
+  CHECK(*cache.find(3) == 30);
+  CHECK(cache.size() == 2);
+}
+
+TEST_CASE("DataManager: hit and miss counts are exact for a known access sequence") {
+  // Items 0..9 on PE 1 (blocks of 5: 0-4 on PE 0, 5-9 on PE 1). PE 0 reads remote items with a
+  // cache of 2: 5 miss, 6 miss, 5 hit, 7 miss (evicts 6), 6 miss (evicts 5), 5 miss (evicts 7),
+  // local 0 (not counted), then prefetch 8 and 9 (evict 6 and 5) and read them: 2 hits.
+  // In all 3 hits and 5 misses.
+  Runtime rt(2, "balanced");
+  std::vector<std::string> partition(10);
+  for (int i = 0; i < 10; ++i) partition[i] = std::string(static_cast<std::size_t>(i + 1), 'x');
+  DataManager<std::string> data(
+      2, OwnerMap::blocks(10, 2), 2, [&](int, ItemId item) { return partition[item]; },
+      [](const std::string& s) { return s.size(); });
+  std::string seen;
+  rt.runStage("read", TaskSet::uniform(2), [&](Pe& pe, TaskId) {
+    if (pe.id() != 0) return;
+    for (ItemId item : {5, 6, 5, 7, 6, 5, 0}) seen += std::to_string(data.acquire(pe, item).size()) + " ";
+    data.prefetch(pe, {8, 9, 0});
+    for (ItemId item : {8, 9}) seen += std::to_string(data.acquire(pe, item).size()) + " ";
+  });
+  CHECK(seen == "6 7 6 8 7 6 1 9 10 ");
+  CHECK(data.hits(0) == 3);
+  CHECK(data.misses(0) == 5);
+  const PeStageRecord& pe0 = rt.record().stages[0].pes[0];
+  const PeStageRecord& pe1 = rt.record().stages[0].pes[1];
+  CHECK(pe0.cacheHits == 3);
+  CHECK(pe0.cacheMisses == 5);
+  CHECK(pe0.prefetches == 2);
+  // 7 fetches (5 misses + 2 prefetches): a request each from PE 0, a reply each from PE 1
+  // carrying the item, in fetch order 5, 6, 7, 6, 5, 8, 9 (item i has i + 1 bytes).
+  CHECK(pe0.messagesSent == 7);
+  CHECK(pe0.bytesSent == 7 * kItemRequestBytes);
+  CHECK(pe1.messagesSent == 7);
+  CHECK(pe1.bytesSent == 6u + 7 + 8 + 7 + 6 + 9 + 10);
+  CHECK(pe0.bytesReceived == pe1.bytesSent);
+}
