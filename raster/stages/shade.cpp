@@ -20,6 +20,8 @@ constexpr float kPi = std::numbers::pi_v<float>;
 // Roughness below this makes the GGX lobe narrower than a pixel's worth of directions and the
 // highlight of a point light a single-sample spike (Filament's clamp, 0.045).
 constexpr float kMinRoughness = 0.045f;
+// Headlight irradiance: pi lux makes a white Lambertian surface facing the camera radiance 1.
+constexpr float kHeadlightLux = kPi;
 
 // Scene-triangle barycentrics from the exact edge values at a sample (shade.h).
 glm::vec3 barycentricsFromEdges(const ScreenTriangle& tri, int64_t e0, int64_t e1, int64_t e2) {
@@ -106,15 +108,7 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
   ctx.scene = &scene;
   ctx.view = view;
   ctx.lights = scene.lights;
-  if (ctx.lights.empty()) {
-    scene::PunctualLight headlight;
-    headlight.name = "headlight";
-    headlight.type = scene::LightType::Directional;
-    headlight.direction = view.forward;
-    headlight.intensity = kPi;
-    ctx.lights.push_back(headlight);
-    ctx.usesHeadlight = true;
-  }
+  ctx.usesHeadlight = ctx.lights.empty();
   return ctx;
 }
 
@@ -176,6 +170,11 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
 
   glm::vec3 V = ctx.view.perspective ? glm::normalize(ctx.view.eye - sp.position) : -ctx.view.forward;
   glm::vec3 albedo(base);
+  if (ctx.usesHeadlight) {
+    float NdotV = glm::dot(sp.normal, V);
+    if (NdotV > 0.0f) radiance += brdf(albedo, metallic, roughness, sp.normal, V, V) * (kHeadlightLux * NdotV);
+    return radiance;
+  }
   for (const scene::PunctualLight& light : ctx.lights) {
     glm::vec3 L, E;
     if (!incidentLight(light, sp.position, L, E)) continue;

@@ -41,9 +41,10 @@ SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm
 struct ShadingContext {
   const scene::Scene* scene = nullptr;
   FrameView view;
-  // The scene's punctual lights; when it has none, one directional headlight along the view
-  // direction of pi lux, so that a white Lambertian surface facing the camera has radiance 1
-  // (a scene lit only by emission or with no lights is still visible). usesHeadlight says so.
+  // The scene's punctual lights. When it has none, a headlight: light arriving from the eye
+  // at every point (L = V) with pi lux, so that a white Lambertian surface facing the camera
+  // has radiance 1 and walls seen at an angle stay visible (a scene lit only by emission is
+  // still readable). usesHeadlight says so; lights is then empty.
   std::vector<scene::PunctualLight> lights;
   bool usesHeadlight = false;
 };

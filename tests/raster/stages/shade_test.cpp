@@ -155,6 +155,24 @@ TEST_CASE("Shade: double-sided back faces are lit on the viewer's side, emission
   CHECK(near(fb.colour(12, 12), lit + glm::vec3(2.0f, 1.0f, 0.0f), 1e-5f));
 }
 
+TEST_CASE("Shade: without punctual lights a headlight at the eye lights by cos(N, V)") {
+  scene::Scene s = test::emptyScene();
+  FrameView view = makeFrameView(test::lookAtCamera({0, 0, 0}, {0, 0, -1}), 16, 16);
+  ShadingContext ctx = makeShadingContext(s, view);
+  CHECK(ctx.usesHeadlight);
+  // A floor point 1 below and 1 ahead of the eye: V = (0, 1, 1)/sqrt 2, N = +y, cos = 1/sqrt 2.
+  SurfacePoint sp;
+  sp.position = glm::vec3(0.0f, -1.0f, -1.0f);
+  sp.normal = glm::vec3(0.0f, 1.0f, 0.0f);
+  glm::vec3 V = glm::normalize(glm::vec3(0.0f, 1.0f, 1.0f));
+  glm::vec3 expected = evalBrdf(glm::vec3(1.0f), 0.0f, 1.0f, sp.normal, V, V) * (kPi * V.y);
+  CHECK(near(shadeSurface(ctx, sp), expected, 1e-5f));
+  CHECK(shadeSurface(ctx, sp).x > 0.5f);
+  // Facing away from the eye: unlit.
+  sp.normal = -sp.normal;
+  CHECK(shadeSurface(ctx, sp) == glm::vec3(0.0f));
+}
+
 TEST_CASE("Shade: base colour textures use the sampler's wrap mode and bilinear filter") {
   scene::Scene s = test::emptyScene();
   scene::Texture tex;
