@@ -125,6 +125,7 @@ struct PreparedVertex {
   glm::vec4 clip;
   float viewDepth;
   uint32_t viewportCode, guardCode;
+  bool finite;            // false for NaN/inf input or a transform that overflowed float
   SnappedVertex snapped;  // valid when guardCode == 0
 };
 
@@ -134,6 +135,12 @@ struct PreparedVertex {
   ClipVertex v{view.viewProjection * hp, glm::dot(view.viewDepthRow, hp), glm::vec2(0.0f)};
   out.clip = v.clip;
   out.viewDepth = v.viewDepth;
+  out.finite = std::isfinite(v.clip.x) && std::isfinite(v.clip.y) && std::isfinite(v.clip.z) &&
+               std::isfinite(v.clip.w) && std::isfinite(v.viewDepth);
+  if (!out.finite) {
+    out.viewportCode = out.guardCode = 0;
+    return;
+  }
   out.viewportCode = outcode(view, v, false);
   out.guardCode = outcode(view, v, true);
   if (out.guardCode == 0) snap(view, v.clip, v.viewDepth, out.snapped);
@@ -144,6 +151,12 @@ struct PreparedVertex {
 int assembleTriangle(const scene::Scene& scene, const FrameView& view, uint32_t index, const PreparedVertex* pv[3],
                      ScreenTriangle* out, GeometryCounters& c) {
   ++c.trianglesIn;
+  // A non-finite corner has no meaningful position on screen: the triangle is dropped whole
+  // (the loader rejects such files; this keeps NaN out of the fixed-point conversion anyway).
+  if (!(pv[0]->finite && pv[1]->finite && pv[2]->finite)) {
+    ++c.culledDegenerate;
+    return 0;
+  }
   // Trivial reject: all three outside one viewport or near plane (the triangle is the convex
   // hull of its clip-space vertices, so it cannot reach into the frustum).
   if (pv[0]->viewportCode & pv[1]->viewportCode & pv[2]->viewportCode) {

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "common/util/error.h"
@@ -261,6 +262,21 @@ TEST_CASE("Geometry: triangles entirely outside or behind are rejected early") {
   auto tris = geometry(s, makeFrameView(test::lookAtCamera({0, 0, 0}, {0, 0, -1}), 16, 16), &counters);
   CHECK(tris.empty());
   CHECK(counters.culledOutside == 2);
+}
+
+TEST_CASE("Geometry: non-finite and overflowing positions are dropped, not rasterized") {
+  scene::Scene s = test::emptyScene();
+  const float inf = std::numeric_limits<float>::infinity();
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  test::addTriangle(s, {nan, 0, -5}, {1, 0, -5}, {0, 1, -5});
+  test::addTriangle(s, {-1, 0, -5}, {inf, 0, -5}, {0, 1, -5});
+  test::addTriangle(s, {-1, 0, -5}, {1, 0, -5}, {0, 3e38f, -5});  // overflows in the transform
+  test::addTriangle(s, {-1, -1, -5}, {1, -1, -5}, {0, 1, -5});    // a normal one still draws
+  GeometryCounters counters;
+  auto tris = geometry(s, makeFrameView(test::lookAtCamera({0, 0, 0}, {0, 0, -1}), 16, 16), &counters);
+  REQUIRE(tris.size() == 1);
+  CHECK(tris[0].primitive == 3);
+  CHECK(counters.culledDegenerate == 3);
 }
 
 TEST_CASE("Geometry: an image size outside the limits is an input error") {
