@@ -181,7 +181,12 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
             grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes;
         r.schedulingMessages += messages;
         r.schedulingBytes += bytes;
-        if (grab.blocking) t += net.seconds(messages, bytes);  // idle until the packet arrives
+        if (grab.blocking && grab.packets > 0) {
+          // Idle until the first packet arrives; refills in the same answer travel while it computes.
+          const std::uint64_t first = (grab.requests > 0 ? kTaskRequestBytes : 0) + kTaskPacketHeaderBytes +
+                                      grab.moved / grab.packets * kTaskEntryBytes;
+          t += net.seconds((grab.requests > 0 ? 1 : 0) + 1, first);
+        }
       }
       for (TaskId id : grab.tasks) {
         double d = stage.costs[id];

@@ -71,8 +71,9 @@ struct SimOptions {
 };
 
 // Runs every stage of the workload under `schedule` in virtual time. PEs ask for work in order
-// of virtual time, ties by lower PE id; a blocking task transfer costs (requests + packets)
-// latencies plus its bytes over the bandwidth. wallSeconds of the result is the makespan.
+// of virtual time, ties by lower PE id; a PE waiting for a task packet is idle for the request
+// and packet latencies plus the packet's bytes over the bandwidth (refills ahead of need are
+// counted as traffic but not waited for). wallSeconds of the result is the makespan.
 RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options);
 RunRecord simulate(const Workload& workload, std::string_view schedule, const SimOptions& options);
 

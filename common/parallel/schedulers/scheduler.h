@@ -36,8 +36,9 @@ struct ScheduleParams {
 // The answer to "PE p asks for work". tasks are run now, in order, by the asking PE. The
 // transfer that brought them (requests, packets task packets, moved tasks, from the controller or
 // another PE) is what the runtime counts as scheduling traffic and the simulator charges on
-// the network model; blocking = false means it was requested ahead of need (a task manager
-// refill), so its latency is off the critical path.
+// the network model. blocking: the PE waits for the first packet (and its request); further
+// packets in the same answer are refills requested ahead of need (a task manager's), whose
+// latency is off the critical path. blocking = false: even the first packet was already local.
 struct Grab {
   std::vector<TaskId> tasks;  // empty: this PE will get no more tasks in this stage
   int from = kController;     // kController, the asking PE itself (local pool), or a victim PE

@@ -1,0 +1,28 @@
+// Preferred-bias allocation (seed 3.4.5): conceptual regions handed out on demand; a PE that
+// finishes its region helps the region with the most estimated work left, from its back end.
+#include <doctest/doctest.h>
+
+#include "common/parallel/simulator.h"
+#include "tests/common/parallel/parallel_test_support.h"
+
+using namespace pr::par;
+
+TEST_CASE("PreferredBias: PEs keep to their region, then help the one with most work left") {
+  // Regions: PE 0 {0..3} (cost 20), PE 1 {4..7} (4), PE 2 {8..11} (8).
+  const Workload w = pr::test::workloadOf({5, 5, 5, 5, 1, 1, 1, 1, 2, 2, 2, 2});
+  SimOptions options;
+  options.pes = 3;
+  options.recordTimeline = true;
+  const RunRecord r = simulate(w, "preferred-bias", options);
+  std::vector<int> pe(12, -1);
+  for (const TaskSpan& s : r.timeline) pe[s.task] = s.pe;
+  for (int id = 4; id < 8; ++id) CHECK(pe[id] == 1);
+  for (int id = 8; id < 12; ++id) CHECK(pe[id] == 2);
+  // PE 1 is done at t = 4 and helps region 0 (tasks 1..3 left, most work): takes task 3.
+  CHECK(pe[3] == 1);
+  CHECK(pe[0] == 0);
+  CHECK(pe[1] == 0);
+  // PE 2 is done at t = 8 with task 2 still unallocated (PE 0 took 1 at t = 5): it takes it.
+  CHECK(pe[2] == 2);
+  CHECK(r.wallSeconds == 13.0);  // PE 2: 8 + 5
+}
