@@ -39,4 +39,10 @@ bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b) {
          std::memcmp(a.colours(), b.colours(), n * sizeof(glm::vec3)) == 0;
 }
 
+image::Image toImage(const RegionFramebuffer& fb) {
+  image::Image img(fb.width(), fb.height());
+  std::copy(fb.colours(), fb.colours() + fb.rect().area(), img.pixels.begin());
+  return img;
+}
+
 }  // namespace pr::raster

@@ -8,6 +8,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/image/image.h"
 #include "raster/region.h"
 #include "raster/stages/depth_resolve.h"
 
@@ -61,5 +62,9 @@ class RegionFramebuffer {
 
 // True when both cover the same rectangle and hold bit-identical keys and colours.
 bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
+
+// The colours as an image of the rectangle's size (row 0 = the rectangle's top row), for
+// image output and comparison (common/image).
+image::Image toImage(const RegionFramebuffer& fb);
 
 }  // namespace pr::raster

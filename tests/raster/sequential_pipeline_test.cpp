@@ -120,6 +120,11 @@ TEST_CASE("SequentialPipeline: region splits composite to the full-frame image b
     CAPTURE(strips);
     CHECK(identical(renderSequential(s, busyCamera(), kW, kH, options), full));
   }
+  // The image handed to output holds the same colours.
+  image::Image img = toImage(full);
+  CHECK(img.width == kW);
+  CHECK(img.height == kH);
+  CHECK(img.at(kW / 2, kH / 3) == full.colour(kW / 2, kH / 3));
   // Uneven tiles offset from the block grid.
   SequentialOptions odd;
   odd.regions = {Rect{0, 0, 13, 60}, Rect{13, 0, 80, 29}, Rect{13, 29, 51, 60}, Rect{51, 29, 80, 60}};
