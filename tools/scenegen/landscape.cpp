@@ -49,11 +49,12 @@ void buildLandscape(GltfBuilder& b, const SceneParams& params) {
   b.addMeshNode("lens", b.addMesh("lens", makeEllipsoid(kLensCenter, kLensRadii, 64, 32), glass));
   b.addMeshNode("light", b.addMesh("light", makeEllipsoid(kLightCenter, glm::vec3(kLightRadius), 32, 16), light));
 
-  // Camera above the terrain's front edge looking down 45 degrees at the caustic under the
-  // lens; the lens shows above the caustic, the light stays out of view. yfov 45 degrees at
-  // 4:3 keeps the image's top edge on the terrain (its far edge is 28 degrees down).
-  b.addPerspectiveCamera("camera", std::numbers::pi_v<float> / 4, 4.0f / 3.0f, 0.1f, 200.0f, {0.0f, 14.0f, 14.0f},
-                         {0.0f, 0.0f, 0.0f});
+  // Camera high above the terrain's front half looking 57 degrees down at the caustic under
+  // the lens; the lens shows above the caustic, the light is out of view. yfov 40 degrees at
+  // 4:3 keeps the whole image on the terrain: the top corners' rays meet height -2 (below
+  // the terrain at seed 1) at |x| = 16.7, z = -17.2, inside the [-20, 20] square.
+  b.addPerspectiveCamera("camera", 40.0f * std::numbers::pi_v<float> / 180.0f, 4.0f / 3.0f, 0.1f, 200.0f,
+                         {0.0f, 20.0f, 12.0f}, {0.0f, 0.0f, -1.0f});
 }
 
 }  // namespace pr::scenegen
