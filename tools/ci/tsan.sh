@@ -1,0 +1,21 @@
+#!/usr/bin/env bash
+# ThreadSanitizer job for the parallel runtime (common/parallel): configures its own build
+# directory with -DPARRENDER_SANITIZE=thread, builds parrender_tests, and runs the runtime's
+# test cases only. Any ThreadSanitizer report stops the run with a non-zero status
+# (halt_on_error=1), so CI fails on the first data race.
+# Usage: tools/ci/tsan.sh [build-dir]   (default: build-tsan next to the sources; JOBS=2)
+set -euo pipefail
+
+source_dir="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build_dir="${1:-$source_dir/build-tsan}"
+jobs="${JOBS:-2}"
+
+# Every runtime test case starts with one of these concept names (tests/common/parallel).
+runtime_tests="Scheduler*,TaskOrder*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*"
+
+cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
+cmake --build "$build_dir" -j"$jobs" --target parrender_tests
+
+export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 ${TSAN_OPTIONS:-}"
+"$build_dir/tests/parrender_tests" -tc="$runtime_tests"
+echo "tsan: runtime tests passed with no ThreadSanitizer report"
