@@ -1,7 +1,8 @@
 // Building the BVH: top-down binned surface area heuristic (Wald 2007, "On fast construction
 // of SAH-based bounding volume hierarchies"). Runs once per scene (image-space) or once per PE
 // over that PE's own triangles (object-space, object partitioning), before any ray is traced;
-// it reads only the triangles it is given and writes only the Bvh it fills.
+// it reads only the triangles it is given and writes only the Bvh it fills. The binary tree is
+// then collapsed to the wide nodes the traversal reads (bvh.h).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -43,10 +44,19 @@ struct Bin {
   uint32_t count = 0;
 };
 
+// A node of the binary SAH tree, before collapsing to 4 wide. Interior: count == 0, the first
+// child follows it, `second` is the other. Leaf: triangles [first, first + count).
+struct BinaryNode {
+  Box box;
+  uint32_t first = 0;
+  uint32_t second = 0;
+  uint32_t count = 0;
+};
+
 class Builder {
  public:
   Builder(const BvhBuildOptions& options, std::vector<PrimRef>& refs,
-          const std::vector<BvhTriangle>& prepared, std::vector<BvhNode>& nodes,
+          const std::vector<BvhTriangle>& prepared, std::vector<BinaryNode>& nodes,
           std::vector<BvhTriangle>& leafTris, BvhStats& stats)
       : options_(options), refs_(refs), prepared_(prepared), nodes_(nodes), leafTris_(leafTris),
         stats_(stats), bins_(std::clamp(options.bins, 2, kMaxBins)) {}
@@ -61,7 +71,7 @@ class Builder {
       centroids.extend(refs_[i].centroid);
     }
     const uint32_t nodeIndex = static_cast<uint32_t>(nodes_.size());
-    nodes_.push_back(BvhNode{bounds.lo, 0, bounds.hi, 0, 0, 0});
+    nodes_.push_back(BinaryNode{bounds, 0, 0, 0});
     const uint32_t count = end - begin;
     if (count == 1) return makeLeaf(nodeIndex, begin, end);
 
@@ -93,8 +103,7 @@ class Builder {
     }
     build(begin, mid, depth + 1);
     const uint32_t second = build(mid, end, depth + 1);
-    nodes_[nodeIndex].offset = second;
-    nodes_[nodeIndex].axis = static_cast<uint8_t>(split.axis);
+    nodes_[nodeIndex].second = second;
     return nodeIndex;
   }
 
@@ -158,9 +167,9 @@ class Builder {
   }
 
   uint32_t makeLeaf(uint32_t nodeIndex, uint32_t begin, uint32_t end) {
-    BvhNode& node = nodes_[nodeIndex];
-    node.offset = static_cast<uint32_t>(leafTris_.size());
-    node.count = static_cast<uint16_t>(end - begin);
+    BinaryNode& node = nodes_[nodeIndex];
+    node.first = static_cast<uint32_t>(leafTris_.size());
+    node.count = end - begin;
     for (uint32_t i = begin; i < end; ++i) leafTris_.push_back(prepared_[refs_[i].slot]);
     stats_.leaves++;
     return nodeIndex;
@@ -169,11 +178,54 @@ class Builder {
   const BvhBuildOptions& options_;
   std::vector<PrimRef>& refs_;
   const std::vector<BvhTriangle>& prepared_;
-  std::vector<BvhNode>& nodes_;
+  std::vector<BinaryNode>& nodes_;
   std::vector<BvhTriangle>& leafTris_;
   BvhStats& stats_;
   int bins_;
 };
+
+// Collapses the binary subtree at `index` into wide nodes appended to `wide` and returns its
+// reference. A node takes its two children, then keeps opening the interior child with the
+// largest surface area (the one a ray is likeliest to enter) until it has kBvhWidth.
+uint32_t collapse(const std::vector<BinaryNode>& binary, uint32_t index, std::vector<BvhNode>& wide) {
+  const BinaryNode& node = binary[index];
+  if (node.count > 0) return BvhRef::leaf(node.first, node.count);
+  std::array<uint32_t, kBvhWidth> kids{};
+  kids[0] = index + 1;
+  kids[1] = node.second;
+  int n = 2;
+  while (n < kBvhWidth) {
+    int open = -1;
+    float largest = -1.0f;
+    for (int i = 0; i < n; ++i) {
+      const BinaryNode& kid = binary[kids[i]];
+      if (kid.count == 0 && kid.box.halfArea() > largest) {
+        largest = kid.box.halfArea();
+        open = i;
+      }
+    }
+    if (open < 0) break;
+    const uint32_t opened = kids[open];
+    kids[open] = opened + 1;
+    kids[n++] = binary[opened].second;
+  }
+  const auto wideIndex = static_cast<uint32_t>(wide.size());
+  wide.emplace_back();
+  for (int lane = 0; lane < kBvhWidth; ++lane) {
+    // Empty lanes get inverted bounds: the slab test's entry is +inf there, so they never hit.
+    const Box box = lane < n ? binary[kids[lane]].box : Box{};
+    for (int a = 0; a < 3; ++a) {
+      wide[wideIndex].bounds[a][lane] = box.lo[a];
+      wide[wideIndex].bounds[3 + a][lane] = box.hi[a];
+    }
+    wide[wideIndex].child[lane] = BvhRef::kEmpty;
+  }
+  for (int lane = 0; lane < n; ++lane) {
+    const uint32_t ref = collapse(binary, kids[lane], wide);  // may reallocate `wide`
+    wide[wideIndex].child[lane] = ref;
+  }
+  return wideIndex;
+}
 
 bool finite(const glm::vec3& p) { return std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z); }
 
@@ -206,10 +258,14 @@ Bvh::Bvh(std::span<const glm::vec3> positions, std::span<const scene::Triangle> 
 
 void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,
                 std::span<const uint32_t> subset, const BvhBuildOptions& options) {
-  PR_CHECK(options.maxLeafSize >= 1 && options.maxLeafSize <= 0xffff, "maxLeafSize out of range");
+  PR_CHECK(options.maxLeafSize >= 1 && uint32_t(options.maxLeafSize) <= BvhRef::kMaxLeafSize,
+           "maxLeafSize " + std::to_string(options.maxLeafSize) + " outside [1, 16]");
+  PR_CHECK(subset.size() < BvhRef::kMaxTriangles, "too many triangles for one BVH: " + std::to_string(subset.size()));
   stats_ = BvhStats{};
   nodes_.clear();
   triangles_.clear();
+  root_ = BvhRef::kEmpty;
+  bounds_ = scene::Bounds{};
   magnitude_ = 0.0f;
   if (subset.empty()) return;
 
@@ -234,24 +290,28 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
     magnitude_ = std::max({magnitude_, m.x, m.y, m.z});
   }
 
-  nodes_.reserve(2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
+  std::vector<BinaryNode> binary;
+  binary.reserve(2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
   triangles_.reserve(subset.size());
-  Builder builder(options, refs, prepared, nodes_, triangles_, stats_);
+  Builder builder(options, refs, prepared, binary, triangles_, stats_);
   builder.build(0, static_cast<uint32_t>(refs.size()), 0);
-  nodes_.shrink_to_fit();
+  // The traversal stack holds at most kBvhWidth - 1 entries per level (bvh_traverse.cpp).
+  PR_CHECK(stats_.maxDepth <= 60, "BVH deeper than the traversal stack: " + std::to_string(stats_.maxDepth));
+  refs = {};
+  prepared = {};
 
+  nodes_.reserve(binary.size() / 2 + 1);
+  root_ = collapse(binary, 0, nodes_);
+  nodes_.shrink_to_fit();
+  bounds_.extend(binary[0].box.lo);
+  bounds_.extend(binary[0].box.hi);
+
+  stats_.binaryNodes = binary.size();
   stats_.nodes = nodes_.size();
   stats_.triangles = triangles_.size();
   stats_.memoryBytes = nodes_.size() * sizeof(BvhNode) + triangles_.size() * sizeof(BvhTriangle);
 }
 
-scene::Bounds Bvh::bounds() const {
-  scene::Bounds b;
-  if (!nodes_.empty()) {
-    b.extend(nodes_[0].boundsMin);
-    b.extend(nodes_[0].boundsMax);
-  }
-  return b;
-}
+scene::Bounds Bvh::bounds() const { return bounds_; }
 
 }  // namespace pr::rt

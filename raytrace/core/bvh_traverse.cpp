@@ -1,10 +1,13 @@
 // BVH queries: closest hit and any hit (shadow). Called by every tracer for every ray, on the
 // PE that holds the BVH (the world-model BVH in image-space, a PE's own BVH in the partitioned
 // tracers); read-only, so any number of PEs may query one Bvh at once.
-// Traversal visits the nearer child first (by the children's entry distances, which follow the
-// sign of the direction on the split axis) and prunes subtrees that start beyond the best hit.
+// Each wide node is two 4-lane SSE slab tests whose near and far planes are picked once per ray
+// by the sign of the direction; hit children are visited nearest first, and subtrees that start
+// beyond the best hit so far are pruned.
 #include <algorithm>
 #include <cmath>
+
+#include <emmintrin.h>  // SSE2: part of every x86-64 target
 
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/triangle.h"
@@ -12,9 +15,10 @@
 namespace pr::rt {
 namespace {
 
-// Depth bound of the build (bvh_build.cpp: 32 SAH levels, then median splits of at most 2^32
-// triangles) plus margin; one entry per level can be pending.
-constexpr int kStackSize = 96;
+// The build's binary depth is at most 60 (bvh_build.cpp); a wide node covers at least one
+// binary level and leaves at most kBvhWidth - 1 siblings pending.
+constexpr int kStackSize = (kBvhWidth - 1) * 60 + kBvhWidth;
+constexpr int kGroups = kBvhWidth / 4;
 
 // Robust slab test (Ize 2013, "Robust BVH ray traversal"; pbrt-v4): the far distances are
 // scaled by 1 + 2 gamma(3), gamma(n) = n u / (1 - n u) with u = 2^-24, which bounds the
@@ -35,36 +39,55 @@ constexpr float kMinDirection = 1e-30f;
 constexpr float kSlackFraction = 0x1p-18f;
 
 struct BoxRay {
-  glm::vec3 origin;
-  glm::vec3 invDir;
-  float lo;     // tMin - slack
-  float slack;
+  __m128 origin[3];
+  __m128 invDir[3];
+  __m128 lo;     // tMin - slack
+  __m128 slack;
+  int nearRow[3];  // BvhNode::bounds row of the entry plane per axis: min for d >= 0, else max
+  int farRow[3];
 };
 
 BoxRay makeBoxRay(const Ray& ray, float magnitude) {
   BoxRay r;
-  r.origin = ray.origin;
   for (int a = 0; a < 3; ++a) {
     const float d = ray.direction[a];
-    r.invDir[a] = 1.0f / (std::fabs(d) < kMinDirection ? std::copysign(kMinDirection, d) : d);
+    const float dClamped = std::fabs(d) < kMinDirection ? std::copysign(kMinDirection, d) : d;
+    r.origin[a] = _mm_set1_ps(ray.origin[a]);
+    r.invDir[a] = _mm_set1_ps(1.0f / dClamped);
+    const bool negative = std::signbit(dClamped);
+    r.nearRow[a] = negative ? 3 + a : a;
+    r.farRow[a] = negative ? a : 3 + a;
   }
   const glm::vec3 ad = glm::abs(ray.direction), ao = glm::abs(ray.origin);
   const float scale = std::max({magnitude, ao.x, ao.y, ao.z});
-  r.slack = kSlackFraction * scale / std::max({ad.x, ad.y, ad.z});
-  r.lo = ray.tMin - r.slack;
+  const float slack = kSlackFraction * scale / std::max({ad.x, ad.y, ad.z});
+  r.slack = _mm_set1_ps(slack);
+  r.lo = _mm_set1_ps(ray.tMin - slack);
   return r;
 }
 
-// Entry distance of the ray into the node's box if the box overlaps [lo, hi + slack], where hi
-// is the best hit so far (or tMax).
-inline bool slab(const BvhNode& node, const BoxRay& r, float hi, float& tEntry) {
-  const glm::vec3 t0 = (node.boundsMin - r.origin) * r.invDir;
-  const glm::vec3 t1 = (node.boundsMax - r.origin) * r.invDir;
-  const glm::vec3 tNear = glm::min(t0, t1), tFar = glm::max(t0, t1);
-  const float enter = std::max(std::max(tNear.x, tNear.y), std::max(tNear.z, r.lo));
-  const float leave = std::min(std::min(tFar.x, tFar.y), tFar.z) * kSlabScale;
-  tEntry = enter;
-  return enter <= std::min(leave, hi) + r.slack;
+// Slab test of the children against [tMin, hi] (hi: the best hit so far, or tMax), widened
+// as described above, four lanes at a time. Returns the lane mask of hit children and their
+// entry distances.
+inline int slab(const BvhNode& node, const BoxRay& r, float hi, __m128 (&tEntry)[kGroups]) {
+  const __m128 hiVec = _mm_set1_ps(hi);
+  const __m128 scale = _mm_set1_ps(kSlabScale);
+  int mask = 0;
+  for (int g = 0; g < kGroups; ++g) {
+    const int o = 4 * g;
+    const __m128 nx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[0]] + o), r.origin[0]), r.invDir[0]);
+    const __m128 ny = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[1]] + o), r.origin[1]), r.invDir[1]);
+    const __m128 nz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[2]] + o), r.origin[2]), r.invDir[2]);
+    const __m128 fx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[0]] + o), r.origin[0]), r.invDir[0]);
+    const __m128 fy = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[1]] + o), r.origin[1]), r.invDir[1]);
+    const __m128 fz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[2]] + o), r.origin[2]), r.invDir[2]);
+    const __m128 enter = _mm_max_ps(_mm_max_ps(nx, ny), _mm_max_ps(nz, r.lo));
+    const __m128 leave = _mm_mul_ps(_mm_min_ps(_mm_min_ps(fx, fy), fz), scale);
+    const __m128 limit = _mm_add_ps(_mm_min_ps(leave, hiVec), r.slack);
+    tEntry[g] = enter;
+    mask |= _mm_movemask_ps(_mm_cmple_ps(enter, limit)) << o;
+  }
+  return mask;
 }
 
 bool usable(const Ray& ray) {
@@ -75,9 +98,46 @@ bool usable(const Ray& ray) {
 }
 
 struct StackEntry {
-  uint32_t node;
+  uint32_t ref;
   float tEntry;
 };
+
+// Continues with the nearest hit child and pushes the others farthest first, so they pop in
+// order of entry distance. mask has at least one bit set.
+inline uint32_t orderChildren(const BvhNode& node, int mask, const __m128 (&tEntry)[kGroups], StackEntry* stack,
+                              int& sp) {
+  const int first = __builtin_ctz(unsigned(mask));
+  mask &= mask - 1;
+  if (mask == 0) return node.child[first];  // one child hit: the common case deep in the tree
+  alignas(16) float t[kBvhWidth];
+  for (int g = 0; g < kGroups; ++g) _mm_store_ps(t + 4 * g, tEntry[g]);
+  const int second = __builtin_ctz(unsigned(mask));
+  mask &= mask - 1;
+  if (mask == 0) {
+    const bool firstNearer = t[first] <= t[second];
+    const int nearLane = firstNearer ? first : second, farLane = firstNearer ? second : first;
+    stack[sp++] = {node.child[farLane], t[farLane]};
+    return node.child[nearLane];
+  }
+  // More: insertion by descending entry distance, then push all but the nearest.
+  StackEntry hits[kBvhWidth];
+  int n = 0;
+  hits[n++] = {node.child[first], t[first]};
+  mask |= 1 << second;
+  while (mask != 0) {
+    const int lane = __builtin_ctz(unsigned(mask));
+    mask &= mask - 1;
+    StackEntry e{node.child[lane], t[lane]};
+    int i = n++;
+    while (i > 0 && hits[i - 1].tEntry < e.tEntry) {
+      hits[i] = hits[i - 1];
+      --i;
+    }
+    hits[i] = e;
+  }
+  for (int i = 0; i < n - 1; ++i) stack[sp++] = hits[i];
+  return hits[n - 1].ref;
+}
 
 }  // namespace
 
@@ -85,20 +145,26 @@ template <int Kz>
 bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
   const RayShear shear = makeRayShear(ray);
   const BoxRay boxRay = makeBoxRay(ray, magnitude_);
+  const float slack = _mm_cvtss_f32(boxRay.slack);
   float bestT = ray.tMax;
   uint32_t bestTriangle = kNoTriangle;
   float bestU = 0.0f, bestV = 0.0f;
 
   StackEntry stack[kStackSize];
   int sp = 0;
-  uint32_t current = 0;
-  float tEntry;
-  if (!slab(nodes_[0], boxRay, bestT, tEntry)) return false;
+  uint32_t ref = root_;
   for (;;) {
-    const BvhNode& node = nodes_[current];
-    if (node.isLeaf()) {
-      const BvhTriangle* tri = triangles_.data() + node.offset;
-      for (uint32_t i = 0; i < node.count; ++i, ++tri) {
+    if (!BvhRef::isLeaf(ref)) {
+      __m128 tEntry[kGroups];
+      const int mask = slab(nodes_[ref], boxRay, bestT, tEntry);
+      if (mask != 0) {
+        ref = orderChildren(nodes_[ref], mask, tEntry, stack, sp);
+        continue;
+      }
+    } else {
+      const BvhTriangle* tri = triangles_.data() + BvhRef::leafFirst(ref);
+      const uint32_t count = BvhRef::leafCount(ref);
+      for (uint32_t i = 0; i < count; ++i, ++tri) {
         TriangleHit th;
         if (!intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, bestT, th)) continue;
         // th.t <= bestT here; equal t keeps the lower triangle index (Hit::closerThan).
@@ -109,25 +175,6 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
           bestV = th.v;
         }
       }
-    } else {
-      const uint32_t first = current + 1, second = node.offset;
-      float t0, t1;
-      const bool hit0 = slab(nodes_[first], boxRay, bestT, t0);
-      const bool hit1 = slab(nodes_[second], boxRay, bestT, t1);
-      if (hit0 && hit1) {
-        if (t0 <= t1) {
-          stack[sp++] = {second, t1};
-          current = first;
-        } else {
-          stack[sp++] = {first, t0};
-          current = second;
-        }
-        continue;
-      }
-      if (hit0 || hit1) {
-        current = hit0 ? first : second;
-        continue;
-      }
     }
     // Next pending subtree that may still hold a hit no farther than the best one.
     for (;;) {
@@ -137,8 +184,8 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
         return true;
       }
       const StackEntry e = stack[--sp];
-      if (e.tEntry <= bestT + boxRay.slack) {
-        current = e.node;
+      if (e.tEntry <= bestT + slack) {
+        ref = e.ref;
         break;
       }
     }
@@ -150,41 +197,32 @@ bool Bvh::occludedK(const Ray& ray) const {
   const RayShear shear = makeRayShear(ray);
   const BoxRay boxRay = makeBoxRay(ray, magnitude_);
   const float tMax = ray.tMax;
-  uint32_t stack[kStackSize];
+  StackEntry stack[kStackSize];
   int sp = 0;
-  uint32_t current = 0;
-  float tEntry;
-  if (!slab(nodes_[0], boxRay, tMax, tEntry)) return false;
+  uint32_t ref = root_;
   for (;;) {
-    const BvhNode& node = nodes_[current];
-    if (node.isLeaf()) {
-      const BvhTriangle* tri = triangles_.data() + node.offset;
-      for (uint32_t i = 0; i < node.count; ++i, ++tri) {
+    if (!BvhRef::isLeaf(ref)) {
+      __m128 tEntry[kGroups];
+      const int mask = slab(nodes_[ref], boxRay, tMax, tEntry);
+      if (mask != 0) {
+        ref = orderChildren(nodes_[ref], mask, tEntry, stack, sp);
+        continue;
+      }
+    } else {
+      const BvhTriangle* tri = triangles_.data() + BvhRef::leafFirst(ref);
+      const uint32_t count = BvhRef::leafCount(ref);
+      for (uint32_t i = 0; i < count; ++i, ++tri) {
         TriangleHit th;
         if (intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, tMax, th)) return true;
       }
-    } else {
-      const uint32_t first = current + 1, second = node.offset;
-      float t0, t1;
-      const bool hit0 = slab(nodes_[first], boxRay, tMax, t0);
-      const bool hit1 = slab(nodes_[second], boxRay, tMax, t1);
-      if (hit0 && hit1) {
-        stack[sp++] = t0 <= t1 ? second : first;
-        current = t0 <= t1 ? first : second;
-        continue;
-      }
-      if (hit0 || hit1) {
-        current = hit0 ? first : second;
-        continue;
-      }
     }
     if (sp == 0) return false;
-    current = stack[--sp];
+    ref = stack[--sp].ref;
   }
 }
 
 bool Bvh::intersect(const Ray& ray, Hit& hit) const {
-  if (nodes_.empty() || !usable(ray)) return false;
+  if (empty() || !usable(ray)) return false;
   switch (dominantAxis(ray.direction)) {
     case 0: return intersectK<0>(ray, hit);
     case 1: return intersectK<1>(ray, hit);
@@ -193,7 +231,7 @@ bool Bvh::intersect(const Ray& ray, Hit& hit) const {
 }
 
 bool Bvh::occluded(const Ray& ray) const {
-  if (nodes_.empty() || !usable(ray)) return false;
+  if (empty() || !usable(ray)) return false;
   switch (dominantAxis(ray.direction)) {
     case 0: return occludedK<0>(ray);
     case 1: return occludedK<1>(ray);

@@ -1,5 +1,6 @@
-// Tests of the binned-SAH BVH build (raytrace/core/bvh_build.cpp): structural invariants that
-// every query relies on, over the whole scene and over subsets (a PE's own triangles).
+// Tests of the binned-SAH BVH build (raytrace/core/bvh_build.cpp): structural invariants of the
+// collapsed wide tree that every query relies on, over the whole scene and over subsets
+// (a PE's own triangles).
 #include <doctest/doctest.h>
 
 #include <functional>
@@ -15,45 +16,62 @@ using pr::rt::BvhNode;
 
 namespace {
 
-bool contains(const BvhNode& outer, glm::vec3 p) {
-  return glm::all(glm::lessThanEqual(outer.boundsMin, p)) && glm::all(glm::lessThanEqual(p, outer.boundsMax));
+struct LaneBox {
+  glm::vec3 lo, hi;
+};
+
+LaneBox lane(const BvhNode& node, int i) {
+  return {{node.bounds[0][i], node.bounds[1][i], node.bounds[2][i]}, {node.bounds[3][i], node.bounds[4][i], node.bounds[5][i]}};
 }
 
-// Walks the tree from the root and checks: every node is reached exactly once, children lie
-// inside their parent, leaf triangles inside their leaf, leaves within the size limit and
-// together covering Bvh::triangles() exactly once. Returns how often each scene triangle
-// index appears in a leaf.
+bool contains(const LaneBox& outer, glm::vec3 p) {
+  return glm::all(glm::lessThanEqual(outer.lo, p)) && glm::all(glm::lessThanEqual(p, outer.hi));
+}
+
+// Walks the wide tree from the root and checks: every node is reached exactly once, each
+// child's boxes lie inside the parent's box for it, leaf triangles lie inside their leaf's
+// box, leaves are within the size limit and together cover Bvh::triangles() exactly once, and
+// empty lanes come last with empty bounds. Returns how often each scene triangle appears.
 std::vector<int> checkStructure(const Bvh& bvh, size_t sceneTriangles, int maxLeafSize) {
+  namespace Ref = pr::rt::BvhRef;
   const auto nodes = bvh.nodes();
   const auto tris = bvh.triangles();
   std::vector<int> nodeSeen(nodes.size(), 0), slotSeen(tris.size(), 0), triangleSeen(sceneTriangles, 0);
-  std::function<void(uint32_t)> visit = [&](uint32_t index) {
-    REQUIRE(index < nodes.size());
-    nodeSeen[index]++;
-    const BvhNode& node = nodes[index];
-    if (node.isLeaf()) {
-      CHECK(node.count <= maxLeafSize);
-      REQUIRE(node.offset + node.count <= tris.size());
-      for (uint32_t i = node.offset; i < node.offset + node.count; ++i) {
+  const pr::scene::Bounds all = bvh.bounds();
+  std::function<void(uint32_t, const LaneBox&)> visit = [&](uint32_t ref, const LaneBox& box) {
+    REQUIRE(ref != Ref::kEmpty);
+    if (Ref::isLeaf(ref)) {
+      CHECK(Ref::leafCount(ref) <= uint32_t(maxLeafSize));
+      REQUIRE(Ref::leafFirst(ref) + Ref::leafCount(ref) <= tris.size());
+      for (uint32_t i = Ref::leafFirst(ref); i < Ref::leafFirst(ref) + Ref::leafCount(ref); ++i) {
         slotSeen[i]++;
         REQUIRE(tris[i].triangle < sceneTriangles);
         triangleSeen[tris[i].triangle]++;
-        CHECK(contains(node, tris[i].p0));
-        CHECK(contains(node, tris[i].p1));
-        CHECK(contains(node, tris[i].p2));
+        CHECK(contains(box, tris[i].p0));
+        CHECK(contains(box, tris[i].p1));
+        CHECK(contains(box, tris[i].p2));
       }
       return;
     }
-    const uint32_t first = index + 1, second = node.offset;
-    REQUIRE(second > first);
-    for (uint32_t child : {first, second}) {
-      REQUIRE(child < nodes.size());
-      CHECK(contains(node, nodes[child].boundsMin));
-      CHECK(contains(node, nodes[child].boundsMax));
-      visit(child);
+    REQUIRE(ref < nodes.size());
+    nodeSeen[ref]++;
+    const BvhNode& node = nodes[ref];
+    int used = 0;
+    for (int i = 0; i < pr::rt::kBvhWidth; ++i) {
+      if (node.child[i] == Ref::kEmpty) {
+        CHECK(node.bounds[0][i] > node.bounds[3][i]);  // inverted: never hit
+        continue;
+      }
+      CHECK(i == used);  // empty lanes only at the end
+      ++used;
+      const LaneBox child = lane(node, i);
+      CHECK(contains(box, child.lo));
+      CHECK(contains(box, child.hi));
+      visit(node.child[i], child);
     }
+    CHECK(used >= 2);
   };
-  visit(0);
+  visit(bvh.root(), LaneBox{all.min, all.max});
   for (int seen : nodeSeen) CHECK(seen == 1);
   for (int seen : slotSeen) CHECK(seen == 1);
   return triangleSeen;
@@ -63,14 +81,15 @@ std::vector<int> checkStructure(const Bvh& bvh, size_t sceneTriangles, int maxLe
 
 TEST_CASE("BvhBuild: every triangle in exactly one leaf and node bounds contain their children") {
   const auto scene = pr::test::randomSoup(3000);
-  for (int maxLeaf : {1, 4, 8}) {
+  for (int maxLeaf : {1, 4, 8, 16}) {
     BvhBuildOptions options;
     options.maxLeafSize = maxLeaf;
     const Bvh bvh(scene, options);
     CHECK(bvh.stats().triangles == scene.triangles.size());
     CHECK(bvh.stats().nodes == bvh.nodes().size());
-    CHECK(bvh.stats().nodes == 2 * bvh.stats().leaves - 1);  // a full binary tree
-    CHECK(bvh.stats().memoryBytes == bvh.nodes().size() * 32 + bvh.triangles().size() * sizeof(pr::rt::BvhTriangle));
+    CHECK(bvh.stats().binaryNodes == 2 * bvh.stats().leaves - 1);  // a full binary tree
+    CHECK(bvh.stats().nodes < bvh.stats().binaryNodes / 2);        // collapsing merges levels
+    CHECK(bvh.stats().memoryBytes == bvh.nodes().size() * sizeof(BvhNode) + bvh.triangles().size() * sizeof(pr::rt::BvhTriangle));
     const auto seen = checkStructure(bvh, scene.triangles.size(), maxLeaf);
     for (int count : seen) CHECK(count == 1);
     // The root bounds are the scene bounds.
@@ -94,7 +113,7 @@ TEST_CASE("BvhBuild: identical triangles (no SAH split exists) still respect the
   const Bvh bvh(scene);
   const auto seen = checkStructure(bvh, scene.triangles.size(), BvhBuildOptions{}.maxLeafSize);
   for (int count : seen) CHECK(count == 1);
-  CHECK(bvh.stats().maxDepth <= 8);  // median splits: ceil(log2(100 / 4)) + 1 levels
+  CHECK(bvh.stats().maxDepth <= 6);  // median splits: 100 -> 50 -> 25 -> 13 -> 7 -> 4
 }
 
 TEST_CASE("BvhBuild: empty input gives an empty BVH that reports no hits") {
@@ -104,6 +123,19 @@ TEST_CASE("BvhBuild: empty input gives an empty BVH that reports no hits") {
   pr::rt::Hit hit;
   CHECK_FALSE(bvh.intersect(pr::rt::Ray{{0, 0, 5}, 0.0f, {0, 0, -1}, pr::rt::kInfinity}, hit));
   CHECK_FALSE(bvh.occluded(pr::rt::Ray{{0, 0, 5}, 0.0f, {0, 0, -1}, pr::rt::kInfinity}));
+}
+
+TEST_CASE("BvhBuild: a scene that fits one leaf has a leaf as root") {
+  pr::scene::Scene scene = pr::test::emptyScene();
+  for (int i = 0; i < 3; ++i) pr::test::addTriangle(scene, {0, 0, 0}, {1, 0, 0}, {0, 1, 0});  // no split exists
+  const Bvh bvh(scene);
+  CHECK(pr::rt::BvhRef::isLeaf(bvh.root()));
+  CHECK(bvh.nodes().empty());
+  pr::rt::Hit hit;
+  CHECK(bvh.intersect(pr::rt::Ray{{0.2f, 0.2f, 1.0f}, 0.0f, {0, 0, -1}, pr::rt::kInfinity}, hit));
+  CHECK(hit.triangle == 0);
+  const auto seen = checkStructure(bvh, scene.triangles.size(), BvhBuildOptions{}.maxLeafSize);
+  for (int count : seen) CHECK(count == 1);
 }
 
 TEST_CASE("BvhBuild: degenerate triangles are counted and kept in a leaf") {
