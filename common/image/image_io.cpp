@@ -55,6 +55,8 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
   // The temporary name keeps the directory (so the rename is atomic) but not the extension,
   // so the format is named explicitly below rather than guessed from the file name.
   fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (!fs::is_directory(dir))
+    throw InputError("cannot write image file '" + path.string() + "': directory '" + dir.string() + "' does not exist");
   std::string tempName = path.filename().string();
   tempName.insert(tempName.begin(), '.');
   tempName += ".tmp";

@@ -224,6 +224,8 @@ std::string GltfBuilder::serialize(bool binary) const {
 
 void writeFileAtomically(const fs::path& path, const std::string& bytes) {
   const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
+  if (!fs::is_directory(dir))
+    throw InputError("cannot write scene file '" + path.string() + "': directory '" + dir.string() + "' does not exist");
   std::string tempName = path.filename().string();
   tempName.insert(tempName.begin(), '.');
   tempName += ".tmp";
