@@ -80,7 +80,7 @@ std::vector<int> checkStructure(const Bvh& bvh, size_t sceneTriangles, int maxLe
 }  // namespace
 
 TEST_CASE("BvhBuild: every triangle in exactly one leaf and node bounds contain their children") {
-  const auto scene = pr::test::randomSoup(3000);
+  const auto scene = pr::test::randomSoup(2000);
   for (int maxLeaf : {1, 4, 8, 16}) {
     BvhBuildOptions options;
     options.maxLeafSize = maxLeaf;

@@ -74,10 +74,10 @@ void checkSame(const Hit& got, const Hit& want) {
 }  // namespace
 
 TEST_CASE("BvhTraverse: closest hit equals brute force on a random soup") {
-  const auto scene = pr::test::randomSoup(2000);
+  const auto scene = pr::test::randomSoup(1200);
   const Bvh bvh(scene);
   int hits = 0;
-  for (const Ray& ray : randomRays(4000, 1.0f, glm::vec3(0.0f), 11)) {
+  for (const Ray& ray : randomRays(3000, 1.0f, glm::vec3(0.0f), 11)) {
     const Hit want = bruteForce(scene, ray);
     checkSame(query(bvh, ray), want);
     hits += want.valid();
@@ -86,7 +86,7 @@ TEST_CASE("BvhTraverse: closest hit equals brute force on a random soup") {
 }
 
 TEST_CASE("BvhTraverse: results do not depend on tree shape or on partitioning the triangles") {
-  const auto scene = pr::test::randomSoup(1500, 1.0f, glm::vec3(0.0f), 3);
+  const auto scene = pr::test::randomSoup(1000, 1.0f, glm::vec3(0.0f), 3);
   BvhBuildOptions small, large;
   small.maxLeafSize = 1;
   small.bins = 16;
@@ -98,7 +98,7 @@ TEST_CASE("BvhTraverse: results do not depend on tree shape or on partitioning t
   for (uint32_t i = 0; i < scene.triangles.size(); ++i) parts[(i * 7) % 3].push_back(i);
   std::vector<Bvh> owners;
   for (const auto& part : parts) owners.emplace_back(scene.positions, scene.triangles, part);
-  for (const Ray& ray : randomRays(3000, 1.0f, glm::vec3(0.0f), 5)) {
+  for (const Ray& ray : randomRays(2000, 1.0f, glm::vec3(0.0f), 5)) {
     const Hit want = bruteForce(scene, ray);
     checkSame(query(a, ray), want);
     checkSame(query(b, ray), want);
