@@ -5,6 +5,7 @@
 // request message to the owner and a reply message from it, in the running stage.
 #pragma once
 
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -143,7 +144,9 @@ class DataManager {
 
  private:
   const T& fetch(Pe& pe, int owner, ItemId item) {
+    const auto t0 = std::chrono::steady_clock::now();
     T value = load_(owner, item);
+    pe.counters().commSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const std::size_t bytes = bytes_ ? bytes_(value) : sizeof(T);
     pe.runtime().countMessage(pe.id(), owner, kItemRequestBytes);
     pe.runtime().countMessage(owner, pe.id(), bytes);

@@ -120,6 +120,8 @@ T field(const json& j, const char* key, const std::string& origin, const std::st
   }
 }
 
+RunRecord parseRunRecord(const std::string& text, const std::string& origin);
+
 }  // namespace
 
 std::string toJsonText(const RunRecord& record) { return toJson(record).dump(1) + "\n"; }
@@ -129,6 +131,16 @@ void writeRunRecord(const RunRecord& record, const std::filesystem::path& file) 
 }
 
 RunRecord runRecordFromJsonText(const std::string& text, const std::string& origin) {
+  try {
+    return parseRunRecord(text, origin);
+  } catch (const json::exception& e) {  // a value of the wrong type deep inside the record
+    throw InputError(origin + ": malformed run record (" + e.what() + ")");
+  }
+}
+
+namespace {
+
+RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
   json j;
   try {
     j = json::parse(text);
@@ -199,6 +211,8 @@ RunRecord runRecordFromJsonText(const std::string& text, const std::string& orig
   }
   return record;
 }
+
+}  // namespace
 
 RunRecord readRunRecord(const std::filesystem::path& file) {
   std::ifstream in(file);

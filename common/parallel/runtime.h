@@ -19,6 +19,10 @@
 //   });
 //   par::writeRunRecord(rt.record(), "run.json");           // per-PE busy/idle, traffic, timeline
 //
+// The system controller's role is split in two: the Scheduler hands out tasks (its requests
+// and task packets are counted as scheduling traffic), and the renderer's controlling thread
+// collates results between stages (Channel::drain), after runStage's barrier.
+//
 // An exception thrown by a task or handler stops every PE at its next task boundary and is
 // rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
 // P may exceed the core count: idle PEs block on a condition variable, they do not spin.

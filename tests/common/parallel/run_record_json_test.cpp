@@ -75,3 +75,9 @@ TEST_CASE("RunRecord: a cost profile from a recorded run sums each task's spans"
   REQUIRE(costs.size() == 6);
   for (const TaskSpan& s : r.timeline) CHECK(costs[s.task] == doctest::Approx(s.end - s.start));
 }
+
+TEST_CASE("RunRecord: a value of the wrong type deep in the record is an input error") {
+  const std::string text =
+      "{\"pes\": 1, \"stages\": [{\"name\": \"s\", \"wallSeconds\": 1, \"tasks\": [[1, \"x\", 0]]}], \"timeline\": []}";
+  CHECK_THROWS_AS(runRecordFromJsonText(text, "m.json"), pr::InputError);
+}
