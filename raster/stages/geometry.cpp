@@ -86,6 +86,10 @@ struct SnappedVertex {
   glm::vec2 bary;
 };
 
+// Round half away from zero with one truncating conversion (std::nearbyint is a library call
+// on baseline x86-64); |v| <= kLimit < 2^31, so the conversion cannot overflow.
+inline int32_t roundToFixed(double v) { return static_cast<int32_t>(v + (v >= 0.0 ? 0.5 : -0.5)); }
+
 // Perspective division and viewport transform, snapped to 24.8 fixed point (round to nearest).
 // Clipping guarantees w > 0 and |x/w| <= guardX; the clamp only absorbs rounding at the guard.
 // Kept out of line so that every vertex, cached or clipped, goes through the same instruction
@@ -95,8 +99,8 @@ struct SnappedVertex {
   double invW = 1.0 / double(clip.w);
   double sx = (0.5 + 0.5 * double(clip.x) * invW) * view.width * kSubpixelScale;
   double sy = (0.5 - 0.5 * double(clip.y) * invW) * view.height * kSubpixelScale;
-  s.x = static_cast<int32_t>(std::nearbyint(std::clamp(sx, -kLimit, kLimit)));
-  s.y = static_cast<int32_t>(std::nearbyint(std::clamp(sy, -kLimit, kLimit)));
+  s.x = roundToFixed(std::clamp(sx, -kLimit, kLimit));
+  s.y = roundToFixed(std::clamp(sy, -kLimit, kLimit));
   s.invW = static_cast<float>(invW);
   s.depth = view.perspective ? -s.invW : viewDepth;
 }
