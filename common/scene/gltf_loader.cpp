@@ -87,6 +87,33 @@ glm::dmat4 localTransform(const Context& ctx, const tinygltf::Node& node, int in
   return m;
 }
 
+// Whether an emissive texture has any non-black texel under a triangle's UVs. Scans the
+// texel rectangle bounding the (transformed) UV triangle, grown by one texel for bilinear
+// bleeding: conservative, so a triangle that emits anywhere is never dropped. Footprints over
+// kMaxTexels (tiled or huge) are assumed to emit rather than scanned.
+bool emissiveTexelUnder(const Texture& texture, const TextureRef& ref, glm::vec2 a, glm::vec2 b, glm::vec2 c) {
+  constexpr double kMaxTexels = 1 << 18;
+  glm::vec2 ta = ref.transformUv(a), tb = ref.transformUv(b), tc = ref.transformUv(c);
+  glm::vec2 lo = glm::min(ta, glm::min(tb, tc)), hi = glm::max(ta, glm::max(tb, tc));
+  double x0 = std::floor(double(lo.x) * texture.width) - 1, x1 = std::floor(double(hi.x) * texture.width) + 1;
+  double y0 = std::floor(double(lo.y) * texture.height) - 1, y1 = std::floor(double(hi.y) * texture.height) + 1;
+  if (!((x1 - x0 + 1) * (y1 - y0 + 1) <= kMaxTexels)) return true;  // also catches NaN
+  auto wrap = [](int i, int n, Wrap mode) {  // the same mapping as Texture::sample
+    if (mode == Wrap::ClampToEdge) return std::clamp(i, 0, n - 1);
+    if (mode == Wrap::Repeat) return ((i % n) + n) % n;
+    int period = 2 * n, m = ((i % period) + period) % period;
+    return m < n ? m : period - 1 - m;
+  };
+  for (int y = int(y0); y <= int(y1); ++y) {
+    const size_t row = size_t(wrap(y, texture.height, texture.sampler.wrapT)) * size_t(texture.width);
+    for (int x = int(x0); x <= int(x1); ++x) {
+      const uint8_t* p = &texture.rgba8[(row + size_t(wrap(x, texture.width, texture.sampler.wrapS))) * 4];
+      if (p[0] | p[1] | p[2]) return true;
+    }
+  }
+  return false;
+}
+
 class Flattener {
  public:
   explicit Flattener(Context& ctx) : ctx_(ctx), accessors_(ctx) {}
@@ -122,7 +149,13 @@ class Flattener {
     if (!anyColors_) s.colors.clear();
     for (uint32_t t = 0; t < s.triangles.size(); ++t) {
       const Triangle& tri = s.triangles[t];
-      if (!s.materials[tri.material].isEmissive()) continue;
+      const Material& material = s.materials[tri.material];
+      if (!material.isEmissive()) continue;
+      if (material.emissiveTexture.present() &&
+          !emissiveTexelUnder(s.textures[size_t(material.emissiveTexture.texture)], material.emissiveTexture,
+                              s.uvs[tri.v[0]], s.uvs[tri.v[1]], s.uvs[tri.v[2]])) {
+        continue;  // emission = factor * texture, and the texture is black under this triangle
+      }
       glm::vec3 e1 = s.positions[tri.v[1]] - s.positions[tri.v[0]];
       glm::vec3 e2 = s.positions[tri.v[2]] - s.positions[tri.v[0]];
       float area = 0.5f * glm::length(glm::cross(e1, e2));

@@ -405,3 +405,29 @@ TEST_CASE("GltfLoader: every bad input throws one InputError naming the file and
     }
   }
 }
+
+TEST_CASE("GltfLoader: only triangles over non-black emissive texels become area lights") {
+  auto dir = pr::test::scratchDir("gltf_emissive_texture");
+  pr::test::GltfWriter w;
+  // 8x1 emissive texture: texels 0-3 black, 4-7 white; emission = factor * texture.
+  std::vector<uint8_t> texels;
+  for (int x = 0; x < 8; ++x) texels.insert(texels.end(), {uint8_t(x < 4 ? 0 : 255), uint8_t(x < 4 ? 0 : 255), uint8_t(x < 4 ? 0 : 255), 255});
+  auto png = pr::test::encodePng(8, 1, texels);
+  w.doc["images"] = {{{"uri", "data:image/png;base64," + pr::test::base64(png)}}};
+  w.doc["samplers"] = {{{"magFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33071}}};
+  w.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  w.doc["materials"] = {{{"emissiveFactor", {1, 1, 1}}, {"emissiveTexture", {{"index", 0}}}}};
+  // Two triangles: UVs within u 0..0.2 (texels 0-1, black even one texel beyond) and within
+  // u 0.7..0.9 (white).
+  int pos = w.addFloats({0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1, 0, 1, 0, 1, 1}, "VEC3");
+  int uv = w.addFloats({0.0f, 0.5f, 0.2f, 0.5f, 0.1f, 0.6f, 0.7f, 0.5f, 0.9f, 0.5f, 0.8f, 0.6f}, "VEC2");
+  w.setRoots({w.addNode({{"mesh", w.addMesh({{"POSITION", pos}, {"TEXCOORD_0", uv}}, -1, 4, 0)}})});
+  Scene s = loadQuiet(w.write(dir, "emissive_texture.gltf"));
+  REQUIRE(s.triangles.size() == 2);
+  REQUIRE(s.areaLights.size() == 1);
+  CHECK(s.areaLights[0].triangle == 1);
+  // The PNG decoded to the texels written (row 0 on top, RGBA).
+  REQUIRE(s.textures.size() == 1);
+  CHECK(s.textures[0].width == 8);
+  CHECK(s.textures[0].rgba8 == texels);
+}

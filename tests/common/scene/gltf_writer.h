@@ -3,6 +3,7 @@
 // Also the catalogue of bad input files shared by the loader and `parrender info` tests.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -32,6 +33,55 @@ inline std::string base64(const std::vector<uint8_t>& bytes) {
     out += '=';
   }
   return out;
+}
+
+// An 8-bit RGBA PNG of the given texels (row 0 on top), uncompressed (stored deflate blocks):
+// enough for tinygltf's decoder, without an image library in the tests.
+inline std::vector<uint8_t> encodePng(int width, int height, const std::vector<uint8_t>& rgba) {
+  auto crc32 = [](const uint8_t* p, size_t n, uint32_t crc = 0xffffffffu) {
+    for (size_t i = 0; i < n; ++i) {
+      crc ^= p[i];
+      for (int k = 0; k < 8; ++k) crc = (crc >> 1) ^ (0xedb88320u & (0u - (crc & 1u)));
+    }
+    return crc;
+  };
+  auto be32 = [](std::vector<uint8_t>& out, uint32_t v) {
+    for (int s = 24; s >= 0; s -= 8) out.push_back(uint8_t(v >> s));
+  };
+  std::vector<uint8_t> raw;  // each row: filter type 0 (none), then the texels
+  for (int y = 0; y < height; ++y) {
+    raw.push_back(0);
+    raw.insert(raw.end(), rgba.begin() + ptrdiff_t(y) * width * 4, rgba.begin() + ptrdiff_t(y + 1) * width * 4);
+  }
+  std::vector<uint8_t> z = {0x78, 0x01};
+  for (size_t at = 0; at < raw.size() || at == 0;) {
+    size_t n = std::min<size_t>(raw.size() - at, 65535);
+    bool last = at + n == raw.size();
+    z.push_back(last ? 1 : 0);
+    z.insert(z.end(), {uint8_t(n), uint8_t(n >> 8), uint8_t(~n), uint8_t(~n >> 8)});
+    z.insert(z.end(), raw.begin() + ptrdiff_t(at), raw.begin() + ptrdiff_t(at + n));
+    at += n;
+    if (last) break;
+  }
+  uint32_t a = 1, b = 0;  // Adler-32 of the uncompressed data
+  for (uint8_t c : raw) a = (a + c) % 65521, b = (b + a) % 65521;
+  be32(z, b << 16 | a);
+  std::vector<uint8_t> png = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  auto chunk = [&](const char* type, const std::vector<uint8_t>& data) {
+    be32(png, uint32_t(data.size()));
+    std::vector<uint8_t> body(type, type + 4);
+    body.insert(body.end(), data.begin(), data.end());
+    png.insert(png.end(), body.begin(), body.end());
+    be32(png, ~crc32(body.data(), body.size()));
+  };
+  std::vector<uint8_t> ihdr;
+  be32(ihdr, uint32_t(width));
+  be32(ihdr, uint32_t(height));
+  ihdr.insert(ihdr.end(), {8, 6, 0, 0, 0});  // 8 bits, RGBA, deflate, no filter, no interlace
+  chunk("IHDR", ihdr);
+  chunk("IDAT", z);
+  chunk("IEND", {});
+  return png;
 }
 
 // Builds one glTF document: binary data goes into buffer 0 (written as a data: URI),

@@ -9,6 +9,7 @@
 #include "common/scene/texture.h"
 #include "common/util/log.h"
 #include "test_support.h"
+#include "tests/common/scene/gltf_writer.h"
 
 namespace {
 
@@ -121,4 +122,32 @@ TEST_CASE("Texture: TextureTransformTest materials carry their transforms and cl
   CHECK((tex.sampler.wrapS == Wrap::ClampToEdge));
   CHECK(tex.width > 0);
   CHECK(tex.rgba8.size() == size_t(tex.width) * size_t(tex.height) * 4);
+}
+
+TEST_CASE("Texture: a PNG in a bufferView loads as 8-bit RGBA with its sampler's modes") {
+  auto dir = pr::test::scratchDir("texture_buffer_view");
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  // 2x2: red, green / blue, white with alpha 128.
+  std::vector<uint8_t> texels = {255, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 128};
+  auto png = pr::test::encodePng(2, 2, texels);
+  int view = w.addView(png.data(), png.size());
+  w.doc["images"] = {{{"bufferView", view}, {"mimeType", "image/png"}}};
+  w.doc["samplers"] = {{{"magFilter", 9728}, {"minFilter", 9986}, {"wrapS", 33648}, {"wrapT", 33071}}};
+  w.doc["textures"] = {{{"source", 0}, {"sampler", 0}}};
+  w.doc["materials"] = {{{"pbrMetallicRoughness", {{"baseColorTexture", {{"index", 0}}}}}}};
+  w.doc["meshes"][0]["primitives"][0]["material"] = 0;
+  pr::setQuiet(true);
+  auto s = pr::scene::loadGltf(w.write(dir, "buffer_view_png.gltf"));
+  pr::setQuiet(false);
+  REQUIRE(s.textures.size() == 1);
+  const Texture& t = s.textures[0];
+  CHECK(t.rgba8 == texels);
+  CHECK((t.sampler.wrapS == Wrap::MirroredRepeat));
+  CHECK((t.sampler.wrapT == Wrap::ClampToEdge));
+  CHECK((t.sampler.magFilter == Filter::Nearest));
+  CHECK((t.sampler.minFilter == Filter::Nearest));  // NEAREST_MIPMAP_LINEAR keeps its base filter
+  CHECK(s.materials[0].baseColorTexture.texture == 0);
+  // v = 0.75 is the bottom row: blue at u = 0.25; the white texel's alpha stays linear.
+  CHECK(t.sample({0.25f, 0.75f}, true) == glm::vec4(0, 0, 1, 1));
+  CHECK(t.sample({0.75f, 0.75f}, true).w == doctest::Approx(128.0f / 255.0f));
 }
