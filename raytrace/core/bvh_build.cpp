@@ -131,6 +131,9 @@ class Builder {
     for (int a = 0; a < 3; ++a) {
       const float extent = centroids.hi[a] - centroids.lo[a];
       scale[a] = extent > 0.0f ? float(bins_) / extent : 0.0f;
+      // A denormal extent overflows the scale; (c - lo) * inf would be NaN, and casting NaN
+      // to int is undefined. Such an axis cannot be split by binning anyway.
+      if (!std::isfinite(scale[a])) scale[a] = 0.0f;
     }
     for (uint32_t i = begin; i < end; ++i) {
       const PrimRef& r = refs_[i];

@@ -149,3 +149,19 @@ TEST_CASE("BvhBuild: degenerate triangles are counted and kept in a leaf") {
   const auto seen = checkStructure(bvh, scene.triangles.size(), BvhBuildOptions{}.maxLeafSize);
   for (int count : seen) CHECK(count == 1);
 }
+
+TEST_CASE("BvhBuild: denormal spacing and huge coordinates build a valid tree") {
+  // Centres 1e-40 apart make the bin scale overflow; coordinates of 1e30 overflow box areas.
+  pr::scene::Scene scene = pr::test::emptyScene();
+  for (int i = 0; i < 12; ++i) {
+    const float d = float(i) * 1e-40f;
+    pr::test::addTriangle(scene, {d, 0, 0}, {d, 1, 0}, {d, 0, 1});
+  }
+  for (int i = 0; i < 12; ++i) {
+    const float x = float(i + 1) * 1e30f;
+    pr::test::addTriangle(scene, {x, 0, 0}, {x, 1e30f, 0}, {x, 0, 1e30f});
+  }
+  const Bvh bvh(scene);
+  const auto seen = checkStructure(bvh, scene.triangles.size(), BvhBuildOptions{}.maxLeafSize);
+  for (int count : seen) CHECK(count == 1);
+}
