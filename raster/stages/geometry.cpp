@@ -64,7 +64,14 @@ ClipVertex intersectEdge(const FrameView& view, const ClipVertex& in, float dIn,
   return v;
 }
 
-// Sutherland-Hodgman against one plane; n vertices in, the count out.
+// Room for clipping: a convex polygon gains at most one vertex per plane (3 + 5 = 8), but
+// vertices moved onto earlier planes can make it non-convex by a rounding error, and then a
+// plane may cut it more than twice. The buffers leave room for that; assembleTriangle drops
+// the (pathological) result when it exceeds kMaxPolygonVertices.
+constexpr int kClipBufferVertices = 2 * kMaxPolygonVertices;
+
+// Sutherland-Hodgman against one plane; n vertices in, the count out (at most
+// kClipBufferVertices; -1 if it would not fit).
 int clipPolygon(const FrameView& view, const ClipVertex* in, int n, ClipVertex* out, int plane) {
   int m = 0;
   for (int i = 0; i < n; ++i) {
@@ -72,6 +79,7 @@ int clipPolygon(const FrameView& view, const ClipVertex* in, int n, ClipVertex* 
     const ClipVertex& b = in[(i + 1) % n];
     float da = planeDistance(view, a, plane);
     float db = planeDistance(view, b, plane);
+    if (m + 2 > kClipBufferVertices) return -1;
     if (da >= 0.0f) out[m++] = a;
     if ((da >= 0.0f) != (db >= 0.0f)) {
       out[m++] = da >= 0.0f ? intersectEdge(view, a, da, b, db, plane) : intersectEdge(view, b, db, a, da, plane);
@@ -180,19 +188,23 @@ int assembleTriangle(const scene::Scene& scene, const FrameView& view, uint32_t 
     // Clip only against the planes some vertex violates: the near plane first, so that w > 0
     // holds before the guard planes (which pass through the eye) are tested.
     ++c.clipped;
-    ClipVertex poly[2][kMaxPolygonVertices];
+    ClipVertex poly[2][kClipBufferVertices];
     for (int k = 0; k < 3; ++k) poly[0][k] = ClipVertex{pv[k]->clip, pv[k]->viewDepth, kCorner[k]};
     int cur = 0;
-    for (int plane = 0; plane < kPlaneCount && n >= 3; ++plane) {
+    for (int plane = 0; plane < kPlaneCount && n >= 3 && n <= kMaxPolygonVertices; ++plane) {
       if (!(clipMask & (1u << plane))) continue;
       n = clipPolygon(view, poly[cur], n, poly[cur ^ 1], plane);
       cur ^= 1;
+    }
+    if (n < 0 || n > kMaxPolygonVertices) {
+      // Only reachable through rounding at vertices already on a clip plane: a sliver.
+      ++c.culledDegenerate;
+      return 0;
     }
     if (n < 3) {
       ++c.culledOutside;
       return 0;
     }
-    PR_DCHECK(n <= kMaxPolygonVertices, "clipped polygon too large");
     for (int k = 0; k < n; ++k) {
       snap(view, poly[cur][k].clip, poly[cur][k].viewDepth, s[k]);
       s[k].bary = poly[cur][k].bary;
