@@ -1,7 +1,17 @@
 #!/usr/bin/env bash
 # Installs every Debian package parrender needs to build, test and benchmark.
 # Idempotent: when everything is present it only checks and returns (no apt traffic).
+#   tools/setup.sh          build and test dependencies
+#   tools/setup.sh --bench  also the benchmark anchors: Intel Embree 3, Mesa llvmpipe over EGL
 set -euo pipefail
+
+bench=0
+for arg in "$@"; do
+  case "$arg" in
+    --bench) bench=1 ;;
+    *) echo "setup: unknown option '$arg' (expected --bench)" >&2; exit 2 ;;
+  esac
+done
 
 packages=(
   build-essential cmake pkg-config
@@ -11,6 +21,12 @@ packages=(
   libcli11-dev                                   # command-line parsing
   doctest-dev                                    # unit tests
 )
+if [ "$bench" -eq 1 ]; then
+  packages+=(
+    libembree-dev                                  # Embree 3 ray tracing anchor
+    libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # llvmpipe raster anchor (EGL surfaceless)
+  )
+fi
 
 missing=()
 for p in "${packages[@]}"; do
