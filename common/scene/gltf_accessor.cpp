@@ -116,23 +116,37 @@ std::vector<double> AccessorReader::decode(int index, const std::string& what, i
   *components = comps;
 
   // Base values: from the bufferView, or zeros when the accessor has none (sparse-only).
-  std::vector<double> out(acc.count * size_t(comps), 0.0);
+  // Ranges are checked before anything is allocated, so an absurd count is a message, not an
+  // allocation failure; a sparse-only accessor is bounded by kMaxSparseOnlyCount.
+  ViewBytes view;
+  size_t stride = elementBytes;
   if (acc.bufferView >= 0) {
-    ViewBytes view = viewBytes(context_, acc.bufferView, where);
-    const size_t stride = view.stride ? view.stride : elementBytes;
+    view = viewBytes(context_, acc.bufferView, where);
+    stride = view.stride ? view.stride : elementBytes;
     if (stride < elementBytes) {
       context_.fail(where + ": bufferView " + std::to_string(acc.bufferView) + " byteStride " +
                     std::to_string(stride) + " is smaller than one element (" + std::to_string(elementBytes) +
                     " bytes)");
     }
-    if (acc.count > 0) {
-      // Last byte read: byteOffset + stride * (count - 1) + elementBytes (spec 3.6.2.4).
-      const size_t end = acc.byteOffset + stride * (acc.count - 1) + elementBytes;
-      if (end > view.length) {
-        context_.fail(where + ": " + std::to_string(acc.count) + " elements need bytes up to " + std::to_string(end) +
-                      " but bufferView " + std::to_string(acc.bufferView) + " has " + std::to_string(view.length));
-      }
+    // Last byte read: byteOffset + stride * (count - 1) + elementBytes (spec 3.6.2.4), checked
+    // without overflow for any count.
+    const bool fits = acc.count == 0 ||
+                      (acc.byteOffset <= view.length && elementBytes <= view.length - acc.byteOffset &&
+                       acc.count - 1 <= (view.length - acc.byteOffset - elementBytes) / stride);
+    if (!fits) {
+      context_.fail(where + ": " + std::to_string(acc.count) + " elements from byte " + std::to_string(acc.byteOffset) +
+                    " (stride " + std::to_string(stride) + ") do not fit: bufferView " +
+                    std::to_string(acc.bufferView) + " has " + std::to_string(view.length) + " bytes");
     }
+  } else {
+    constexpr size_t kMaxSparseOnlyCount = size_t(1) << 28;
+    if (acc.count > kMaxSparseOnlyCount) {
+      context_.fail(where + ": count " + std::to_string(acc.count) + " without a bufferView exceeds " +
+                    std::to_string(kMaxSparseOnlyCount));
+    }
+  }
+  std::vector<double> out(acc.count * size_t(comps), 0.0);
+  if (acc.bufferView >= 0) {
     for (size_t i = 0; i < acc.count; ++i) {
       const uint8_t* element = view.data + acc.byteOffset + i * stride;
       for (int c = 0; c < comps; ++c) {

@@ -431,3 +431,44 @@ TEST_CASE("GltfLoader: only triangles over non-black emissive texels become area
   CHECK(s.textures[0].width == 8);
   CHECK(s.textures[0].rgba8 == texels);
 }
+
+TEST_CASE("GltfLoader: sparse accessors substitute values, with or without a base bufferView") {
+  auto dir = pr::test::scratchDir("gltf_sparse");
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  // Sparse on POSITION: element 1 becomes (5, 5, 0). UNSIGNED_BYTE index, as the spec allows.
+  uint8_t index[1] = {1};
+  float value[3] = {5, 5, 0};
+  int indexView = w.addView(index, 1);
+  int valueView = w.addView(value, sizeof value);
+  w.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                     {"indices", {{"bufferView", indexView}, {"componentType", 5121}}},
+                                     {"values", {{"bufferView", valueView}}}};
+  // A sparse-only TEXCOORD_0 (no bufferView): zeros except element 2 = (0.5, 0.25).
+  float uvValue[2] = {0.5f, 0.25f};
+  uint8_t uvIndex[1] = {2};
+  int uvIndexView = w.addView(uvIndex, 1);
+  int uvValueView = w.addView(uvValue, sizeof uvValue);
+  int uv = w.addAccessor(-1, 5126, 3, "VEC2");
+  w.doc["accessors"][uv]["sparse"] = {{"count", 1},
+                                      {"indices", {{"bufferView", uvIndexView}, {"componentType", 5121}}},
+                                      {"values", {{"bufferView", uvValueView}}}};
+  w.doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = uv;
+  Scene s = loadQuiet(w.write(dir, "sparse.gltf"));
+  checkNear(s.positions[0], glm::vec3(0, 0, 0));
+  checkNear(s.positions[1], glm::vec3(5, 5, 0));
+  checkNear(s.positions[2], glm::vec3(0, 1, 0));
+  CHECK(s.uvs[0] == glm::vec2(0.0f));
+  CHECK(s.uvs[2] == glm::vec2(0.5f, 0.25f));
+
+  // A sparse index past the accessor's count is bad input.
+  index[0] = 9;
+  pr::test::GltfWriter bad = pr::test::oneTriangle();
+  int badIndexView = bad.addView(index, 1);
+  int badValueView = bad.addView(value, sizeof value);
+  bad.doc["accessors"][0]["sparse"] = {{"count", 1},
+                                       {"indices", {{"bufferView", badIndexView}, {"componentType", 5121}}},
+                                       {"values", {{"bufferView", badValueView}}}};
+  CHECK_THROWS_WITH_AS(loadQuiet(bad.write(dir, "bad_sparse.gltf")), doctest::Contains("sparse index 9 is out of range"),
+                       pr::InputError);
+  pr::setQuiet(false);
+}
