@@ -10,6 +10,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -64,7 +65,10 @@ class Channel : public ChannelBase {
   // Inside a task on PE `me`: takes one waiting message, if any.
   bool tryReceive(Pe& me, T& out) {
     PR_CHECK(!handler_, "Channel '" + name_ + "' has a handler; its messages are delivered to it");
-    return pop(me.id(), out);
+    std::optional<T> message;
+    if (!pop(me.id(), message)) return false;
+    out = std::move(*message);
+    return true;
   }
 
   // Between stages, on the controlling thread: every message waiting for pe, in arrival order.
@@ -80,9 +84,9 @@ class Channel : public ChannelBase {
   bool pending(int pe) const override { return boxes_[pe]->size.load(std::memory_order_acquire) > 0; }
 
   bool handleOne(Pe& pe) override {
-    T message;
+    std::optional<T> message;
     if (!pop(pe.id(), message)) return false;
-    handler_(pe, std::move(message));
+    handler_(pe, std::move(*message));
     return true;
   }
 
@@ -93,12 +97,12 @@ class Channel : public ChannelBase {
     std::atomic<std::size_t> size{0};  // lets an idle PE poll without taking the lock
   };
 
-  bool pop(int pe, T& out) {
+  bool pop(int pe, std::optional<T>& out) {
     Mailbox& box = *boxes_[pe];
     if (box.size.load(std::memory_order_acquire) == 0) return false;
     std::lock_guard lock(box.mutex);
     if (box.queue.empty()) return false;
-    out = std::move(box.queue.front());
+    out.emplace(std::move(box.queue.front()));
     box.queue.pop_front();
     box.size.store(box.queue.size(), std::memory_order_release);
     return true;

@@ -74,3 +74,21 @@ TEST_CASE("DataDriven: the thread engine runs exactly the simulator's assignment
     }
   }
 }
+
+TEST_CASE("DataDriven: an unbalanced split from the profile of an earlier run") {
+  // An earlier demand-driven run recorded each task's cost; the next run splits by it. Without
+  // it (every estimate 1) the unbalanced split can only give each PE 8 tasks and misses 14.
+  Workload w = pr::test::seedExample();
+  for (TaskInfo& t : w.stages[0].tasks.tasks) t.costEstimate = 1.0;
+  SimOptions options;
+  options.pes = 3;
+  options.recordTimeline = true;
+  const RunRecord earlier = simulate(w, "demand", options);
+  const RunRecord blind = simulate(w, "unbalanced", options);
+  CHECK(blind.wallSeconds > 14.0);
+  for (const PeStageRecord& pe : blind.stages[0].pes) CHECK(pe.tasks == 8);
+  const std::vector<double> profile = taskCostProfile(earlier, 0);
+  CHECK(profile == pr::test::seedExampleCosts());
+  for (std::size_t i = 0; i < profile.size(); ++i) w.stages[0].tasks.tasks[i].costEstimate = profile[i];
+  CHECK(simulate(w, "unbalanced", options).wallSeconds == 14.0);
+}
