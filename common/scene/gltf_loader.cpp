@@ -49,9 +49,10 @@ tinygltf::Model parse(const std::filesystem::path& path, std::vector<std::string
                      (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") + ")");
   }
   std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(file + ": cannot read the file (permission denied or unreadable)");
+  // A .glb starts with the magic "glTF" (spec 4.4.2); anything else is parsed as JSON.
   char magic[4] = {};
-  if (!in || !in.read(magic, 4)) throw InputError(file + ": cannot read the file (unreadable or shorter than 4 bytes)");
-  const bool binary = std::string_view(magic, 4) == "glTF";
+  const bool binary = in.read(magic, 4) && std::string_view(magic, 4) == "glTF";
 
   tinygltf::TinyGLTF parser;
   tinygltf::Model model;
