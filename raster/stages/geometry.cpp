@@ -44,13 +44,24 @@ float planeDistance(const FrameView& view, const ClipVertex& v, int plane) {
 // (no cracks along clipped shared edges). The result is then put exactly on the plane: far
 // outside vertices (w = -1e6 behind the camera) would otherwise leave rounding errors larger
 // than znear and a vertex with w <= 0.
+// The interpolation starts from the nearer endpoint in parameter: from `in` with
+// t = dIn / (dIn - dOut) when t <= 1/2, else from `out` with 1 - t = dOut / (dOut - dIn)
+// computed directly. in + t (out - in) with t rounded to 1 would lose `out` entirely when the
+// endpoints differ by orders of magnitude (w = 9e6 against w = 0.01 gives w = 0).
 ClipVertex intersectEdge(const FrameView& view, const ClipVertex& in, float dIn, const ClipVertex& out,
                          float dOut, int plane) {
-  float t = dIn / (dIn - dOut);
   ClipVertex v;
-  v.clip = in.clip + t * (out.clip - in.clip);
-  v.viewDepth = in.viewDepth + t * (out.viewDepth - in.viewDepth);
-  v.bary = in.bary + t * (out.bary - in.bary);
+  if (dIn <= -dOut) {
+    float t = dIn / (dIn - dOut);
+    v.clip = in.clip + t * (out.clip - in.clip);
+    v.viewDepth = in.viewDepth + t * (out.viewDepth - in.viewDepth);
+    v.bary = in.bary + t * (out.bary - in.bary);
+  } else {
+    float s = dOut / (dOut - dIn);
+    v.clip = out.clip + s * (in.clip - out.clip);
+    v.viewDepth = out.viewDepth + s * (in.viewDepth - out.viewDepth);
+    v.bary = out.bary + s * (in.bary - out.bary);
+  }
   switch (plane) {
     case kNear:
       if (view.perspective) v.clip.w = view.znear;
@@ -206,6 +217,13 @@ int assembleTriangle(const scene::Scene& scene, const FrameView& view, uint32_t 
       return 0;
     }
     for (int k = 0; k < n; ++k) {
+      // Clipping keeps w >= znear up to rounding; a polygon that still has a vertex at w <= 0
+      // or a non-finite one is a numerical sliver and is dropped rather than divided by zero.
+      const glm::vec4& cp = poly[cur][k].clip;
+      if (!(cp.w > 0.0f) || !std::isfinite(cp.x) || !std::isfinite(cp.y) || !std::isfinite(poly[cur][k].viewDepth)) {
+        ++c.culledDegenerate;
+        return 0;
+      }
       snap(view, poly[cur][k].clip, poly[cur][k].viewDepth, s[k]);
       s[k].bary = poly[cur][k].bary;
     }

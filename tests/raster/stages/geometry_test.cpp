@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "common/util/error.h"
@@ -252,6 +253,37 @@ TEST_CASE("Geometry: extreme depth ranges keep the nearer surface in front") {
       CHECK(wrong == 0);
     }
   }
+}
+
+TEST_CASE("Geometry: random triangles through every clip plane stay finite and single-covering") {
+  // Corners anywhere from 1e-3 to 1e7 units around the eye, in front and behind: near-plane
+  // and guard-band clipping in every combination. Each primitive's pieces must cover a pixel
+  // at most once (the fan of a clipped polygon does not overlap itself).
+  constexpr int kW = 48, kH = 32;
+  scene::Scene s = test::emptyScene();
+  s.materials[0].doubleSided = true;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f), exponent(-3.0f, 7.0f);
+  auto coordinate = [&] { return std::copysign(std::pow(10.0f, exponent(rng)), unit(rng)); };
+  for (int i = 0; i < 3000; ++i) {
+    glm::vec3 p[3];
+    for (auto& v : p) v = glm::vec3(coordinate(), coordinate(), coordinate());
+    test::addTriangle(s, p[0], p[1], p[2]);
+  }
+  GeometryCounters counters;
+  auto tris = geometry(s, makeFrameView(test::lookAtCamera({0, 0, 0}, {0, 0, -1}, 1.0f, 0.01f), kW, kH), &counters);
+  CHECK(counters.clipped > 500);
+  CHECK(tris.size() > 300);
+  CHECK(allFinite(tris));
+  int overlapping = 0;
+  for (size_t i = 0; i < tris.size();) {
+    size_t j = i;
+    while (j < tris.size() && tris[j].primitive == tris[i].primitive) ++j;
+    auto counts = test::coverageCounts(kW, kH, std::vector<ScreenTriangle>(tris.begin() + i, tris.begin() + j));
+    for (int c : counts) overlapping += c > 1;
+    i = j;
+  }
+  CHECK(overlapping == 0);
 }
 
 TEST_CASE("Geometry: triangles entirely outside or behind are rejected early") {
