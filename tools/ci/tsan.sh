@@ -11,7 +11,7 @@ build_dir="${1:-$source_dir/build-tsan}"
 jobs="${JOBS:-2}"
 
 # Every runtime test case starts with one of these concept names (tests/common/parallel).
-runtime_tests="Scheduler*,TaskOrder*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*"
+runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*"
 
 cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests

@@ -7,6 +7,18 @@
 
 namespace pr::par {
 
+// Factories, each defined in its strategy's file.
+std::unique_ptr<Scheduler> makeBalancedDataDriven();
+std::unique_ptr<Scheduler> makeUnbalancedDataDriven();
+std::unique_ptr<Scheduler> makeDemandSerial();
+std::unique_ptr<Scheduler> makeDemandSpiral();
+std::unique_ptr<Scheduler> makeDemandRandom();
+std::unique_ptr<Scheduler> makeDemandHotSpots();
+std::unique_ptr<Scheduler> makeHybrid();
+std::unique_ptr<Scheduler> makeTaskManager();
+std::unique_ptr<Scheduler> makeDistributed();
+std::unique_ptr<Scheduler> makePreferredBias();
+
 const std::vector<ScheduleInfo>& schedules() {
   static const std::vector<ScheduleInfo> kSchedules = {
       {"balanced", "balanced data-driven: equal contiguous portions, fixed before the run", makeBalancedDataDriven},

@@ -88,19 +88,7 @@ bool isSchedule(std::string_view name);
 // "name: description" lines, for --help.
 std::string describeSchedules();
 
-// Factories, one per strategy file.
-std::unique_ptr<Scheduler> makeBalancedDataDriven();
-std::unique_ptr<Scheduler> makeUnbalancedDataDriven();
-std::unique_ptr<Scheduler> makeDemandSerial();
-std::unique_ptr<Scheduler> makeDemandSpiral();
-std::unique_ptr<Scheduler> makeDemandRandom();
-std::unique_ptr<Scheduler> makeDemandHotSpots();
-std::unique_ptr<Scheduler> makeHybrid();
-std::unique_ptr<Scheduler> makeTaskManager();
-std::unique_ptr<Scheduler> makeDistributed();
-std::unique_ptr<Scheduler> makePreferredBias();
-
-// Static splits shared by several strategies (and checked directly by tests).
+// Static splits shared by several strategies (balanced.cpp, unbalanced.cpp; tests check them).
 // Balanced: contiguous blocks of ids [0, n), the first n mod P PEs one task more (seed 3.2.1).
 std::vector<std::vector<TaskId>> balancedSplit(std::size_t n, int pes);
 // Unbalanced: by cost estimate, longest first to the least-loaded PE (ties: lowest PE), each
