@@ -2,7 +2,8 @@
 // Prints, with the anchor of each ratio measured in the same run:
 //  1. the seed's worked example (24 tasks, 42 units) with spinning busy work in the thread
 //     engine for every strategy, beside the simulator's makespans;
-//  2. scheduling overhead per task for every strategy at P = 2 (target < 1 us, demand pool);
+//  2. scheduling overhead per task for every strategy at P = 2 (target < 1 us, demand pool),
+//     and the effect of the grain (task packet size) on efficiency and request traffic;
 //  3. parallel efficiency at P = 2 on an embarrassingly parallel workload (target >= 97%);
 //  4. the simulator's prediction of recorded runs at P = 1 and 2 (target within 10%);
 //  5. simulator speed in simulated tasks per second (target >= 1M).
@@ -84,6 +85,21 @@ void schedulingOverhead() {
               2 * secondsSince(t0) / n * 1e6);
 }
 
+void granularity() {
+  // Larger packets mean fewer requests but a coarser end of stage: the seed's granularity trade.
+  std::vector<double> costs(4000);
+  for (std::size_t i = 0; i < costs.size(); ++i) costs[i] = 20e-6 * (1 + i % 5);
+  std::printf("\n2b. granularity, demand-driven, P = 2, 4000 tasks of 20..100 us\n");
+  std::printf("%6s %10s %8s %10s %12s\n", "grain", "wall s", "effic.", "imbalance", "sched. msgs");
+  for (int grain : {1, 4, 16, 64, 256, 1000}) {
+    ScheduleParams params;
+    params.grain = grain;
+    const RunSummary s = summarize(runSpin(2, "demand", costs, params));
+    std::printf("%6d %10.5f %8.4f %10.4f %12llu\n", grain, s.wallSeconds, s.total.efficiency, s.total.imbalance,
+                (unsigned long long)s.total.schedulingMessages);
+  }
+}
+
 void efficiency() {
   const std::vector<double> costs(400, 1e-3);
   std::printf("\n3. parallel efficiency, 400 tasks of 1 ms spinning (embarrassingly parallel)\n");
@@ -153,6 +169,7 @@ int main() {
   workedExample(3, 5e-3);
   workedExample(2, 5e-3);
   schedulingOverhead();
+  granularity();
   efficiency();
   prediction();
   simulatorSpeed();
