@@ -4,6 +4,7 @@
 #include "tools/bench/anchors/embree_anchor.h"
 
 #include <chrono>
+#include <ctime>
 #include <stdexcept>
 #include <string>
 #include <thread>
@@ -87,30 +88,39 @@ void occlusionChunk(RTCScene scene, const RayIn* rays, uint8_t* occluded, size_t
   }
 }
 
-// Runs chunk(first, count) over `threads` contiguous chunks of n items, timing spawn to join.
+double threadCpuSeconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
+}
+
+// Runs chunk(first, count) over `threads` contiguous chunks of n items and fills the
+// result's timing: wall clock from spawn to join, CPU time summed over the chunks.
 template <typename Chunk>
-double runChunked(size_t n, int threads, Chunk chunk) {
+void runChunked(size_t n, int threads, TraceResult& result, Chunk chunk) {
   if (threads < 1) throw std::invalid_argument("Embree anchor: threads must be >= 1, got " + std::to_string(threads));
+  std::vector<double> cpu(size_t(threads), 0.0);
+  const auto timedChunk = [&](int t) {
+    const size_t first = n * size_t(t) / size_t(threads), last = n * size_t(t + 1) / size_t(threads);
+    const double cpuStart = threadCpuSeconds();
+    chunk(first, last - first);
+    cpu[size_t(t)] = threadCpuSeconds() - cpuStart;
+  };
   const auto start = Clock::now();
   if (threads == 1) {
-    chunk(size_t(0), n);
+    timedChunk(0);
   } else {
     std::vector<std::thread> workers;
     workers.reserve(size_t(threads));
-    for (int t = 0; t < threads; ++t) {
-      const size_t first = n * size_t(t) / size_t(threads), last = n * size_t(t + 1) / size_t(threads);
-      workers.emplace_back(chunk, first, last - first);
-    }
+    for (int t = 0; t < threads; ++t) workers.emplace_back(timedChunk, t);
     for (std::thread& w : workers) w.join();
   }
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-void finishResult(TraceResult& result, size_t rays, int threads, double seconds) {
-  result.rays = rays;
+  result.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  result.rays = n;
   result.threads = threads;
-  result.seconds = seconds;
-  result.mraysPerSecond = seconds > 0.0 ? double(rays) / seconds * 1e-6 : 0.0;
+  for (double c : cpu) result.cpuSeconds += c;
+  result.mraysPerSecond = result.seconds > 0.0 ? double(n) / result.seconds * 1e-6 : 0.0;
+  result.mraysPerCpuSecond = result.cpuSeconds > 0.0 ? double(n) / result.cpuSeconds * 1e-6 : 0.0;
 }
 
 }  // namespace
@@ -167,10 +177,9 @@ TraceResult EmbreeAnchor::traceClosest(const std::vector<RayIn>& rays, int threa
   TraceResult result;
   result.hits.resize(rays.size());
   auto scene = static_cast<RTCScene>(scene_);
-  const double seconds = runChunked(rays.size(), threads, [&](size_t first, size_t count) {
+  runChunked(rays.size(), threads, result, [&](size_t first, size_t count) {
     closestChunk(scene, rays.data() + first, result.hits.data() + first, count);
   });
-  finishResult(result, rays.size(), threads, seconds);
   for (const HitOut& h : result.hits) result.hitCount += h.hit() ? 1 : 0;
   return result;
 }
@@ -179,10 +188,9 @@ TraceResult EmbreeAnchor::traceOcclusion(const std::vector<RayIn>& rays, int thr
   TraceResult result;
   result.occluded.resize(rays.size());
   auto scene = static_cast<RTCScene>(scene_);
-  const double seconds = runChunked(rays.size(), threads, [&](size_t first, size_t count) {
+  runChunked(rays.size(), threads, result, [&](size_t first, size_t count) {
     occlusionChunk(scene, rays.data() + first, result.occluded.data() + first, count);
   });
-  finishResult(result, rays.size(), threads, seconds);
   for (uint8_t o : result.occluded) result.hitCount += o;
   return result;
 }

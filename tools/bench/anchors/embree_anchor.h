@@ -33,6 +33,10 @@ struct HitOut {
 struct TraceResult {
   double seconds = 0.0;       // wall clock of the whole trace (all threads, spawn to join)
   double mraysPerSecond = 0.0;
+  // CPU time the tracing threads spent, summed: on a machine shared with other jobs the wall
+  // clock also counts time they held the cores, so rays / CPU second is the steadier figure.
+  double cpuSeconds = 0.0;
+  double mraysPerCpuSecond = 0.0;
   int threads = 1;
   size_t rays = 0;
   size_t hitCount = 0;              // rays that hit (closest) or were occluded (occlusion)

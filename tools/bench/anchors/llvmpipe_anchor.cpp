@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstddef>
+#include <ctime>
 #include <stdexcept>
 #include <string>
 #include <unordered_map>
@@ -213,6 +214,12 @@ void setLights(GLuint program, const scene::Scene& scene, const scene::Camera& c
   glUniform4fv(glGetUniformLocation(program, "uEye"), 1, glm::value_ptr(eye));
 }
 
+double processCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
 double median(std::vector<double> values) {
   std::sort(values.begin(), values.end());
   const size_t n = values.size();
@@ -302,12 +309,16 @@ RasterAnchorResult renderWithLlvmpipe(const scene::Scene& scene, const scene::Ca
   };
   drawFrame();  // warm-up: llvmpipe compiles the shaders to machine code at the first draw
   result.frameMs.reserve(size_t(frames));
+  result.frameCpuMs.reserve(size_t(frames));
   for (int f = 0; f < frames; ++f) {
     const auto start = Clock::now();
+    const double cpuStart = processCpuMs();
     drawFrame();
+    result.frameCpuMs.push_back(processCpuMs() - cpuStart);
     result.frameMs.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
   }
   result.msPerFrameMedian = median(result.frameMs);
+  result.cpuMsPerFrameMedian = median(result.frameCpuMs);
   if (GLenum error = glGetError(); error != GL_NO_ERROR)
     throw std::runtime_error("llvmpipe anchor: GL error " + std::to_string(error) + " while drawing");
 

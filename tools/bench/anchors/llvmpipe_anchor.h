@@ -16,6 +16,10 @@ namespace pr::bench {
 struct RasterAnchorResult {
   double msPerFrameMedian = 0.0;
   std::vector<double> frameMs;   // each timed frame: glClear + draws + glFinish, wall clock
+  // CPU time of the whole process per frame (front end and tile threads together): on a
+  // machine shared with other jobs it does not count the time they held the cores.
+  double cpuMsPerFrameMedian = 0.0;
+  std::vector<double> frameCpuMs;
   double uploadMs = 0.0;         // VBO/IBO upload and shader build, once, not in frameMs
   int coveredPixels = 0;         // pixels some triangle wrote in the final frame
   int width = 0, height = 0;

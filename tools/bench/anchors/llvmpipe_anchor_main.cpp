@@ -54,6 +54,7 @@ int main(int argc, char** argv) {
         {"anchor", "llvmpipe"},     {"scene", scenePath},          {"triangles", r.trianglesDrawn},
         {"width", width},           {"height", height},            {"threads", r.threads},
         {"frames", frames},         {"msPerFrameMedian", r.msPerFrameMedian}, {"frameMs", r.frameMs},
+        {"cpuMsPerFrameMedian", r.cpuMsPerFrameMedian},
         {"uploadMs", r.uploadMs},   {"coveredPixels", r.coveredPixels},       {"renderer", r.renderer}};
     std::printf("%s\n", line.dump().c_str());
   } catch (const pr::InputError& e) {
