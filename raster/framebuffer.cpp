@@ -39,6 +39,16 @@ bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b) {
          std::memcmp(a.colours(), b.colours(), n * sizeof(glm::vec3)) == 0;
 }
 
+RegionFramebuffer crop(const RegionFramebuffer& fb, const Rect& rect) {
+  RegionFramebuffer out(intersect(fb.rect(), rect));
+  const Rect& r = out.rect();
+  for (int y = r.y0; y < r.y1; ++y) {
+    std::copy_n(fb.keys() + fb.index(r.x0, y), r.width(), out.keys() + out.index(r.x0, y));
+    std::copy_n(fb.colours() + fb.index(r.x0, y), r.width(), out.colours() + out.index(r.x0, y));
+  }
+  return out;
+}
+
 image::Image toImage(const RegionFramebuffer& fb) {
   image::Image img(fb.width(), fb.height());
   std::copy(fb.colours(), fb.colours() + fb.rect().area(), img.pixels.begin());

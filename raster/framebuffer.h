@@ -63,6 +63,10 @@ class RegionFramebuffer {
 // True when both cover the same rectangle and hold bit-identical keys and colours.
 bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
 
+// The part of fb inside rect (intersected with fb's rectangle): keys and colours copied,
+// triangle indices kNoTriangle. What a sort-last PE sends to the owner of a screen region.
+RegionFramebuffer crop(const RegionFramebuffer& fb, const Rect& rect);
+
 // The colours as an image of the rectangle's size (row 0 = the rectangle's top row), for
 // image output and comparison (common/image).
 image::Image toImage(const RegionFramebuffer& fb);
