@@ -20,8 +20,9 @@ inline constexpr int kSubpixelBits = 8;
 inline constexpr int32_t kSubpixelScale = 1 << kSubpixelBits;
 
 // Largest image side. With the guard band below, snapped coordinates stay within
-// +-(2^18 + 2^16) px = +-2^26.4 fixed-point units, edge-function coefficients within 2^27.4 and
-// edge values within 2^55.8: all exact in int64 (see setup.h).
+// +-(2^18 + 2^16) px = +-2^26.4 fixed-point units and edge-function coefficients (coordinate
+// differences) within 2^27.4, so every product and sum of setup.h stays below 2^56: exact in
+// int64 with bits to spare.
 inline constexpr int kMaxImageSidePx = 1 << 16;
 
 // Guard band: a triangle is clipped against the side planes only where it reaches farther

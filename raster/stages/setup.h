@@ -16,7 +16,8 @@ namespace pr::raster {
 //   E_k(X, Y) = a[k] * X + b[k] * Y + c[k]
 // is twice the signed area of (vertex k+1, vertex k+2, sample), positive inside, and
 // E_0 + E_1 + E_2 = area2; E_k / area2 is the screen-space barycentric of vertex k.
-// Magnitudes (geometry.h): |a|, |b| < 2^27.4, |X|, |Y| < 2^26.4, so |E| < 2^55.8: exact.
+// Magnitudes (geometry.h): |a|, |b| < 2^27.4 and |X|, |Y|, |x_i|, |y_i| < 2^26.4, so each
+// product is below 2^53.8 and c, E below 2^56: exact.
 struct EdgeFunctions {
   int64_t a[3], b[3], c[3];
 };
