@@ -64,6 +64,8 @@ struct ScreenTriangle {
   uint8_t sub;          // fan index when clipping split the triangle, else 0
   uint8_t backFacing;   // 1: a double-sided triangle seen from behind (shading flips the normal)
 };
+// The size of one sort-middle message payload per triangle.
+static_assert(sizeof(ScreenTriangle) == 80, "ScreenTriangle layout changed: update message accounting");
 
 // Per-batch counts of the geometry stage (Geometry/...).
 struct GeometryCounters {
