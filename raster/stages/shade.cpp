@@ -149,14 +149,14 @@ inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3
 }
 
 // brdf() for L = V (the headlight): then H = V, NdotH = NdotL = NdotV, VdotH = 1 and F = F0,
-// which saves normalizing H; |N x H|^2 = 1 - NdotV^2 cannot cancel badly here because the
-// alpha^2 NdotV^2 term dominates near NdotV = 1.
-inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, float NdotV) {
+// which saves normalizing H. |N x V|^2 stands for 1 - NdotV^2 as in brdf().
+inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V) {
   float r = std::max(roughness, kMinRoughness);
   float alpha = r * r;
   float alpha2 = alpha * alpha;
-  float c = std::max(NdotV, 1e-4f);
-  float denom = std::max(1.0f - c * c, 0.0f) + c * c * alpha2;
+  float c = std::max(glm::dot(N, V), 1e-4f);
+  glm::vec3 NxV = glm::cross(N, V);
+  float denom = glm::dot(NxV, NxV) + c * c * alpha2;
   float k = 0.5f * alpha;
   float g = c * (1.0f - k) + k;
   float specularScale = alpha2 / (4.0f * kPi * denom * denom * g * g);
@@ -189,7 +189,7 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
   glm::vec3 albedo(base);
   if (ctx.usesHeadlight) {
     float NdotV = glm::dot(sp.normal, V);
-    if (NdotV > 0.0f) radiance += headlightBrdf(albedo, metallic, roughness, NdotV) * (kHeadlightLux * NdotV);
+    if (NdotV > 0.0f) radiance += headlightBrdf(albedo, metallic, roughness, sp.normal, V) * (kHeadlightLux * NdotV);
     return radiance;
   }
   for (const scene::PunctualLight& light : ctx.lights) {

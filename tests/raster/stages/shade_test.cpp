@@ -168,6 +168,13 @@ TEST_CASE("Shade: without punctual lights a headlight at the eye lights by cos(N
   glm::vec3 expected = evalBrdf(glm::vec3(1.0f), 0.0f, 1.0f, sp.normal, V, V) * (kPi * V.y);
   CHECK(near(shadeSurface(ctx, sp), expected, 1e-5f));
   CHECK(shadeSurface(ctx, sp).x > 0.5f);
+  // A smooth metal seen 2 degrees off its normal (the narrow GGX peak) agrees with the general
+  // BRDF evaluated for L = V.
+  s.materials[0].metallicFactor = 1.0f;
+  s.materials[0].roughnessFactor = 0.05f;
+  sp.normal = glm::normalize(V + glm::vec3(0.035f, 0.0f, 0.0f));
+  glm::vec3 smooth = evalBrdf(glm::vec3(1.0f), 1.0f, 0.05f, sp.normal, V, V) * (kPi * glm::dot(sp.normal, V));
+  CHECK(near(shadeSurface(ctx, sp), smooth, 1e-4f));
   // Facing away from the eye: unlit.
   sp.normal = -sp.normal;
   CHECK(shadeSurface(ctx, sp) == glm::vec3(0.0f));
