@@ -149,6 +149,7 @@ EmbreeAnchor::EmbreeAnchor(const scene::Scene& scene, int buildThreads) : triang
                                                                     3 * sizeof(uint32_t), scene.triangles.size()));
     if (!vertices || !indices) {
       rtcReleaseGeometry(geometry);
+      release();
       throw std::runtime_error("Embree anchor: cannot allocate geometry buffers (" + error + ")");
     }
     for (size_t i = 0; i < scene.positions.size(); ++i) {
@@ -165,12 +166,18 @@ EmbreeAnchor::EmbreeAnchor(const scene::Scene& scene, int buildThreads) : triang
   rtcCommitScene(rtcScene);
   buildSeconds_ = std::chrono::duration<double>(Clock::now() - start).count();
   rtcSetDeviceErrorFunction(device, nullptr, nullptr);
-  if (!error.empty()) throw std::runtime_error("Embree anchor: scene build failed: " + error);
+  if (!error.empty()) {
+    release();
+    throw std::runtime_error("Embree anchor: scene build failed: " + error);
+  }
 }
 
-EmbreeAnchor::~EmbreeAnchor() {
+EmbreeAnchor::~EmbreeAnchor() { release(); }
+
+void EmbreeAnchor::release() {
   if (scene_) rtcReleaseScene(static_cast<RTCScene>(scene_));
   if (device_) rtcReleaseDevice(static_cast<RTCDevice>(device_));
+  scene_ = device_ = nullptr;
 }
 
 TraceResult EmbreeAnchor::traceClosest(const std::vector<RayIn>& rays, int threads) const {

@@ -49,7 +49,8 @@ struct TraceResult {
 // Tracing is const and may run from any number of threads at once.
 class EmbreeAnchor {
  public:
-  // buildThreads: Embree's worker threads for the BVH build (0 = all hardware threads).
+  // buildThreads: Embree's worker threads for the BVH build (0 = all hardware threads). Embree
+  // limits its TBB pool process-wide while the device lives.
   // Throws std::runtime_error when Embree cannot create the device or build the scene.
   explicit EmbreeAnchor(const scene::Scene& scene, int buildThreads = 1);
   ~EmbreeAnchor();
@@ -66,6 +67,8 @@ class EmbreeAnchor {
   TraceResult traceOcclusion(const std::vector<RayIn>& rays, int threads = 1) const;
 
  private:
+  void release();  // the scene, then the device (also when the constructor throws)
+
   void* device_ = nullptr;  // RTCDevice
   void* scene_ = nullptr;   // RTCScene
   double buildSeconds_ = 0.0;
