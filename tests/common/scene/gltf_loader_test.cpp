@@ -472,3 +472,40 @@ TEST_CASE("GltfLoader: sparse accessors substitute values, with or without a bas
                        pr::InputError);
   pr::setQuiet(false);
 }
+
+TEST_CASE("GltfLoader: integer component types convert as values or, when normalized, to [-1, 1]") {
+  auto dir = pr::test::scratchDir("gltf_component_types");
+  pr::test::GltfWriter w;
+  // POSITION as SHORT values (KHR_mesh_quantization style): plain integers, not normalized.
+  std::vector<int16_t> pos = {0, 0, 0, 2, 0, 0, 0, -3, 0, 0};  // 3 x VEC3 + padding
+  int posAcc = w.addAccessor(w.addView(pos.data(), pos.size() * 2), 5122, 3, "VEC3");
+  // NORMAL as normalized BYTE: -128 clamps to -1 (spec 3.11: max(c / 127, -1)).
+  std::vector<int8_t> nrm = {0, 0, -128, 0, 0, -127, 0, 0, -64, 0, 0, 0};
+  int nrmAcc = w.addAccessor(w.addView(nrm.data(), nrm.size()), 5120, 3, "VEC3", 0, true);
+  // TEXCOORD_0 as normalized SHORT.
+  std::vector<int16_t> uv = {32767, -32768, 0, 16384, 0, 0};
+  int uvAcc = w.addAccessor(w.addView(uv.data(), uv.size() * 2), 5122, 3, "VEC2", 0, true);
+  // Indices as UNSIGNED_BYTE and, in a second instance below, UNSIGNED_INT.
+  std::vector<uint8_t> idx8 = {0, 1, 2, 0};  // 3 indices + padding
+  int idxAcc = w.addAccessor(w.addView(idx8.data(), idx8.size()), 5121, 3, "SCALAR");
+  std::vector<uint32_t> idx32 = {0, 1, 2};
+  int idx32Acc = w.addAccessor(w.addView(idx32.data(), idx32.size() * 4), 5125, 3, "SCALAR");
+  nlohmann::json attributes = {{"POSITION", posAcc}, {"NORMAL", nrmAcc}, {"TEXCOORD_0", uvAcc}};
+  int meshA = w.addMesh(attributes, idxAcc);
+  int meshB = w.addMesh(attributes, idx32Acc);
+  w.setRoots({w.addNode({{"mesh", meshA}}), w.addNode({{"mesh", meshB}})});
+  Scene s = loadQuiet(w.write(dir, "component_types.gltf"));
+  REQUIRE(s.positions.size() == 6);
+  checkNear(s.positions[1], glm::vec3(2, 0, 0));
+  checkNear(s.positions[2], glm::vec3(0, -3, 0));
+  checkNear(s.normals[0], glm::vec3(0, 0, -1));
+  checkNear(s.normals[2], glm::vec3(0, 0, -1));  // normalised after decoding -64/127
+  CHECK(s.uvs[0].x == doctest::Approx(1.0f));
+  CHECK(s.uvs[0].y == doctest::Approx(-1.0f));
+  CHECK(s.uvs[1].y == doctest::Approx(16384.0f / 32767.0f));
+  REQUIRE(s.triangles.size() == 2);
+  CHECK(s.triangles[1].v[2] == 3 + 2);  // the UNSIGNED_INT instance, offset by its base vertex
+  // (0,0,0), (2,0,0), (0,-3,0): cross((2,0,0), (0,-3,0)) = (0,0,-6), facing -Z like NORMAL.
+  checkNear(windingNormal(s, 0), glm::vec3(0, 0, -1));
+  CHECK(s.colors.empty());  // no primitive has COLOR_0
+}
