@@ -62,6 +62,11 @@ tinygltf::Model parse(const std::filesystem::path& path, std::vector<std::string
   if (!ok) {
     // tinygltf reports several lines; the first names the actual problem.
     std::string reason = err.empty() ? "unknown parse error" : err.substr(0, err.find('\n'));
+    const std::string kNotFound = "File not found : ";
+    if (reason.rfind(kNotFound, 0) == 0) {
+      throw InputError(file + ": buffer file '" + reason.substr(kNotFound.size()) +
+                       "' is missing or unreadable (looked next to the glTF file)");
+    }
     throw InputError(file + ": not a valid glTF " + (binary ? "binary (.glb)" : "file") + ": " + reason);
   }
   for (size_t start = 0; start < warn.size();) {

@@ -195,6 +195,14 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
   }
   {
     GltfWriter w = oneTriangle();
+    auto path = w.write(dir, "missing_buffer.gltf");
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+    doc["buffers"][0]["uri"] = "missing_buffer.bin";
+    std::ofstream(path) << doc.dump(1);
+    bad.push_back({"missing buffer file", path, "buffer file 'missing_buffer.bin' is missing"});
+  }
+  {
+    GltfWriter w = oneTriangle();
     w.doc["extensionsUsed"] = {"KHR_draco_mesh_compression"};
     w.doc["extensionsRequired"] = {"KHR_draco_mesh_compression"};
     bad.push_back({"unsupported required extension", w.write(dir, "required_ext.gltf"),
