@@ -149,6 +149,11 @@ TEST_CASE("GltfLoader: Box as .gltf, .glb and embedded .gltf gives the same worl
                           a.positions[a.triangles[t].v[2]]) / 3.0f;
     CHECK(glm::dot(windingNormal(a, t), centroid) > 0.0f);
   }
+  // The authored normals went through the root matrix too: each is an outward face normal.
+  for (size_t v = 0; v < a.positions.size(); ++v) {
+    CHECK(glm::length(a.normals[v]) == doctest::Approx(1.0f));
+    CHECK(glm::dot(a.normals[v], a.positions[v]) == doctest::Approx(0.5f));
+  }
 }
 
 TEST_CASE("GltfLoader: BoxInterleaved equals Box geometry") {
