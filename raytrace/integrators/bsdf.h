@@ -1,0 +1,77 @@
+// The glTF material at a hit as the integrators see it: textures resolved, and the BSDF it
+// stands for — a Lambertian diffuse part, a GGX microfacet specular part whose roughness makes
+// the glossy lobe (a mirror below kDeltaAlpha), and a smooth dielectric part for transmission.
+// Evaluated by the PE that shades the hit; shared by the Whitted and path-tracing integrators.
+#pragma once
+
+#include <glm/glm.hpp>
+
+#include "common/scene/scene.h"
+#include "raytrace/core/interaction.h"
+
+namespace pr::rt {
+
+// GGX alpha (roughness^2) below which the specular lobe is treated as a perfect mirror: a
+// lobe this narrow (under 2 degrees) cannot be sampled usefully by light sampling.
+inline constexpr float kDeltaAlpha = 1.0e-3f;
+
+// The material at one hit, textures applied. Vectors in the local shading frame (z = normal
+// on the side of wo) are used by the BSDF functions below.
+struct ShadingMaterial {
+  glm::vec3 baseColor{1.0f};
+  float metallic = 0.0f;
+  float roughness = 1.0f;
+  float alpha = 1.0f;         // GGX alpha = roughness^2
+  float transmission = 0.0f;  // weight of the smooth dielectric part
+  float ior = 1.5f;
+  glm::vec3 emission{0.0f};   // radiance (nits) leaving the emitting side
+  bool doubleSided = false;
+
+  // Weight of the Lambertian part: the non-metallic, non-transmissive share of baseColor.
+  glm::vec3 diffuseColor() const { return (1.0f - metallic) * (1.0f - transmission) * baseColor; }
+  // Specular reflectance at normal incidence. A dielectric has 4% (ior 1.5); a fully rough
+  // dielectric (roughness 1) is taken as pure Lambertian so its albedo is exactly baseColor
+  // (the white-furnace test relies on it), as in Jensen's purely diffuse Cornell walls.
+  glm::vec3 specularF0() const {
+    const float dielectric = roughness < 1.0f ? 0.04f : 0.0f;
+    return glm::mix(glm::vec3(dielectric) * (1.0f - transmission), baseColor, metallic);
+  }
+  bool deltaSpecular() const { return alpha < kDeltaAlpha; }
+  // Share of the smooth dielectric (refracting) part.
+  float dielectricWeight() const { return transmission * (1.0f - metallic); }
+};
+
+ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si);
+
+// Radiance emitted towards wo: the material's emission on its front side (both sides when
+// double-sided), zero otherwise.
+glm::vec3 emittedRadiance(const ShadingMaterial& m, const SurfaceInteraction& si);
+
+// Schlick's approximation of the conductor/dielectric Fresnel term (glTF 2.0 appendix B).
+glm::vec3 fresnelSchlick(const glm::vec3& f0, float cosTheta);
+// Exact unpolarised Fresnel reflectance of a smooth dielectric interface; eta = n_t / n_i,
+// cosI > 0 on the incident side. Returns 1 for total internal reflection.
+float fresnelDielectric(float cosI, float eta);
+// Refracts unit w (pointing away from the surface, on n's side) through the interface with
+// relative ior eta = n_t / n_i; false on total internal reflection.
+bool refractDirection(const glm::vec3& w, const glm::vec3& n, float eta, glm::vec3& wt);
+
+// The opaque (diffuse + glossy) part in the local frame, wo.z > 0: f(wo, wi) (without cos),
+// and the pdf of sampleOpaque for wi. Both zero when wi is below the surface.
+glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi);
+float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi);
+// Samples wi for the opaque part with (lobe, u, v) in [0,1)^3: the specular lobe with
+// probability specularProbability, else the cosine hemisphere. weight = f cos / pdf. For a
+// delta specular lobe the mirror direction is returned with delta = true and pdf = 0.
+struct BsdfSample {
+  glm::vec3 wi{0.0f};
+  glm::vec3 weight{0.0f};
+  float pdf = 0.0f;
+  bool delta = false;
+  bool valid = false;
+};
+BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// Probability that sampleOpaque picks the specular lobe (from Fresnel and diffuse luminance).
+float specularProbability(const ShadingMaterial& m, float cosO);
+
+}  // namespace pr::rt

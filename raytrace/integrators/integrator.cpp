@@ -1,0 +1,136 @@
+// What the Whitted and path-tracing integrators share (see integrator.h): camera rays,
+// the shading frame, next-event estimation and continuation rays. Runs on whichever PE holds
+// a message; reads the Scene and light sampler only, writes the Film through Emit.
+#include "raytrace/integrators/integrator.h"
+
+#include <cmath>
+#include <string>
+
+#include "common/util/error.h"
+
+namespace pr::rt {
+
+std::string_view toString(IntegratorKind kind) { return kind == IntegratorKind::Whitted ? "whitted" : "path"; }
+
+IntegratorKind integratorKindFromString(std::string_view name) {
+  if (name == "whitted") return IntegratorKind::Whitted;
+  if (name == "path") return IntegratorKind::Path;
+  throw InputError("unknown integrator '" + std::string(name) + "' (expected one of: whitted, path)");
+}
+
+IntegratorContext::IntegratorContext(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                                     const IntegratorOptions& options)
+    : scene_(&scene), camera_(camera), width_(width), height_(height), options_(options), lights_(scene) {
+  PR_CHECK(width > 0 && height > 0, "image size must be positive");
+  PR_CHECK(options.spp >= 1 && options.spp <= kMaxSpp, "spp out of range: " + std::to_string(options.spp));
+  PR_CHECK(options.maxDepth >= 1 && options.maxDepth <= kMaxDepthLimit,
+           "max depth out of range: " + std::to_string(options.maxDepth));
+}
+
+ShadingFrame::ShadingFrame(const SurfaceInteraction& si)
+    : ng(si.frontFace ? si.geometricNormal : -si.geometricNormal),
+      ns(si.frontFace ? si.shadingNormal : -si.shadingNormal),
+      frame(ns),
+      woLocal(0.0f) {
+  // Interpolated normals can put wo below the shading hemisphere at silhouettes; the
+  // geometric normal is then the only frame in which wo is above the surface.
+  if (glm::dot(ns, si.wo) <= 1.0e-6f) {
+    ns = ng;
+    frame = Frame(ng);
+  }
+  woLocal = frame.toLocal(si.wo);
+  woLocal.z = std::max(woLocal.z, 1.0e-6f);  // wo lies in the upper hemisphere by construction
+}
+
+void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
+                                    const glm::vec3& woLocal, const RayMessage& msg, float opaqueWeight, bool mis,
+                                    Emit& out) const {
+  if (!(opaqueWeight > 0.0f)) return;
+  // Light from behind the geometric surface cannot reach an opaque side (no leaks through
+  // thin walls whose interpolated normal leans towards the light).
+  const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
+  auto addSample = [&](const LightSample& ls) {
+    if (glm::dot(ls.wi, ng) <= 0.0f) return;
+    const glm::vec3 wiLocal = frame.toLocal(ls.wi);
+    if (wiLocal.z <= 0.0f) return;
+    const glm::vec3 f = evalOpaque(m, woLocal, wiLocal) * opaqueWeight;
+    float weight = 1.0f;
+    if (mis && ls.pdf > 0.0f) {
+      // Power heuristic (Veach 1997, eq. 9.13) against the BSDF sample that could hit this light.
+      const float pb = opaqueWeight * pdfOpaque(m, woLocal, wiLocal);
+      weight = ls.pdf * ls.pdf / (ls.pdf * ls.pdf + pb * pb);
+    }
+    const glm::vec3 c = msg.throughput * f * ls.radiance * (wiLocal.z * weight);
+    if (!(maxComponent(c) > 0.0f) || !isFinite(c)) return;
+    RayMessage shadow;
+    shadow.ray = ls.shadowRay;
+    shadow.throughput = c;
+    shadow.pixel = msg.pixel;
+    shadow.sample = msg.sample;
+    shadow.depth = msg.depth;
+    shadow.kind = RayKind::Shadow;
+    out.push(shadow);
+  };
+  LightSample ls;
+  for (const scene::PunctualLight& light : scene_->lights)
+    if (lights_.samplePunctual(light, si, ls)) addSample(ls);
+  if (lights_.hasAreaLights() &&
+      lights_.sampleArea(si, sample(msg, Dim::kLightPick), sample(msg, Dim::kLightU), sample(msg, Dim::kLightV), ls))
+    addSample(ls);
+}
+
+RayMessage IntegratorContext::continuation(const SurfaceInteraction& si, const RayMessage& msg, const glm::vec3& wi,
+                                           const glm::vec3& throughput, float bsdfPdf) const {
+  RayMessage next;
+  next.ray = spawnRay(si, wi);
+  next.throughput = throughput;
+  next.pixel = msg.pixel;
+  next.sample = msg.sample;
+  next.depth = uint8_t(msg.depth + 1);
+  next.kind = RayKind::Continuation;
+  next.bsdfPdf = bsdfPdf;
+  return next;
+}
+
+Integrator::Integrator(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                       const IntegratorOptions& options)
+    : ctx_(scene, camera, width, height, options),
+      camera_(camera),
+      impl_(options.kind == IntegratorKind::Whitted
+                ? std::variant<WhittedIntegrator, PathIntegrator>(WhittedIntegrator(ctx_))
+                : std::variant<WhittedIntegrator, PathIntegrator>(PathIntegrator(ctx_))) {}
+
+void Integrator::cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const {
+  const int w = ctx_.width(), h = ctx_.height();
+  const int spp = ctx_.options().spp;
+  const float aspect = float(w) / float(h);
+  const glm::mat3 rotation(camera_.cameraToWorld);
+  const glm::vec3 eye = camera_.position();
+  const float tanY = std::tan(0.5f * camera_.yfov);
+  out.reserve(out.size() + size_t(rect.pixels()) * size_t(spp));
+  for (int y = rect.y0; y < rect.y1; ++y) {
+    for (int x = rect.x0; x < rect.x1; ++x) {
+      RayMessage m;
+      m.pixel = uint32_t(y) * uint32_t(w) + uint32_t(x);
+      m.kind = RayKind::Camera;
+      for (int s = 0; s < spp; ++s) {
+        m.sample = uint16_t(s);
+        const glm::vec2 j = stratifiedPixelSample(s, spp, ctx_.sample(m, Dim::kPixelX), ctx_.sample(m, Dim::kPixelY));
+        // Film position in [-1, 1]^2, +y up (row 0 is the top of the picture).
+        const float sx = 2.0f * (float(x) + j.x) / float(w) - 1.0f;
+        const float sy = 1.0f - 2.0f * (float(y) + j.y) / float(h);
+        if (camera_.projection == scene::Projection::Orthographic) {
+          // The image aspect wins: ymag is kept, x widened (camera.h).
+          const glm::vec3 local(sx * camera_.ymag * aspect, sy * camera_.ymag, 0.0f);
+          m.ray = Ray{eye + rotation * local, 0.0f, glm::normalize(rotation * glm::vec3(0.0f, 0.0f, -1.0f)), kInfinity};
+        } else {
+          const glm::vec3 local(sx * tanY * aspect, sy * tanY, -1.0f);
+          m.ray = Ray{eye, 0.0f, glm::normalize(rotation * local), kInfinity};
+        }
+        out.push_back(m);
+      }
+    }
+  }
+}
+
+}  // namespace pr::rt

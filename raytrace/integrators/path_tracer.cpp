@@ -1,0 +1,85 @@
+// Path-tracing shading of one hit (Kajiya 1986), the reference the photon map is checked
+// against: emission weighted against light sampling by MIS, next-event estimation, one
+// sampled continuation (dielectric or opaque lobe), Russian roulette from depth 3 on. Each
+// hit spawns at most one continuation, so a path is a chain of messages. Runs on any PE.
+#include <algorithm>
+#include <cmath>
+
+#include "raytrace/integrators/integrator.h"
+
+namespace pr::rt {
+
+namespace {
+// Roulette starts after this many bounces: short paths carry most of the image's energy.
+constexpr int kRouletteDepth = 3;
+// Survival probability cap: even a bright path ends with probability >= 5% per bounce.
+constexpr float kMaxSurvival = 0.95f;
+}  // namespace
+
+void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
+  const IntegratorContext& ctx = *ctx_;
+  const ShadingMaterial m = evalMaterial(ctx.scene(), si);
+
+  // Emission: full weight for camera rays and after delta events; otherwise MIS against the
+  // light sample taken at the previous vertex (power heuristic).
+  const glm::vec3 le = emittedRadiance(m, si);
+  if (maxComponent(le) > 0.0f) {
+    float weight = 1.0f;
+    if (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f) {
+      const float distance = si.t * glm::length(msg.ray.direction);
+      const float cosLight = std::fabs(glm::dot(si.geometricNormal, si.wo));
+      const float pl = ctx.lights().areaPdf(si.triangle, distance, cosLight);
+      weight = msg.bsdfPdf * msg.bsdfPdf / (msg.bsdfPdf * msg.bsdfPdf + pl * pl);
+    }
+    out.addRadiance(msg.pixel, msg.throughput * le * weight);
+  }
+  if (msg.depth >= ctx.options().maxDepth) return;
+
+  const ShadingFrame sf(si);
+  const float dielectric = m.dielectricWeight();
+  const float opaque = 1.0f - dielectric;
+  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, true, out);
+
+  // Choose the part: the dielectric with probability `dielectric` (its selection probability
+  // cancels its weight), else the opaque lobes.
+  const float lobe = ctx.sample(msg, Dim::kLobe);
+  glm::vec3 wi;
+  glm::vec3 throughput;
+  float pdf = 0.0f;
+  if (lobe < dielectric) {
+    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+    const float cosI = glm::dot(sf.ns, si.wo);
+    const float fr = fresnelDielectric(cosI, eta);
+    // Reflect or refract with probabilities F and 1 - F, which cancel the Fresnel weights.
+    const float choice = lobe / dielectric;
+    glm::vec3 wt;
+    if (choice < fr || !refractDirection(si.wo, sf.ns, eta, wt)) {
+      wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+      throughput = msg.throughput;
+    } else {
+      wi = wt;
+      throughput = msg.throughput * m.baseColor;
+    }
+  } else {
+    const float u = dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe;
+    const BsdfSample s = sampleOpaque(m, sf.woLocal, std::min(u, kOneMinusEpsilon), ctx.sample(msg, Dim::kBsdfU),
+                                      ctx.sample(msg, Dim::kBsdfV));
+    if (!s.valid) return;
+    wi = sf.frame.toWorld(s.wi);
+    // A reflection must leave on the side it arrived from (no leaks through the surface).
+    if (glm::dot(wi, sf.ng) <= 0.0f) return;
+    throughput = msg.throughput * s.weight;
+    pdf = s.delta ? 0.0f : s.pdf * opaque;
+  }
+
+  // Russian roulette (Arvo and Kirk 1990): survive with q = max throughput component.
+  if (msg.depth + 1 >= kRouletteDepth) {
+    const float q = std::min(kMaxSurvival, maxComponent(throughput));
+    if (!(q > 0.0f) || ctx.sample(msg, Dim::kRoulette) >= q) return;
+    throughput /= q;
+  }
+  if (!(maxComponent(throughput) > 0.0f) || !isFinite(throughput)) return;
+  out.push(ctx.continuation(si, msg, wi, throughput, pdf));
+}
+
+}  // namespace pr::rt

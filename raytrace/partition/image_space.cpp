@@ -1,0 +1,127 @@
+// Image-space partitioning (seed section 5.1.2): the image is cut into tiles, each tile is a
+// task on par::Runtime, and every scheduling strategy of the runtime decides which PE renders
+// which tile. World model: every PE reads the whole scene and its BVH, counted as one
+// broadcast of the scene's bytes per PE. Cost estimates for the unbalanced and hot-spot
+// strategies come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
+#include <algorithm>
+#include <memory>
+#include <string>
+
+#include "raytrace/partition/partition.h"
+
+namespace pr::rt {
+
+namespace {
+
+// The pre-pass traces one pixel in kPrePassStride x kPrePassStride (1/16 of the pixels), one
+// sample each: rays traced per tile is the cost estimate, a pure count, so the estimates (and
+// any schedule built on them) do not depend on timing.
+constexpr int kPrePassStride = 4;
+// Adaptive subdivision: a tile estimated at more than this many times the mean tile cost is
+// split into four, so no single task dominates the end of the stage.
+constexpr double kAdaptiveSplitFactor = 2.0;
+
+struct TileTask {
+  PixelRect rect;
+  float x = 0.0f, y = 0.0f;  // centre in tile units (spiral order, reports)
+  double cost = 1.0;
+};
+
+bool needsCostEstimates(const std::string& schedule) { return schedule == "unbalanced" || schedule == "hot-spots"; }
+
+class ImageSpacePartition final : public Partition {
+ public:
+  std::string_view name() const override { return "image-space"; }
+
+  TraceResult render(const TraceJob& job, par::Runtime& rt) override {
+    const Bvh bvh(job.scene, job.options.bvh);
+    const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
+    std::vector<TileTask> tiles = makeTiles(job);
+    if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles);
+    if (job.options.adaptive) tiles = subdivide(tiles);
+
+    par::TaskSet set;
+    set.tasks.reserve(tiles.size());
+    for (const TileTask& t : tiles) set.tasks.push_back({t.cost, t.x, t.y});
+
+    Film film(job.width, job.height, job.options.integrator.spp);
+    TraceCounters counters;
+    std::atomic<int64_t> done{0};
+    const int64_t total = int64_t(tiles.size());
+    // World model: the scene is replicated on every PE (DESIGN.md rule 1).
+    rt.recordBroadcast(job.scene.memoryBytes());
+    rt.runStage("trace", set, [&](par::Pe&, par::TaskId id) {
+      TraceStats stats;
+      std::vector<RayMessage> queue;
+      integrator.cameraRays(tiles[size_t(id)].rect, queue);
+      traceToCompletion(job.scene, bvh, integrator, queue, film, stats);
+      counters.add(stats);
+      const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (job.options.progress) job.options.progress(n, total);
+    });
+    return TraceResult{film.toImage(), counters.stats(), tiles.size()};
+  }
+
+ private:
+  static std::vector<TileTask> makeTiles(const TraceJob& job) {
+    const int ts = job.options.tileSizePx;
+    const int cols = (job.width + ts - 1) / ts, rows = (job.height + ts - 1) / ts;
+    std::vector<TileTask> tiles;
+    tiles.reserve(size_t(cols) * size_t(rows));
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        tiles.push_back({PixelRect{c * ts, r * ts, std::min(job.width, (c + 1) * ts), std::min(job.height, (r + 1) * ts)},
+                         c + 0.5f, r + 0.5f, 1.0});
+    return tiles;
+  }
+
+  // Low-resolution pre-pass on the controlling thread: rays traced per sampled pixel, scaled
+  // to the tile's pixel count. Its film is thrown away.
+  static void estimateCosts(const TraceJob& job, const Bvh& bvh, std::vector<TileTask>& tiles) {
+    IntegratorOptions pre = job.options.integrator;
+    pre.spp = 1;
+    const Integrator integrator(job.scene, job.camera, job.width, job.height, pre);
+    Film scratch(job.width, job.height, 1);
+    std::vector<RayMessage> queue;
+    for (TileTask& t : tiles) {
+      TraceStats stats;
+      int64_t sampled = 0;
+      for (int y = t.rect.y0; y < t.rect.y1; y += kPrePassStride)
+        for (int x = t.rect.x0; x < t.rect.x1; x += kPrePassStride) {
+          integrator.cameraRays(PixelRect{x, y, x + 1, y + 1}, queue);
+          traceToCompletion(job.scene, bvh, integrator, queue, scratch, stats);
+          ++sampled;
+        }
+      t.cost = sampled > 0 ? double(stats.total()) * double(t.rect.pixels()) / double(sampled) : 1.0;
+      t.cost = std::max(t.cost, 1.0);
+    }
+  }
+
+  // Splits each tile costing more than kAdaptiveSplitFactor x the mean into four quarters
+  // (each keeps a quarter of the cost estimate); tiles of one pixel stay whole.
+  static std::vector<TileTask> subdivide(const std::vector<TileTask>& tiles) {
+    double sum = 0.0;
+    for (const TileTask& t : tiles) sum += t.cost;
+    const double mean = tiles.empty() ? 0.0 : sum / double(tiles.size());
+    std::vector<TileTask> out;
+    for (const TileTask& t : tiles) {
+      const PixelRect& r = t.rect;
+      const int mx = (r.x0 + r.x1) / 2, my = (r.y0 + r.y1) / 2;
+      if (t.cost <= kAdaptiveSplitFactor * mean || r.pixels() <= 1) {
+        out.push_back(t);
+        continue;
+      }
+      const PixelRect quarters[4] = {{r.x0, r.y0, mx, my}, {mx, r.y0, r.x1, my}, {r.x0, my, mx, r.y1}, {mx, my, r.x1, r.y1}};
+      const float qx[4] = {-0.25f, 0.25f, -0.25f, 0.25f}, qy[4] = {-0.25f, -0.25f, 0.25f, 0.25f};
+      for (int q = 0; q < 4; ++q)
+        if (quarters[q].pixels() > 0) out.push_back({quarters[q], t.x + qx[q], t.y + qy[q], t.cost / 4.0});
+    }
+    return out;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Partition> makeImageSpacePartition() { return std::make_unique<ImageSpacePartition>(); }
+
+}  // namespace pr::rt

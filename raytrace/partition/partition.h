@@ -1,0 +1,110 @@
+// Partition: how a ray tracer splits work and data over the PEs of par::Runtime — the seed's
+// classification (section 5.1.2): image-space (tiles; world model), object-space (voxels own
+// geometry; rays travel as messages) and object partitioning (objects own geometry; rays
+// visit owners). All of them move the same RayMessages through the same Integrator and the
+// same Bvh queries, so they give the same image bit for bit; a Partition decides only where a
+// message is traced. One implementation per file beside this one, one line in registry.cpp.
+#pragma once
+
+#include <atomic>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "common/image/image.h"
+#include "common/parallel/runtime.h"
+#include "common/scene/camera.h"
+#include "common/scene/scene.h"
+#include "raytrace/core/bvh.h"
+#include "raytrace/integrators/film.h"
+#include "raytrace/integrators/integrator.h"
+
+namespace pr::rt {
+
+struct TraceOptions {
+  IntegratorOptions integrator;
+  int tileSizePx = 16;    // image-space: tile edge in pixels (the task granularity)
+  bool adaptive = false;  // image-space: split tiles whose estimated cost is far above the mean
+  BvhBuildOptions bvh;
+  // Called after each task with (tasks done, tasks total), from the PE that ran it: must be
+  // thread-safe and cheap. Empty = no progress reports.
+  std::function<void(int64_t, int64_t)> progress;
+};
+
+// Rays traced, by kind, summed over PEs (algorithm counters: "Rays/camera", ...).
+struct TraceStats {
+  uint64_t cameraRays = 0;
+  uint64_t continuationRays = 0;
+  uint64_t shadowRays = 0;
+  uint64_t total() const { return cameraRays + continuationRays + shadowRays; }
+  TraceStats& operator+=(const TraceStats& o) {
+    cameraRays += o.cameraRays;
+    continuationRays += o.continuationRays;
+    shadowRays += o.shadowRays;
+    return *this;
+  }
+};
+
+// Per-PE counters merged after the run (atomics: a PE adds its task's counts once per task).
+struct TraceCounters {
+  std::atomic<uint64_t> cameraRays{0}, continuationRays{0}, shadowRays{0};
+  void add(const TraceStats& s) {
+    cameraRays.fetch_add(s.cameraRays, std::memory_order_relaxed);
+    continuationRays.fetch_add(s.continuationRays, std::memory_order_relaxed);
+    shadowRays.fetch_add(s.shadowRays, std::memory_order_relaxed);
+  }
+  TraceStats stats() const { return {cameraRays.load(), continuationRays.load(), shadowRays.load()}; }
+};
+
+struct TraceResult {
+  image::Image image;
+  TraceStats rays;
+  size_t tasks = 0;  // tasks of the trace stage
+};
+
+// One render: the scene, its camera, the image size and the options.
+struct TraceJob {
+  const scene::Scene& scene;
+  const scene::Camera& camera;
+  int width = 0, height = 0;
+  TraceOptions options;
+};
+
+class Partition {
+ public:
+  virtual ~Partition() = default;
+  virtual std::string_view name() const = 0;
+  // Runs the render on rt's PEs (stages recorded in rt.record()). Called from the
+  // controlling thread.
+  virtual TraceResult render(const TraceJob& job, par::Runtime& rt) = 0;
+};
+
+// Registry: name -> description -> factory (registry.cpp); feeds --help, validation, reports.
+struct PartitionInfo {
+  std::string_view name;
+  std::string_view description;
+  std::unique_ptr<Partition> (*make)();
+};
+const std::vector<PartitionInfo>& partitions();
+bool isPartition(std::string_view name);
+// Throws pr::InputError naming the unknown partition and listing the valid ones.
+std::unique_ptr<Partition> makePartition(std::string_view name);
+
+// Validates the job (size, options) and runs the named partition.
+TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                       const TraceOptions& options, std::string_view partition, par::Runtime& rt);
+
+// The message loop of a PE that holds the whole world (sequential, image-space): traces every
+// message in `queue` and every message shading spawns until none is left, against the full
+// BVH. Adds rays traced by kind to `stats`. The queue is used as a stack (depth first), which
+// bounds its length; order does not change the image (fixed-point film).
+void traceToCompletion(const scene::Scene& scene, const Bvh& bvh, const Integrator& integrator,
+                       std::vector<RayMessage>& queue, Film& film, TraceStats& stats);
+
+// Factories, one per partition file.
+std::unique_ptr<Partition> makeSequentialPartition();
+std::unique_ptr<Partition> makeImageSpacePartition();
+
+}  // namespace pr::rt
