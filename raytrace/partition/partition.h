@@ -106,5 +106,7 @@ void traceToCompletion(const scene::Scene& scene, const Bvh& bvh, const Integrat
 // Factories, one per partition file.
 std::unique_ptr<Partition> makeSequentialPartition();
 std::unique_ptr<Partition> makeImageSpacePartition();
+std::unique_ptr<Partition> makeObjectSpacePartition();  // object_space.cpp
+std::unique_ptr<Partition> makeObjectPartition();       // object_partition.cpp
 
 }  // namespace pr::rt

@@ -11,6 +11,8 @@ const std::vector<PartitionInfo>& partitions() {
   static const std::vector<PartitionInfo> kPartitions = {
       {"sequential", "one PE, one message queue, the whole scene (the reference)", makeSequentialPartition},
       {"image-space", "PEs render image tiles as tasks; world model (scene broadcast to every PE)", makeImageSpacePartition},
+      {"object-space", "voxels of a cost-balanced kd split own their geometry; rays travel between owners as messages", makeObjectSpacePartition},
+      {"object", "objects balanced by triangle count own their geometry; rays query the owners they can reach, hits return", makeObjectPartition},
   };
   return kPartitions;
 }

@@ -1,0 +1,65 @@
+// ObjectAssignment: the data split of object partitioning (seed section 5.1.2). Objects are the
+// scene's glTF mesh primitives (Scene::objects), split further by spatial median when large;
+// the pieces are assigned to PEs balanced by triangle count (longest processing time first).
+// object_partition.cpp builds each PE's BVH over its own triangles and sends a ray only to the
+// owners whose piece bounds it can reach (ownersAlong).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "common/scene/scene.h"
+#include "raytrace/core/ray.h"
+
+namespace pr::rt {
+
+struct ObjectAssignmentOptions {
+  int pes = 1;
+  // A piece never holds more triangles than this; 0 = max(64, ceil(triangles / (4 P))), so
+  // every PE gets several pieces and the greedy assignment can balance them.
+  uint32_t maxPieceTriangles = 0;
+  // Piece bounds are grown by this much (partitionMargin, partition_margin.h) before rays are
+  // tested against them, so an owner whose triangle a ray hits is never skipped.
+  float margin = 0.0f;
+};
+
+// A part of one scene object: its triangles (scene indices, ascending) and their bounds.
+struct ObjectPiece {
+  uint32_t object = 0;  // index into Scene::objects; Scene::objects.size() for triangles in none
+  int owner = 0;
+  std::vector<uint32_t> triangles;
+  scene::Bounds bounds;  // of the triangles' vertices, not grown
+};
+
+class ObjectAssignment {
+ public:
+  ObjectAssignment() = default;
+  // Throws pr::InputError for pes outside [1, 4096].
+  ObjectAssignment(const scene::Scene& scene, const ObjectAssignmentOptions& options);
+
+  int pes() const { return static_cast<int>(perPe_.size()); }
+  float margin() const { return margin_; }
+  std::span<const ObjectPiece> pieces() const { return pieces_; }
+  // The triangles PE `pe` owns (the union of its pieces), ascending scene indices.
+  std::span<const uint32_t> triangles(int pe) const { return perPe_[pe]; }
+  // Indices into pieces() of the pieces PE `pe` owns.
+  std::span<const uint32_t> piecesOf(int pe) const { return piecesOf_[pe]; }
+
+  // The owners of pieces whose grown bounds the ray can reach for t in [tMin, tMax],
+  // ascending, each once (cleared first). A pure function of the ray.
+  void ownersAlong(const Ray& ray, std::vector<int>& owners) const;
+
+ private:
+  std::vector<ObjectPiece> pieces_;
+  std::vector<std::vector<uint32_t>> perPe_;
+  std::vector<std::vector<uint32_t>> piecesOf_;
+  float margin_ = 0.0f;
+};
+
+// True when the ray meets the box (grown by margin) for some t in [tMin, tMax]. Conservative:
+// the far distance is widened by the rounding bound of the slab test (Ize 2013); a direction
+// component of zero is handled without 0 * inf.
+bool rayReachesBox(const Ray& ray, const scene::Bounds& box, float margin);
+
+}  // namespace pr::rt

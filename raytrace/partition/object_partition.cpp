@@ -1,0 +1,228 @@
+// The object-partitioning tracer. Stage "build": each owner builds one BVH over its pieces'
+// triangles. Stage "trace": image tiles are tasks that make camera rays on their PE, which
+// becomes the rays' originator. The originator keeps a pending record per ray, sends a
+// RayQuery to each owner whose piece bounds the ray can reach ("queries" Channel; its own
+// pieces it answers itself), and merges the HitReply messages ("hits" Channel) in the
+// deterministic order of Hit::closerThan, so the result does not depend on arrival order. A
+// hit reply carries the SurfaceInteraction the owner made from its own geometry; the
+// originator shades with it and originates the spawned rays. Shadow queries return one bit.
+#include "raytrace/partition/object_partition.h"
+
+#include <atomic>
+#include <vector>
+
+#include "common/parallel/channel.h"
+#include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/partition_margin.h"
+
+namespace pr::rt {
+namespace {
+
+// To an owner: the ray (not its path state, which stays with the originator) and where the
+// answer goes.
+struct RayQuery {
+  Ray ray;
+  uint32_t slot = 0;    // the originator's pending record
+  uint16_t origin = 0;  // the originator PE
+  bool shadow = false;
+};
+
+// Back to the originator. A miss or a shadow answer is only the header (slot and flag); a hit
+// carries the hit record and the interaction made by the owner of the hit triangle.
+struct HitReply {
+  uint32_t slot = 0;
+  bool found = false;  // a hit (closest-hit query) or an occluder (shadow query)
+  Hit hit;
+  SurfaceInteraction si;
+};
+constexpr size_t kReplyHeaderBytes = 8;
+
+class ObjectFrame {
+ public:
+  ObjectFrame(const TraceJob& job, par::Runtime& rt, uint32_t maxPieceTriangles)
+      : job_(job),
+        rt_(rt),
+        assignment_(job.scene, {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position())}),
+        integrator_(job.scene, job.camera, job.width, job.height, job.options.integrator),
+        film_(job.width, job.height, job.options.integrator.spp),
+        bvhs_(rt.pes()),
+        state_(rt.pes()) {}
+
+  TraceResult run(PartitionFigures& figures) {
+    const int pes = rt_.pes();
+    rt_.runStage("build", par::TaskSet::uniform(pes), [&](par::Pe&, par::TaskId t) {
+      if (!assignment_.triangles(int(t)).empty())
+        bvhs_[t] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(int(t)), job_.options.bvh);
+    });
+
+    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    const auto total = int64_t(tiles.size());
+    std::atomic<int64_t> done{0};
+    par::Channel<RayQuery> queries(rt_, "queries", [this](par::Pe& pe, RayQuery&& q) { answerRemote(pe, q); });
+    par::Channel<HitReply> hits(rt_, "hits", [this](par::Pe& pe, HitReply&& r) {
+      merge(pe, r);
+      drain(pe);
+    });
+    queries_ = &queries;
+    hits_ = &hits;
+    // Materials, textures and lights are replicated on every PE; geometry is not.
+    rt_.recordBroadcast(shadingDataBytes(job_.scene));
+    rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+      PeState& st = state_[pe.id()];
+      const size_t before = st.start.size();
+      integrator_.cameraRays(tiles[size_t(id)], st.start);
+      st.stats.cameraRays += st.start.size() - before;
+      drain(pe);
+      const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (job_.options.progress) job_.options.progress(n, total);
+    });
+    queries_ = nullptr;
+    hits_ = nullptr;
+
+    TraceResult result{film_.toImage(), {}, tiles.size()};
+    figures = PartitionFigures{};
+    figures.partitions = int(assignment_.pieces().size());
+    for (int p = 0; p < pes; ++p) {
+      const uint64_t n = assignment_.triangles(p).size();
+      figures.triangles.push_back(n);
+      figures.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
+    }
+    for (const PeState& st : state_) {
+      PR_CHECK(st.live == 0, "object partitioning: a ray still waits for hit replies after the stage");
+      result.rays += st.stats;
+      figures.rayMessages += st.queriesSent;
+      figures.hitMessages += st.repliesSent;
+    }
+    return result;
+  }
+
+ private:
+  struct Pending {
+    RayMessage message;
+    uint32_t remaining = 0;  // replies still to come
+    HitReply best;           // closest hit so far (found = false: none yet)
+  };
+  // Padded to a cache line: each PE writes only its own.
+  struct alignas(64) PeState {
+    std::vector<RayMessage> start;  // rays this PE originates, not yet sent
+    std::vector<Pending> pending;
+    std::vector<uint32_t> freeSlots;
+    std::vector<int> owners;
+    std::vector<RayMessage> spawned;
+    TraceStats stats;
+    uint64_t queriesSent = 0, repliesSent = 0;
+    size_t live = 0;  // pending records in use
+  };
+
+  // On the originator: sends every ray waiting in its start list to the owners it can reach.
+  void drain(par::Pe& pe) {
+    PeState& st = state_[pe.id()];
+    while (!st.start.empty()) {
+      const RayMessage m = st.start.back();
+      st.start.pop_back();
+      launch(pe, st, m);
+    }
+  }
+
+  void launch(par::Pe& pe, PeState& st, const RayMessage& m) {
+    assignment_.ownersAlong(m.ray, st.owners);
+    if (st.owners.empty()) {
+      Emit emit(film_, st.spawned);
+      integrator_.miss(m, emit);  // reaches no object: nothing to ask
+      return;
+    }
+    uint32_t slot;
+    if (!st.freeSlots.empty()) {
+      slot = st.freeSlots.back();
+      st.freeSlots.pop_back();
+    } else {
+      slot = uint32_t(st.pending.size());
+      st.pending.emplace_back();
+    }
+    ++st.live;
+    st.pending[slot] = Pending{m, uint32_t(st.owners.size()), HitReply{}};
+    const bool shadow = m.kind == RayKind::Shadow;
+    bool local = false;
+    for (int owner : st.owners) {
+      if (owner == pe.id()) {
+        local = true;
+        continue;
+      }
+      queries_->send(pe, owner, RayQuery{m.ray, slot, uint16_t(pe.id()), shadow});
+      ++st.queriesSent;
+    }
+    // The own pieces last: their answer may complete the record, which must not be reused
+    // while queries naming it are still being sent.
+    if (local) merge(pe, answer(pe.id(), m.ray, slot, shadow));
+  }
+
+  // On an owner: the nearest hit among its own triangles (or whether any occludes).
+  HitReply answer(int pe, const Ray& ray, uint32_t slot, bool shadow) const {
+    HitReply r;
+    r.slot = slot;
+    const Bvh& bvh = bvhs_[pe];
+    if (shadow) {
+      r.found = bvh.occluded(ray);
+    } else if (bvh.intersect(ray, r.hit)) {
+      r.found = true;
+      r.si = makeInteraction(job_.scene, ray, r.hit);
+    }
+    return r;
+  }
+
+  void answerRemote(par::Pe& pe, const RayQuery& q) {
+    PeState& st = state_[pe.id()];
+    HitReply r = answer(pe.id(), q.ray, q.slot, q.shadow);
+    const size_t bytes = r.found && !q.shadow ? sizeof(HitReply) : kReplyHeaderBytes;
+    hits_->send(pe, q.origin, std::move(r), bytes);
+    ++st.repliesSent;
+  }
+
+  // On the originator: folds one reply into the pending record; the last one resolves it.
+  void merge(par::Pe& pe, const HitReply& r) {
+    PeState& st = state_[pe.id()];
+    Pending& p = st.pending[r.slot];
+    PR_CHECK(p.remaining > 0, "object partitioning: reply for a ray that expects none");
+    if (r.found && (!p.best.found || r.hit.closerThan(p.best.hit))) p.best = r;
+    if (--p.remaining > 0) return;
+    const Pending done = p;
+    st.freeSlots.push_back(r.slot);
+    --st.live;
+    Emit emit(film_, st.spawned);
+    if (done.message.kind == RayKind::Shadow) {
+      if (!done.best.found) integrator_.miss(done.message, emit);
+      return;
+    }
+    if (!done.best.found) {
+      integrator_.miss(done.message, emit);
+      return;
+    }
+    integrator_.shade(done.best.si, done.message, emit);
+    for (const RayMessage& s : st.spawned) {
+      ++(s.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
+      st.start.push_back(s);
+    }
+    st.spawned.clear();
+  }
+
+  const TraceJob& job_;
+  par::Runtime& rt_;
+  ObjectAssignment assignment_;
+  Integrator integrator_;
+  Film film_;
+  std::vector<Bvh> bvhs_;
+  std::vector<PeState> state_;
+  par::Channel<RayQuery>* queries_ = nullptr;
+  par::Channel<HitReply>* hits_ = nullptr;
+};
+
+}  // namespace
+
+TraceResult ObjectPartition::render(const TraceJob& job, par::Runtime& rt) {
+  ObjectFrame frame(job, rt, maxPieceTriangles_);
+  return frame.run(figures_);
+}
+
+std::unique_ptr<Partition> makeObjectPartition() { return std::make_unique<ObjectPartition>(); }
+
+}  // namespace pr::rt

@@ -1,0 +1,34 @@
+// Object partitioning (seed section 5.1.2): scene objects (glTF mesh primitives, split when
+// large) are assigned to PEs balanced by triangle count (object_assignment.h); each PE holds
+// only its objects' geometry and BVH. A ray's originator sends a query to every owner whose
+// object bounds the ray can reach; each owner answers with its nearest hit; the originator
+// keeps the closest (Hit::closerThan) and continues: shades, and becomes the originator of
+// the rays it spawns. A shadow ray is blocked when any owner reports an occluder.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include "raytrace/partition/partition.h"
+#include "raytrace/partition/partitioned.h"
+
+namespace pr::rt {
+
+class ObjectPartition final : public Partition {
+ public:
+  // maxPieceTriangles: objects above this are split (0: ObjectAssignmentOptions' default).
+  explicit ObjectPartition(uint32_t maxPieceTriangles = 0) : maxPieceTriangles_(maxPieceTriangles) {}
+  std::string_view name() const override { return "object"; }
+  TraceResult render(const TraceJob& job, par::Runtime& rt) override;
+  // Figures of the last render.
+  const PartitionFigures& figures() const { return figures_; }
+
+ private:
+  uint32_t maxPieceTriangles_;
+  PartitionFigures figures_;
+};
+
+std::unique_ptr<Partition> makeObjectPartition();
+
+}  // namespace pr::rt

@@ -1,0 +1,32 @@
+// Object-space partitioning (seed section 5.1.2): space is split into voxels (voxel_split.h),
+// each owned by a PE that holds only its voxels' geometry and BVHs; rays are Channel messages
+// that travel from owner to owner in the order they pass the voxels, until they hit inside the
+// voxel being traversed or leave the scene. The owner of a hit shades and sends the rays it
+// spawns on their way. Termination detection of the runtime ends the frame.
+#pragma once
+
+#include <memory>
+#include <string_view>
+
+#include "raytrace/partition/partition.h"
+#include "raytrace/partition/partitioned.h"
+
+namespace pr::rt {
+
+class ObjectSpacePartition final : public Partition {
+ public:
+  // voxelsPerPe: k of the k·P voxels (1..64); more voxels than PEs spread hot spots.
+  explicit ObjectSpacePartition(int voxelsPerPe = 1);
+  std::string_view name() const override { return "object-space"; }
+  TraceResult render(const TraceJob& job, par::Runtime& rt) override;
+  // Figures of the last render.
+  const PartitionFigures& figures() const { return figures_; }
+
+ private:
+  int voxelsPerPe_;
+  PartitionFigures figures_;
+};
+
+std::unique_ptr<Partition> makeObjectSpacePartition();
+
+}  // namespace pr::rt

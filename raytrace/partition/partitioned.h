@@ -1,0 +1,61 @@
+// What the two data-partitioned tracers (object-space, object partitioning) share besides the
+// integrator and the BVH: the figures they report beyond the run record (geometry held per
+// PE, messages by kind), the camera-ray tasks (image tiles whose rays are sent to owners), and
+// the size of the shading data every PE keeps a copy of (materials, textures, lights).
+#pragma once
+
+#include <algorithm>
+#include <cstdint>
+#include <string_view>
+#include <vector>
+
+#include "common/parallel/task.h"
+#include "common/scene/scene.h"
+#include "raytrace/integrators/integrator.h"
+#include "raytrace/partition/partition.h"
+
+namespace pr::rt {
+
+// Per-PE figures of one render. Message counts are algorithm counters kept next to each send
+// (STYLE.md §4), split by kind; their sum equals the run record's count of the trace stage.
+struct PartitionFigures {
+  std::vector<uint64_t> geometryBytes;   // per PE: its BVHs plus its triangles' vertex data
+  std::vector<uint64_t> triangles;       // per PE: triangles held (straddlers counted per holder)
+  uint64_t rayMessages = 0;              // rays (object-space) or ray queries (object) between PEs
+  uint64_t hitMessages = 0;              // hit records sent back (object partitioning)
+  int partitions = 0;                    // voxels or object pieces
+};
+
+// Bytes a PE holds per triangle besides its BVH: the index triple and material, and the
+// vertex data shading reads at a hit (position, normal, uv of three vertices).
+inline constexpr uint64_t kTriangleVertexBytes =
+    sizeof(scene::Triangle) + 3 * (2 * sizeof(glm::vec3) + sizeof(glm::vec2));
+
+// The replicated, read-only part of the scene every PE shades with: everything but the
+// geometry (vertices, triangles, objects), counted as one broadcast per PE.
+inline uint64_t shadingDataBytes(const scene::Scene& s) {
+  const uint64_t geometry = s.positions.size() * sizeof(glm::vec3) + s.normals.size() * sizeof(glm::vec3) +
+                            s.uvs.size() * sizeof(glm::vec2) + s.colors.size() * sizeof(glm::vec4) +
+                            s.triangles.size() * sizeof(scene::Triangle) + s.objects.size() * sizeof(scene::Object);
+  const uint64_t all = s.memoryBytes();
+  return all > geometry ? all - geometry : 0;
+}
+
+// Image tiles of tileSizePx, row-major: the camera-ray tasks of the partitioned tracers.
+inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx) {
+  std::vector<PixelRect> tiles;
+  for (int y = 0; y < height; y += tileSizePx)
+    for (int x = 0; x < width; x += tileSizePx)
+      tiles.push_back({x, y, std::min(width, x + tileSizePx), std::min(height, y + tileSizePx)});
+  return tiles;
+}
+
+inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx) {
+  par::TaskSet set;
+  for (const PixelRect& r : tiles)
+    set.tasks.push_back({double(r.pixels()), float(r.x0 + r.x1) * 0.5f / float(tileSizePx),
+                         float(r.y0 + r.y1) * 0.5f / float(tileSizePx)});
+  return set;
+}
+
+}  // namespace pr::rt

@@ -1,0 +1,159 @@
+// Tests of object partitioning's data split (raytrace/partition/object_assignment.cpp): every
+// triangle has exactly one owner, large objects are split, PEs are balanced by triangle
+// count, and a ray is sent to every owner holding a triangle it hits (never skipped).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "common/util/error.h"
+#include "raytrace/core/bvh.h"
+#include "raytrace/core/geometry_builders.h"
+#include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/partition_margin.h"
+
+using pr::rt::ObjectAssignment;
+using pr::rt::Ray;
+
+namespace {
+
+// A scene of `sizes.size()` objects, object i a random soup of sizes[i] triangles around its
+// own centre, recorded in Scene::objects as the loader would.
+pr::scene::Scene objectsScene(const std::vector<uint32_t>& sizes) {
+  pr::scene::Scene s = pr::test::emptyScene();
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (size_t o = 0; o < sizes.size(); ++o) {
+    pr::scene::Object obj;
+    obj.name = "object" + std::to_string(o);
+    obj.firstTriangle = uint32_t(s.triangles.size());
+    obj.triangleCount = sizes[o];
+    const glm::vec3 centre(3.0f * float(o), 0.0f, 0.0f);
+    for (uint32_t i = 0; i < sizes[o]; ++i) {
+      const glm::vec3 a = centre + glm::vec3(u(rng), u(rng), u(rng));
+      pr::test::addTriangle(s, a, a + 0.1f * glm::vec3(u(rng), u(rng), u(rng)), a + 0.1f * glm::vec3(u(rng), u(rng), u(rng)));
+    }
+    for (uint32_t t = obj.firstTriangle; t < obj.firstTriangle + obj.triangleCount; ++t)
+      for (uint32_t v : s.triangles[t].v) obj.bounds.extend(s.positions[v]);
+    s.objects.push_back(obj);
+  }
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("ObjectAssignment: every triangle has exactly one owner; pieces stay within objects") {
+  const pr::scene::Scene s = objectsScene({500, 40, 40, 10, 300});
+  const ObjectAssignment a(s, {3, 100, 0.0f});
+  REQUIRE(a.pes() == 3);
+  std::vector<int> owner(s.triangles.size(), -1);
+  for (int pe = 0; pe < 3; ++pe) {
+    const auto tris = a.triangles(pe);
+    CHECK(std::is_sorted(tris.begin(), tris.end()));
+    for (uint32_t t : tris) {
+      CHECK(owner[t] == -1);
+      owner[t] = pe;
+    }
+  }
+  CHECK(std::count(owner.begin(), owner.end(), -1) == 0);
+  for (const auto& piece : a.pieces()) {
+    CHECK(piece.triangles.size() <= 100);
+    CHECK(!piece.triangles.empty());
+    const auto& obj = s.objects[piece.object];
+    for (uint32_t t : piece.triangles) {
+      CHECK(t >= obj.firstTriangle);
+      CHECK(t < obj.firstTriangle + obj.triangleCount);
+      CHECK(owner[t] == piece.owner);
+      for (uint32_t v : s.triangles[t].v) {
+        CHECK(glm::all(glm::greaterThanEqual(s.positions[v], piece.bounds.min)));
+        CHECK(glm::all(glm::lessThanEqual(s.positions[v], piece.bounds.max)));
+      }
+    }
+  }
+  // The 500-triangle object was split (into at least 5 pieces); the small ones were not.
+  size_t piecesOfFirst = 0;
+  for (const auto& piece : a.pieces()) piecesOfFirst += piece.object == 0 ? 1 : 0;
+  CHECK(piecesOfFirst >= 5);
+}
+
+TEST_CASE("ObjectAssignment: PEs are balanced by triangle count") {
+  // One object of 900 triangles and three of 100: without splitting, one PE would hold 75%.
+  const pr::scene::Scene s = objectsScene({900, 100, 100, 100});
+  const ObjectAssignment a(s, {4, 0, 0.0f});  // default piece size: ceil(1200 / 16) = 75 -> 75
+  size_t lo = s.triangles.size(), hi = 0;
+  for (int pe = 0; pe < 4; ++pe) {
+    lo = std::min(lo, a.triangles(pe).size());
+    hi = std::max(hi, a.triangles(pe).size());
+  }
+  // LPT with pieces of at most 75: the spread is at most one piece.
+  CHECK(hi - lo <= 75);
+  // One PE: everything, no splitting needed for correctness.
+  const ObjectAssignment one(s, {1, 0, 0.0f});
+  CHECK(one.triangles(0).size() == s.triangles.size());
+  CHECK_THROWS_AS(ObjectAssignment(s, {0, 0, 0.0f}), pr::InputError);
+}
+
+TEST_CASE("ObjectAssignment: triangles outside every object form one more object") {
+  pr::scene::Scene s = pr::test::randomSoup(30);  // built in code: no Scene::objects
+  const ObjectAssignment a(s, {2, 0, 0.0f});
+  CHECK(a.triangles(0).size() + a.triangles(1).size() == 30);
+  for (const auto& piece : a.pieces()) CHECK(piece.object == 0);
+}
+
+TEST_CASE("ObjectAssignment: a ray reaches every owner of a triangle it hits") {
+  const pr::scene::Scene s = objectsScene({200, 150, 120, 90, 60, 30});
+  const glm::vec3 eye(7.0f, 0.5f, 6.0f);
+  const ObjectAssignment a(s, {4, 50, pr::rt::partitionMargin(s, eye)});
+  std::vector<pr::rt::Bvh> bvhs;
+  for (int pe = 0; pe < 4; ++pe) bvhs.emplace_back(s.positions, s.triangles, a.triangles(pe));
+  std::mt19937 rng(13);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  std::vector<int> owners;
+  size_t asked = 0, hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    Ray ray;
+    ray.origin = eye;
+    // Aimed at a triangle's centroid (most rays hit), or anywhere near the objects.
+    const auto& tri = s.triangles[size_t(i * 7) % s.triangles.size()];
+    const glm::vec3 target = i % 3 == 0 ? glm::vec3(7.5f * u(rng) + 7.5f, u(rng), u(rng))
+                                        : (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) / 3.0f;
+    ray.direction = glm::normalize(target - eye);
+    if (i % 4 == 0) ray.tMax = 3.0f;  // short segments skip far owners
+    a.ownersAlong(ray, owners);
+    CHECK(std::is_sorted(owners.begin(), owners.end()));
+    CHECK(std::set<int>(owners.begin(), owners.end()).size() == owners.size());
+    asked += owners.size();
+    for (int pe = 0; pe < 4; ++pe) {
+      pr::rt::Hit h;
+      if (!bvhs[pe].intersect(ray, h)) continue;
+      ++hits;
+      CHECK(std::find(owners.begin(), owners.end(), pe) != owners.end());
+    }
+  }
+  CHECK(hits > 100);
+  CHECK(asked < 4 * 400);  // bounds culling sends fewer queries than a broadcast would
+}
+
+TEST_CASE("ObjectAssignment: the box test is conservative for axis-parallel and boundary rays") {
+  const pr::scene::Bounds box{glm::vec3(0.0f), glm::vec3(1.0f)};
+  Ray along;  // in the face plane x = 0, parallel to it
+  along.origin = glm::vec3(0.0f, 0.5f, -1.0f);
+  along.direction = glm::vec3(0.0f, 0.0f, 1.0f);
+  CHECK(pr::rt::rayReachesBox(along, box, 0.0f));
+  along.origin.x = -1e-3f;
+  CHECK(!pr::rt::rayReachesBox(along, box, 0.0f));
+  CHECK(pr::rt::rayReachesBox(along, box, 2e-3f));  // the margin grows the box
+  Ray touching;  // ends exactly on the face
+  touching.origin = glm::vec3(0.5f, 0.5f, -1.0f);
+  touching.direction = glm::vec3(0.0f, 0.0f, 1.0f);
+  touching.tMax = 1.0f;
+  CHECK(pr::rt::rayReachesBox(touching, box, 0.0f));
+  touching.tMax = 0.5f;
+  CHECK(!pr::rt::rayReachesBox(touching, box, 0.0f));
+  Ray away = touching;  // pointing away
+  away.tMax = pr::rt::kInfinity;
+  away.direction = -away.direction;
+  CHECK(!pr::rt::rayReachesBox(away, box, 0.0f));
+}

@@ -1,0 +1,241 @@
+// Tests of the object-space kd split (raytrace/partition/voxel_split.cpp): cells tile space and
+// hold every triangle that overlaps them, splits balance triangle counts rather than volumes,
+// walks give contiguous ordered spans (also for rays lying in split planes), and the first hit
+// found voxel by voxel is bit-identical to the full BVH's.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <random>
+#include <set>
+#include <vector>
+
+#include "common/util/error.h"
+#include "raytrace/core/bvh.h"
+#include "raytrace/core/geometry_builders.h"
+#include "raytrace/partition/partition_margin.h"
+#include "raytrace/partition/voxel_split.h"
+
+using pr::rt::Bvh;
+using pr::rt::Hit;
+using pr::rt::Ray;
+using pr::rt::VoxelSpan;
+using pr::rt::VoxelSplit;
+
+namespace {
+
+bool overlaps(const pr::scene::Bounds& a, const pr::scene::Bounds& b, float margin) {
+  for (int k = 0; k < 3; ++k)
+    if (a.max[k] < b.min[k] - margin || a.min[k] > b.max[k] + margin) return false;
+  return true;
+}
+
+pr::scene::Bounds triangleBounds(const pr::scene::Scene& s, uint32_t t) {
+  pr::scene::Bounds b;
+  for (uint32_t v : s.triangles[t].v) b.extend(s.positions[v]);
+  return b;
+}
+
+// The object-space rule, here without messages: visit the voxels in order, query each voxel's
+// own BVH up to the end of its span, stop at the first hit.
+Hit voxelByVoxel(const VoxelSplit& split, const std::vector<Bvh>& bvhs, const Ray& ray) {
+  Hit result;
+  split.walk(ray, [&](const VoxelSpan& span) {
+    Ray clipped = ray;
+    clipped.tMax = std::min(ray.tMax, span.tExit);
+    Hit h;
+    if (bvhs[span.voxel].intersect(clipped, h)) {
+      result = h;
+      return false;
+    }
+    return true;
+  });
+  return result;
+}
+
+std::vector<Bvh> voxelBvhs(const pr::scene::Scene& s, const VoxelSplit& split) {
+  std::vector<Bvh> bvhs;
+  for (int v = 0; v < split.voxels(); ++v) bvhs.emplace_back(s.positions, s.triangles, split.triangles(v));
+  return bvhs;
+}
+
+// The finite split-plane coordinates per axis, read off the cells.
+std::vector<std::set<float>> splitPlanes(const VoxelSplit& split) {
+  std::vector<std::set<float>> planes(3);
+  for (int v = 0; v < split.voxels(); ++v)
+    for (int a = 0; a < 3; ++a) {
+      if (std::isfinite(split.cell(v).min[a])) planes[a].insert(split.cell(v).min[a]);
+      if (std::isfinite(split.cell(v).max[a])) planes[a].insert(split.cell(v).max[a]);
+    }
+  return planes;
+}
+
+}  // namespace
+
+TEST_CASE("VoxelSplit: cells tile space and hold every triangle overlapping them") {
+  const pr::scene::Scene s = pr::test::randomSoup(600, 1.0f, glm::vec3(0.0f), 3);
+  const float margin = pr::rt::partitionMargin(s, glm::vec3(0.0f, 0.0f, 5.0f));
+  const VoxelSplit split(s, {7, margin});
+  REQUIRE(split.voxels() == 7);
+  for (int v = 0; v < split.voxels(); ++v) {
+    const auto tris = split.triangles(v);
+    CHECK(std::is_sorted(tris.begin(), tris.end()));
+    const std::set<uint32_t> held(tris.begin(), tris.end());
+    for (uint32_t t = 0; t < s.triangles.size(); ++t)
+      CHECK(held.count(t) == (overlaps(triangleBounds(s, t), split.cell(v), margin) ? 1u : 0u));
+  }
+  // Every point lies in exactly one cell, the one voxelAt names (upper side on a plane).
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  for (int i = 0; i < 500; ++i) {
+    const glm::vec3 p(u(rng), u(rng), u(rng));
+    int inside = 0;
+    for (int v = 0; v < split.voxels(); ++v) {
+      const auto& c = split.cell(v);
+      if (p.x >= c.min.x && p.x < c.max.x && p.y >= c.min.y && p.y < c.max.y && p.z >= c.min.z && p.z < c.max.z) {
+        ++inside;
+        CHECK(split.voxelAt(p) == v);
+      }
+    }
+    CHECK(inside == 1);
+  }
+}
+
+TEST_CASE("VoxelSplit: splits balance triangle counts, not volumes") {
+  // 900 small triangles packed into x in [0, 1] and 100 spread over x in [1, 10], in a thin
+  // slab along x: an equal-size split at x = 5 would leave one voxel 95% of the work.
+  pr::scene::Scene s = pr::test::emptyScene();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int i = 0; i < 1000; ++i) {
+    const float x = i < 900 ? u(rng) : 1.0f + 9.0f * u(rng);
+    const glm::vec3 a(x, 0.05f * u(rng), 0.05f * u(rng));  // a thin slab: x is the axis to cut
+    pr::test::addTriangle(s, a, a + glm::vec3(0.01f, 0.0f, 0.0f), a + glm::vec3(0.0f, 0.01f, 0.0f));
+  }
+  const VoxelSplit split(s, {2, pr::rt::partitionMargin(s, glm::vec3(0.0f))});
+  const size_t a = split.triangles(0).size(), b = split.triangles(1).size();
+  CHECK(a + b >= 1000);
+  CHECK(a + b <= 1020);  // few straddlers of one plane
+  CHECK(std::max(a, b) <= 530);
+  // The plane sits inside the dense cluster, far from the middle of the scene.
+  const auto planes = splitPlanes(split);
+  REQUIRE(planes[0].size() == 1);
+  CHECK(*planes[0].begin() < 1.0f);
+
+  // k·P voxels: the greedy owners hold about the same geometry.
+  const VoxelSplit fine(s, {12, pr::rt::partitionMargin(s, glm::vec3(0.0f))});
+  const std::vector<int> owners = pr::rt::assignVoxelOwners(fine, 4);
+  std::vector<size_t> held(4, 0);
+  for (int v = 0; v < 12; ++v) held[owners[v]] += fine.triangles(v).size();
+  CHECK(*std::max_element(held.begin(), held.end()) <= 1.2 * (*std::min_element(held.begin(), held.end())) + 10);
+  const std::vector<int> same = pr::rt::assignVoxelOwners(split, 2);
+  CHECK(same == std::vector<int>{0, 1});
+}
+
+TEST_CASE("VoxelSplit: spans are contiguous, ordered and lie in their voxels") {
+  const pr::scene::Scene s = pr::test::randomSoup(400, 1.0f, glm::vec3(0.0f), 8);
+  const VoxelSplit split(s, {8, pr::rt::partitionMargin(s, glm::vec3(0.0f))});
+  std::mt19937 rng(2);
+  std::uniform_real_distribution<float> u(-2.0f, 2.0f);
+  for (int i = 0; i < 300; ++i) {
+    Ray ray;
+    ray.origin = glm::vec3(u(rng), u(rng), u(rng));
+    ray.direction = pr::test::randomDirection(rng);
+    ray.tMin = i % 3 == 0 ? 0.5f : 0.0f;
+    ray.tMax = i % 2 == 0 ? pr::rt::kInfinity : 3.0f;
+    const std::vector<VoxelSpan> spans = split.spans(ray);
+    REQUIRE(!spans.empty());
+    CHECK(spans.front().tEnter == ray.tMin);
+    CHECK(spans.back().tExit == ray.tMax);
+    std::set<uint32_t> seen;
+    for (size_t k = 0; k < spans.size(); ++k) {
+      CHECK(spans[k].tEnter < spans[k].tExit);
+      if (k > 0) CHECK(spans[k].tEnter == spans[k - 1].tExit);
+      CHECK(seen.insert(spans[k].voxel).second);  // kd cells are convex: visited once
+      const float tEnd = std::isfinite(spans[k].tExit) ? spans[k].tExit : spans[k].tEnter + 100.0f;
+      const float tMid = 0.5f * (spans[k].tEnter + tEnd);
+      CHECK(split.voxelAt(ray.origin + tMid * ray.direction) == int(spans[k].voxel));
+    }
+  }
+}
+
+TEST_CASE("VoxelSplit: voxel by voxel first hits equal the full BVH bit for bit") {
+  const pr::scene::Scene s = pr::test::randomSoup(800, 1.0f, glm::vec3(0.0f), 21);
+  const glm::vec3 eye(0.3f, -0.2f, 4.0f);
+  const VoxelSplit split(s, {6, pr::rt::partitionMargin(s, eye)});
+  const Bvh full(s);
+  const std::vector<Bvh> bvhs = voxelBvhs(s, split);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<float> u(-1.2f, 1.2f);
+  int hits = 0;
+  for (int i = 0; i < 600; ++i) {
+    Ray ray;
+    ray.origin = i % 2 == 0 ? eye : glm::vec3(u(rng), u(rng), u(rng));
+    ray.direction = i % 2 == 0 ? glm::normalize(glm::vec3(u(rng), u(rng), 0.0f) - eye) : pr::test::randomDirection(rng);
+    Hit expected;
+    const bool hit = full.intersect(ray, expected);
+    const Hit got = voxelByVoxel(split, bvhs, ray);
+    REQUIRE(got.valid() == hit);
+    if (!hit) continue;
+    ++hits;
+    CHECK(got.triangle == expected.triangle);
+    CHECK(got.t == expected.t);
+    CHECK(got.u == expected.u);
+    CHECK(got.v == expected.v);
+  }
+  CHECK(hits > 200);
+}
+
+TEST_CASE("VoxelSplit: rays lying in split planes find the same hits as the full BVH") {
+  // A closed box tessellated into a grid: its vertices, edges and the split planes coincide,
+  // so rays along a plane pass exactly through shared edges and triangles lying in it.
+  const pr::scene::Scene s = pr::test::closedBox(glm::vec3(-1.0f), glm::vec3(1.0f), 4);
+  const VoxelSplit split(s, {8, pr::rt::partitionMargin(s, glm::vec3(0.0f))});
+  const Bvh full(s);
+  const std::vector<Bvh> bvhs = voxelBvhs(s, split);
+  const auto planes = splitPlanes(split);
+  int tested = 0;
+  for (int a = 0; a < 3; ++a)
+    for (float plane : planes[a]) {
+      for (int k = 0; k < 16; ++k) {
+        // Origin in the plane, direction in the plane (component a exactly 0).
+        Ray ray;
+        ray.origin = glm::vec3(0.1f * (k % 4) - 0.15f, 0.1f * (k / 4) - 0.15f, 0.05f * k - 0.4f);
+        ray.origin[a] = plane;
+        glm::vec3 d(std::cos(0.4f * k), std::sin(0.4f * k), std::cos(0.9f * k));
+        d[a] = 0.0f;
+        ray.direction = d;
+        for (const VoxelSpan& span : split.spans(ray)) {
+          // The whole ray stays on the upper side of its own plane.
+          CHECK(split.cell(span.voxel).min[a] <= plane);
+          CHECK(split.cell(span.voxel).max[a] > plane);
+        }
+        Hit expected;
+        REQUIRE(full.intersect(ray, expected));  // inside a closed box every ray hits
+        const Hit got = voxelByVoxel(split, bvhs, ray);
+        CHECK(got.triangle == expected.triangle);
+        CHECK(got.t == expected.t);
+        ++tested;
+      }
+    }
+  CHECK(tested >= 16);
+  // A ray from a point on a plane, leaving it: it visits only the side it points to.
+  Ray leave;
+  leave.origin = glm::vec3(0.0f);
+  leave.origin.x = *planes[0].begin();
+  leave.direction = glm::vec3(-1.0f, 0.0f, 0.0f);
+  for (const VoxelSpan& span : split.spans(leave)) CHECK(split.cell(span.voxel).max.x <= leave.origin.x);
+}
+
+TEST_CASE("VoxelSplit: one voxel holds the whole scene; bad counts are input errors") {
+  const pr::scene::Scene s = pr::test::randomSoup(50);
+  const VoxelSplit one(s, {1, 0.0f});
+  CHECK(one.voxels() == 1);
+  CHECK(one.triangles(0).size() == 50);
+  CHECK(one.spans(Ray{}).size() == 1);
+  CHECK_THROWS_AS(VoxelSplit(s, {0, 0.0f}), pr::InputError);
+  CHECK_THROWS_AS(VoxelSplit(s, {5000, 0.0f}), pr::InputError);
+  // An empty scene still splits space (every span misses).
+  const VoxelSplit empty(pr::test::emptyScene(), {4, 0.0f});
+  CHECK(empty.voxels() == 4);
+  CHECK(empty.storedTriangles() == 0);
+}
