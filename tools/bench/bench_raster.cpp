@@ -1,0 +1,231 @@
+// bench_raster: frame time of the raster pipelines against Mesa's llvmpipe in the same run
+// (shared/ANCHORS.md). For the 1M-triangle landscape and the Cornell box: ms per frame by stage
+// (geometry, clear + rasterize, shade), Mtriangles/s and Mpixels/s of the sequential pipeline,
+// then llvmpipe drawing the same scene, camera and size (one child process per LP_NUM_THREADS
+// value, since a process can use only one) and the ratio parrender / llvmpipe. Not in ctest.
+//   bench_raster [--landscape FILE] [--cornell FILE] [--width 1920] [--height 1080] [--frames 7]
+//                [--anchor PATH/llvmpipe_anchor] [--no-anchor]
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "common/scene/camera_select.h"
+#include "common/scene/gltf_loader.h"
+#include "common/util/error.h"
+#include "raster/framebuffer.h"
+#include "raster/sequential_pipeline.h"
+#include "raster/stages/geometry.h"
+#include "raster/stages/rasterize.h"
+#include "raster/stages/shade.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace raster = pr::raster;
+
+double nowMs() { return std::chrono::duration<double, std::milli>(Clock::now().time_since_epoch()).count(); }
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// FNV-1a over keys and colours: equal hashes before and after a change of the stages' insides
+// show the image stayed bit-identical.
+uint64_t imageHash(const raster::RegionFramebuffer& fb) {
+  uint64_t h = 1469598103934665603ull;
+  auto mix = [&h](const void* data, size_t bytes) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (size_t i = 0; i < bytes; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  };
+  const size_t n = static_cast<size_t>(fb.rect().area());
+  mix(fb.keys(), n * sizeof(uint64_t));
+  mix(fb.colours(), n * sizeof(glm::vec3));
+  return h;
+}
+
+// CPU time of the calling thread: the sequential stages run on it alone.
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
+// Wall and CPU milliseconds of one stage over the timed frames.
+struct Span {
+  std::vector<double> wall, cpu;
+  void add(double wallMs, double cpuMs) {
+    wall.push_back(wallMs);
+    cpu.push_back(cpuMs);
+  }
+};
+
+struct StageTimes {
+  Span geometry, raster, shade, total;
+};
+
+// One frame of the sequential pipeline over the whole screen (no regions), the stage calls of
+// renderSequential with a clock around each; the image is checked against renderSequential.
+void timedFrame(const pr::scene::Scene& scene, const raster::FrameView& view,
+                                     raster::RegionFramebuffer& fb, StageTimes& t) {
+  const double c0 = threadCpuMs(), t0 = nowMs();
+  std::vector<raster::ScreenTriangle> tris;
+  tris.reserve(scene.triangles.size());
+  const uint32_t total = static_cast<uint32_t>(scene.triangles.size());
+  constexpr uint32_t kBatch = 4096;
+  for (uint32_t first = 0; first < total; first += kBatch)
+    raster::processTriangles(scene, view, first, std::min(kBatch, total - first), tris);
+  const double c1 = threadCpuMs(), t1 = nowMs();
+  fb.clear();
+  raster::rasterizeTriangles(tris, fb);
+  const double c2 = threadCpuMs(), t2 = nowMs();
+  raster::shadeRegion(raster::makeShadingContext(scene, view), tris, fb);
+  const double c3 = threadCpuMs(), t3 = nowMs();
+  t.geometry.add(t1 - t0, c1 - c0);
+  t.raster.add(t2 - t1, c2 - c1);
+  t.shade.add(t3 - t2, c3 - c2);
+  t.total.add(t3 - t0, c3 - c0);
+}
+
+struct Anchor {
+  bool ok = false;
+  double ms = 0.0, cpuMs = 0.0;
+  std::string note;
+};
+
+// Runs the llvmpipe_anchor program once (its own process: LP_NUM_THREADS is fixed per process)
+// and reads its JSON line.
+Anchor runAnchor(const std::string& program, const std::string& scenePath, int width, int height, int threads,
+                 int frames) {
+  Anchor a;
+  const std::string cmd = "\"" + program + "\" \"" + scenePath + "\" --width " + std::to_string(width) + " --height " +
+                          std::to_string(height) + " --threads " + std::to_string(threads) + " --frames " +
+                          std::to_string(frames) + " 2>&1";
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) {
+    a.note = "cannot start " + program;
+    return a;
+  }
+  std::string out;
+  char buf[4096];
+  while (size_t n = fread(buf, 1, sizeof buf, pipe)) out.append(buf, n);
+  const int status = pclose(pipe);
+  const size_t brace = out.find('{');
+  if (status != 0 || brace == std::string::npos) {
+    a.note = "llvmpipe_anchor failed: " + out.substr(0, 200);
+    return a;
+  }
+  try {
+    const nlohmann::json j = nlohmann::json::parse(out.substr(brace, out.find('\n', brace) - brace));
+    a.ms = j.at("msPerFrameMedian").get<double>();
+    a.cpuMs = j.at("cpuMsPerFrameMedian").get<double>();
+    a.ok = true;
+  } catch (const std::exception& e) {
+    a.note = std::string("unreadable llvmpipe_anchor output: ") + e.what();
+  }
+  return a;
+}
+
+struct Options {
+  int width = 1920, height = 1080, frames = 7;
+  std::string anchor;
+  bool noAnchor = false;
+};
+
+void benchScene(const std::string& label, const std::string& path, const Options& o) {
+  if (!std::filesystem::exists(path)) {
+    std::printf("%s: %s not found, skipped (generate it: parrender generate landscape -o FILE)\n", label.c_str(),
+                path.c_str());
+    return;
+  }
+  const pr::scene::Scene scene = pr::scene::loadGltf(path);
+  const pr::scene::Camera camera = pr::scene::selectCamera(scene, "", float(o.width) / float(o.height));
+  const raster::FrameView view = raster::makeFrameView(camera, o.width, o.height);
+  const double triangles = double(scene.triangles.size()), pixels = double(o.width) * o.height;
+  std::printf("\n== %s: %s, %zu triangles, %dx%d, median of %d frames (after one warm-up)\n", label.c_str(),
+              path.c_str(), scene.triangles.size(), o.width, o.height, o.frames);
+
+  raster::RegionFramebuffer fb(raster::Rect{0, 0, o.width, o.height});
+  StageTimes t;
+  timedFrame(scene, view, fb, t);  // warm-up: first touch of the framebuffer and the scene
+  t = {};
+  for (int f = 0; f < o.frames; ++f) timedFrame(scene, view, fb, t);
+  const raster::RegionFramebuffer reference = raster::renderSequential(scene, view);
+  PR_CHECK(raster::identical(fb, reference), "bench_raster: timed stages differ from renderSequential");
+
+  const double ms = median(t.total.wall), cpuMs = median(t.total.cpu);
+  std::printf("sequential P=1 wall: geometry %.1f ms, clear+raster %.1f ms, shade %.1f ms | total %.1f ms\n",
+              median(t.geometry.wall), median(t.raster.wall), median(t.shade.wall), ms);
+  std::printf("sequential P=1 cpu:  geometry %.1f ms, clear+raster %.1f ms, shade %.1f ms | total %.1f ms\n",
+              median(t.geometry.cpu), median(t.raster.cpu), median(t.shade.cpu), cpuMs);
+  const double covered = double(std::max<size_t>(1, fb.coveredPixels()));
+  std::printf("sequential P=1: %.2f Mtriangles/s, %.1f Mpixels/s (per cpu second: %.2f, %.1f), %zu covered pixels, "
+              "shade %.1f cpu ns/covered pixel\n",
+              triangles / ms / 1e3, pixels / ms / 1e3, triangles / cpuMs / 1e3, pixels / cpuMs / 1e3,
+              fb.coveredPixels(), 1e6 * median(t.shade.cpu) / covered);
+  std::printf("image hash %016llx\n", static_cast<unsigned long long>(imageHash(fb)));
+  std::printf("parallel sort-first / sort-middle / sort-last: not in this build (raster/sort/ absent)\n");
+
+  if (o.noAnchor) return;
+  if (o.anchor.empty() || !std::filesystem::exists(o.anchor)) {
+    std::printf("llvmpipe: anchor program not available (build the llvmpipe_anchor target), no ratios\n");
+    return;
+  }
+  for (int threads : {0, 1}) {
+    const Anchor a = runAnchor(o.anchor, path, o.width, o.height, threads, o.frames);
+    if (!a.ok) {
+      std::printf("llvmpipe LP_NUM_THREADS=%d: %s\n", threads, a.note.c_str());
+      continue;
+    }
+    std::printf("llvmpipe LP_NUM_THREADS=%d: %.1f ms (cpu %.1f ms) | sequential P=1 / llvmpipe = %.2f (cpu %.2f)\n",
+                threads, a.ms, a.cpuMs, ms / a.ms, cpuMs / a.cpuMs);
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_raster: raster pipeline frame times against Mesa llvmpipe in the same run"};
+  Options o;
+  std::string landscape = PARRENDER_BINARY_DIR "/scenes/landscape.glb";
+  std::string cornell = PARRENDER_SOURCE_DIR "/scenes/cornell.gltf";
+#ifdef PARRENDER_LLVMPIPE_ANCHOR_EXE
+  o.anchor = PARRENDER_LLVMPIPE_ANCHOR_EXE;
+#endif
+  app.add_option("--landscape", landscape, "large scene (parrender generate landscape -o FILE)")->capture_default_str();
+  app.add_option("--cornell", cornell, "fill-bound scene")->capture_default_str();
+  app.add_option("--width", o.width, "image width")->check(CLI::Range(1, raster::kMaxImageSidePx))->capture_default_str();
+  app.add_option("--height", o.height, "image height")->check(CLI::Range(1, raster::kMaxImageSidePx))
+      ->capture_default_str();
+  app.add_option("--frames", o.frames, "timed frames per measurement")->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  app.add_option("--anchor", o.anchor, "llvmpipe_anchor program")->capture_default_str();
+  app.add_flag("--no-anchor", o.noAnchor, "skip llvmpipe");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = app.exit(e);
+    return status == 0 ? 0 : pr::kExitBadInput;
+  }
+  try {
+    benchScene("landscape", landscape, o);
+    rusage usage{};
+    getrusage(RUSAGE_SELF, &usage);
+    std::printf("peak memory after the landscape (ru_maxrss): %.1f MiB\n", double(usage.ru_maxrss) / 1024.0);
+    benchScene("cornell", cornell, o);
+  } catch (const pr::InputError& e) {
+    std::fprintf(stderr, "bench_raster: error: %s\n", e.what());
+    return pr::kExitBadInput;
+  }
+  return 0;
+}
