@@ -9,6 +9,7 @@ namespace pr::cli {
 // One declaration per subcommand, each defined in its cmd_*.cpp.
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
+void addRenderCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 
 }  // namespace pr::cli

@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   // One line per subcommand (tools/commands.h).
   pr::cli::addGenerateCommand(app);
   pr::cli::addInfoCommand(app);
+  pr::cli::addRenderCommand(app);
   pr::cli::addSimulateCommand(app);
 
   try {

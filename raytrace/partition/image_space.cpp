@@ -34,7 +34,9 @@ class ImageSpacePartition final : public Partition {
   std::string_view name() const override { return "image-space"; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
-    const Bvh bvh(job.scene, job.options.bvh);
+    std::unique_ptr<Bvh> built;
+    if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+    const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
     std::vector<TileTask> tiles = makeTiles(job);
     if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles);

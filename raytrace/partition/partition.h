@@ -28,6 +28,9 @@ struct TraceOptions {
   int tileSizePx = 16;    // image-space: tile edge in pixels (the task granularity)
   bool adaptive = false;  // image-space: split tiles whose estimated cost is far above the mean
   BvhBuildOptions bvh;
+  // A BVH already built over the whole scene with these options, reused by the world-model
+  // tracers (sequential, image-space) instead of building one; nullptr = build it.
+  const Bvh* worldBvh = nullptr;
   // Called after each task with (tasks done, tasks total), from the PE that ran it: must be
   // thread-safe and cheap. Empty = no progress reports.
   std::function<void(int64_t, int64_t)> progress;

@@ -35,7 +35,9 @@ class SequentialPartition final : public Partition {
   std::string_view name() const override { return "sequential"; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
-    const Bvh bvh(job.scene, job.options.bvh);
+    std::unique_ptr<Bvh> built;
+    if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+    const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
     Film film(job.width, job.height, job.options.integrator.spp);
     TraceCounters counters;

@@ -1,0 +1,76 @@
+// `parrender render`: renders a bundled scene to PNG/EXR with a summary, writes run records;
+// every bad input (file, method, option of the other family, range, extension) exits 2 with a
+// message naming it.
+#include <filesystem>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "common/image/image_io.h"
+#include "test_support.h"
+
+using pr::test::runParrender;
+
+namespace {
+// Joins with append: GCC 12 warns (-Wrestrict, falsely) on chains of literal + std::string.
+std::string join(std::initializer_list<std::string> parts) {
+  std::string out;
+  for (const std::string& p : parts) out.append(p);
+  return out;
+}
+std::string quoted(const std::filesystem::path& p) { return join({"\"", p.string(), "\""}); }
+std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
+}  // namespace
+
+TEST_CASE("Render: image-space render writes the image, run record and a summary") {
+  const auto dir = pr::test::scratchDir("render_ok");
+  const auto out = dir / "c.exr";
+  const auto metrics = dir / "run.json";
+  const auto r = runParrender(join({"render ", cornell(), " -m image-space -o ", quoted(out),
+                                     " --width 32 --height 24 --threads 2 --schedule spiral --integrator whitted --spp 1",
+                                     " --metrics ", quoted(metrics)}));
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  CHECK(std::filesystem::exists(metrics));
+  const pr::image::Image img = pr::image::readImage(out);
+  CHECK(img.width == 32);
+  CHECK(img.height == 24);
+  CHECK(r.output.find("method image-space") != std::string::npos);
+  CHECK(r.output.find("Mrays/s") != std::string::npos);
+  CHECK(r.output.find("load imbalance") != std::string::npos);
+}
+
+TEST_CASE("Render: default output name is <scene stem>_<method>.png") {
+  const auto dir = pr::test::scratchDir("render_default");
+  // Run from the scratch directory so the default name lands there.
+  const std::filesystem::path previous = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  const auto r = runParrender(join({"render ", cornell(), " -m sequential --width 8 --height 8 --spp 1 --max-depth 2"}));
+  std::filesystem::current_path(previous);
+  INFO(r.output);
+  CHECK(r.exitStatus == 0);
+  CHECK(std::filesystem::exists(dir / "cornell_sequential.png"));
+}
+
+// Each case runs the program once (about half a second of start-up), one test case each.
+#define RENDER_BAD_INPUT(TITLE, ARGS, EXPECT)                                  \
+  TEST_CASE("Render: " TITLE " exits 2 naming it") {                           \
+    const auto dir = pr::test::scratchDir("render_bad");                       \
+    const std::string out = join({" -o ", quoted(dir / "x.png")});            \
+    const auto r = runParrender(ARGS);                                         \
+    INFO(r.output);                                                            \
+    CHECK(r.exitStatus == 2);                                                  \
+    CHECK(r.output.find(EXPECT) != std::string::npos);                         \
+    CHECK_FALSE(std::filesystem::exists(dir / "x.png"));                       \
+  }
+
+RENDER_BAD_INPUT("a missing scene file", join({"render /nonexistent/scene.gltf", out}), "scene.gltf")
+RENDER_BAD_INPUT("an unknown method", join({"render ", cornell(), " -m nonsense", out}), "nonsense")
+RENDER_BAD_INPUT("an unknown integrator", join({"render ", cornell(), " --integrator photons", out}), "photons")
+RENDER_BAD_INPUT("spp out of range", join({"render ", cornell(), " --spp 0", out}), "--spp")
+RENDER_BAD_INPUT("max depth out of range", join({"render ", cornell(), " --max-depth 1000", out}), "--max-depth")
+RENDER_BAD_INPUT("zero threads", join({"render ", cornell(), " --threads 0", out}), "--threads")
+RENDER_BAD_INPUT("an unknown schedule", join({"render ", cornell(), " --schedule nope", out}), "nope")
+RENDER_BAD_INPUT("a zero width", join({"render ", cornell(), " --width 0", out}), "--width")
+RENDER_BAD_INPUT("an unknown camera", join({"render ", cornell(), " --camera 7", out}), "7")
+RENDER_BAD_INPUT("an unsupported output extension", join({"render ", cornell(), " -o \"", (dir / "x.jpg").string(), "\""}), ".jpg")

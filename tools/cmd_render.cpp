@@ -1,0 +1,149 @@
+// `parrender render SCENE -m METHOD -o out.png|out.exr ...`: loads a glTF scene, renders it with
+// one method of the registry (tools/render_methods.h) on the parallel runtime with P PEs and a
+// scheduling strategy, writes the image, the run record and the timeline when asked, and
+// prints a summary read from the RunRecord through common/parallel/metrics.h.
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <mutex>
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "common/image/image_io.h"
+#include "common/parallel/metrics.h"
+#include "common/parallel/run_options.h"
+#include "common/scene/camera_select.h"
+#include "common/scene/gltf_loader.h"
+#include "common/util/error.h"
+#include "tools/commands.h"
+#include "tools/render_methods.h"
+
+namespace pr::cli {
+
+namespace {
+
+struct RenderArgs {
+  std::string scene;
+  std::string method = "image-space";
+  std::string output;
+  int width = 512, height = 512;
+  std::string camera;
+  int threads = 1;
+  bool quiet = false;
+  par::ScheduleOptions schedule;
+  par::RunOutputOptions outputs;
+  RenderSettings settings;
+  FamilyOptions family;
+};
+
+// A progress bar on stderr: appears once a render has run for a second, redrawn when the
+// shown percentage changes; off when stderr is not a terminal or with --quiet.
+class ProgressBar {
+ public:
+  explicit ProgressBar(bool enabled) : enabled_(enabled), start_(std::chrono::steady_clock::now()) {}
+  ~ProgressBar() { finish(); }
+
+  void update(int64_t done, int64_t total) {
+    if (!enabled_ || total <= 0) return;
+    std::unique_lock<std::mutex> lock(mutex_, std::try_to_lock);
+    if (!lock.owns_lock()) return;  // another PE is drawing; skip rather than wait
+    const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+    if (elapsed < kDelaySeconds) return;
+    const int percent = int(100 * done / total);
+    if (percent == lastPercent_) return;
+    lastPercent_ = percent;
+    constexpr int kWidth = 40;
+    const int filled = int(kWidth * done / total);
+    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %lld/%lld tasks %.1fs", filled, "########################################",
+                 kWidth - filled, "", percent, (long long)done, (long long)total, elapsed);
+    std::fflush(stderr);
+    drawn_ = true;
+  }
+
+  void finish() {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (drawn_) std::fprintf(stderr, "\n");
+    drawn_ = false;
+  }
+
+ private:
+  static constexpr double kDelaySeconds = 1.0;
+  bool enabled_;
+  std::chrono::steady_clock::time_point start_;
+  std::mutex mutex_;
+  int lastPercent_ = -1;
+  bool drawn_ = false;
+};
+
+std::string defaultOutput(const std::string& scene, const std::string& method) {
+  return std::filesystem::path(scene).stem().string() + "_" + method + ".png";
+}
+
+void run(RenderArgs& a) {
+  const RenderMethod& method = findRenderMethod(a.method);
+  checkFamilyOptions(method, a.family);
+  if (a.output.empty()) a.output = defaultOutput(a.scene, a.method);
+  const std::string ext = std::filesystem::path(a.output).extension().string();
+  if (ext != ".png" && ext != ".exr")
+    throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
+
+  const scene::Scene scene = scene::loadGltf(a.scene);
+  const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
+
+  a.schedule.params.pes = a.threads;
+  par::Runtime runtime(par::RuntimeOptions{a.threads, a.schedule.schedule, a.schedule.params, true});
+  ProgressBar bar(!a.quiet && isatty(STDERR_FILENO));
+  const RenderRequest request{scene, camera, a.width, a.height, a.settings, runtime,
+                              [&bar](int64_t done, int64_t total) { bar.update(done, total); }};
+  RenderOutcome outcome = method.render(method.name, request);
+  bar.finish();
+
+  image::writeImage(a.output, outcome.image);
+  par::writeRunOutputs(runtime.record(), a.outputs);
+
+  const par::RunSummary summary = par::summarize(runtime.record());
+  const double wall = summary.wallSeconds;
+  std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.family)).c_str(),
+              a.threads, a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+  if (!outcome.details.empty()) std::printf("%s\n", outcome.details.c_str());
+  std::printf("wall %.3f s", wall);
+  if (outcome.rays > 0)
+    std::printf(", rays %llu, %.2f Mrays/s", (unsigned long long)outcome.rays, wall > 0.0 ? double(outcome.rays) / wall * 1e-6 : 0.0);
+  std::printf(", load imbalance %.3f, efficiency %.3f, messages %llu (%llu bytes), broadcast %.0f bytes per PE\n",
+              summary.total.imbalance, summary.total.efficiency, (unsigned long long)summary.total.messages,
+              (unsigned long long)summary.total.bytes, summary.total.figure("broadcastBytesReceived").mean);
+}
+
+}  // namespace
+
+void addRenderCommand(CLI::App& app) {
+  auto args = std::make_shared<RenderArgs>();
+  CLI::App* cmd = app.add_subcommand("render", "render a glTF scene with one method on P PEs; write the image and a summary");
+  cmd->add_option("scene", args->scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
+  std::string names;
+  for (const RenderMethod& m : renderMethods()) names += (names.empty() ? "" : ", ") + std::string(m.name);
+  cmd->add_option("-m,--method", args->method, "render method (default image-space):\n" + describeRenderMethods())
+      ->check(CLI::Validator(
+          [names](std::string& v) {
+            for (const RenderMethod& m : renderMethods())
+              if (m.name == v) return std::string();
+            return "unknown method '" + v + "' (expected one of: " + names + ")";
+          },
+          "METHOD"));
+  cmd->add_option("-o,--output", args->output, "output image, .png or .exr (default <scene stem>_<method>.png)");
+  cmd->add_option("--width", args->width, "image width in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
+  cmd->add_option("--height", args->height, "image height in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
+  cmd->add_option("--camera", args->camera, "camera: index, name, or 'auto' (default: the file's first)");
+  cmd->add_option("--threads", args->threads, "P, the number of PEs")->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_flag("--quiet", args->quiet, "no progress bar");
+  par::addScheduleOptions(*cmd, args->schedule);
+  par::addRunOutputOptions(*cmd, args->outputs);
+  addRayOptions(*cmd, args->settings, args->family);
+  cmd->callback([args] { run(*args); });
+}
+
+}  // namespace pr::cli

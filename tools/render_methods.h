@@ -1,0 +1,78 @@
+// The render methods of `parrender render -m NAME`: a registry (name -> family -> description
+// -> function) over both families, the ray tracers (one method per raytrace Partition) and the
+// rasterization pipelines. Family-specific options (ray: --integrator --spp --max-depth --seed
+// --tile-size --adaptive) are registered with their family, so giving one to a method of the
+// other family is an input error naming the option. Used by cmd_render.cpp.
+#pragma once
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common/image/image.h"
+#include "common/parallel/runtime.h"
+#include "common/scene/camera.h"
+#include "common/scene/scene.h"
+
+namespace pr::cli {
+
+enum class MethodFamily { Ray, Raster };
+std::string_view toString(MethodFamily family);  // "ray-tracing" | "rasterization"
+
+// Options of the ray-tracing family.
+struct RayOptions {
+  std::string integrator = "path";
+  int spp = 4;
+  int maxDepth = 8;
+  uint64_t seed = 1;
+  int tileSizePx = 16;
+  bool adaptive = false;
+};
+
+// Every family's options, filled by CLI11.
+struct RenderSettings {
+  RayOptions ray;
+};
+
+// What a method needs for one render.
+struct RenderRequest {
+  const scene::Scene& scene;
+  const scene::Camera& camera;
+  int width = 0, height = 0;
+  const RenderSettings& settings;
+  par::Runtime& runtime;
+  std::function<void(int64_t, int64_t)> progress;  // (tasks done, total), thread-safe
+};
+
+struct RenderOutcome {
+  image::Image image;
+  uint64_t rays = 0;     // rays traced (ray family), 0 otherwise
+  std::string details;   // one extra summary line (family-specific), may be empty
+};
+
+struct RenderMethod {
+  std::string_view name;
+  MethodFamily family;
+  std::string_view description;
+  RenderOutcome (*render)(std::string_view name, const RenderRequest& request);
+};
+
+// Every method, ray tracers first (from the raytrace partition registry).
+const std::vector<RenderMethod>& renderMethods();
+// Throws pr::InputError naming the unknown method and listing the valid ones.
+const RenderMethod& findRenderMethod(std::string_view name);
+// "name (family): description" lines for --help.
+std::string describeRenderMethods();
+
+// Family-specific options as registered on the command: checked after parsing.
+using FamilyOptions = std::vector<std::pair<CLI::Option*, MethodFamily>>;
+void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family);
+// Throws pr::InputError when an option of another family than the method's was given.
+void checkFamilyOptions(const RenderMethod& method, const FamilyOptions& family);
+
+}  // namespace pr::cli
