@@ -1,0 +1,173 @@
+// Tests of the object-space tracer (raytrace/partition/object_space.cpp): images bit-identical
+// to the sequential tracer for every P (bundled scenes, shared models, k·P voxels, rays along
+// voxel boundaries), exact message counts on a hand-checked scene, traffic invariants, the
+// geometry each PE holds, and termination under a timeout guard.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdlib>
+#include <future>
+
+#include "raytrace/core/geometry_builders.h"
+#include "raytrace/integrators/integrator_scenes.h"
+#include "raytrace/partition/partitioned_test_support.h"
+
+using namespace pr;
+
+namespace {
+
+constexpr int kW = 24, kH = 18;
+const int kPes[] = {1, 2, 3, 4, 8};
+
+void checkScene(const std::filesystem::path& file, rt::IntegratorKind kind, int spp, std::initializer_list<int> pes,
+                int voxelsPerPe = 1) {
+  scene::Scene s = scene::loadGltf(file);
+  const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
+  test::addHeadlightIfUnlit(s, cam);
+  const rt::TraceOptions opt = test::partitionedOptions(kind, spp);
+  const image::Image reference = test::renderSequential(s, cam, kW, kH, opt);
+  CHECK(std::any_of(reference.pixels.begin(), reference.pixels.end(),
+                    [](const glm::vec3& c) { return c.x + c.y + c.z > 0.0f; }));  // not a black frame
+  for (int p : pes) {
+    CAPTURE(file);
+    CAPTURE(p);
+    rt::ObjectSpacePartition partition(voxelsPerPe);
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, kW, kH, opt, p);
+    CHECK(run.image.pixels == reference.pixels);
+    test::checkTraffic(run, p);
+    CHECK(run.figures.partitions == voxelsPerPe * p);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("ObjectSpace: Cornell box, Whitted and path tracer, = sequential for P in {1,2,3,4,8}") {
+  const rt::IntegratorKind kinds[] = {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path};
+  for (rt::IntegratorKind kind : kinds)
+    checkScene(test::bundledScene("cornell.gltf"), kind, kind == rt::IntegratorKind::Path ? 2 : 1,
+               {kPes[0], kPes[1], kPes[2], kPes[3], kPes[4]});
+  checkScene(test::bundledScene("cornell-diffuse.gltf"), rt::IntegratorKind::Path, 1, {1, 2, 3, 4, 8});
+}
+
+TEST_CASE("ObjectSpace: hot-spot scene = sequential for P = 3") {
+  checkScene(test::bundledScene("hotspot.gltf"), rt::IntegratorKind::Whitted, 1, {3});
+}
+
+TEST_CASE("ObjectSpace: hot-spot scene = sequential for P = 8") {
+  checkScene(test::bundledScene("hotspot.gltf"), rt::IntegratorKind::Whitted, 1, {8});
+}
+
+TEST_CASE("ObjectSpace: k·P voxels = sequential") {
+  checkScene(test::bundledScene("cornell.gltf"), rt::IntegratorKind::Path, 1, {2, 3}, 4);
+}
+
+TEST_CASE("ObjectSpace: shared glTF models = sequential") {
+  if (!test::haveSharedScenes()) return;
+  for (const char* file : {"BoxTextured/glTF/BoxTextured.gltf", "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf",
+                           "Duck/glTF-Binary/Duck.glb"})
+    checkScene(test::sharedScenes() / file, rt::IntegratorKind::Path, 1, {2, 4});
+}
+
+TEST_CASE("ObjectSpace: axis-aligned city, rays parallel to the split planes, = sequential") {
+  // Adjacent boxes on a grid share faces at integer coordinates, where the kd split puts its
+  // planes; the top-down orthographic camera's rays run parallel to the vertical planes and
+  // cross the horizontal ones where box tops lie. A point light adds shadow rays.
+  scene::Scene s = test::emptyScene();
+  const uint32_t white = test::addMaterial(s, test::diffuse(0.8f));
+  test::addGround(s, 0.0f, white);
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) {
+      const scene::Scene box = test::closedBox(glm::vec3(i - 2, 0, j - 2), glm::vec3(i - 1, 1 + (i * 3 + j) % 4, j - 1), 1);
+      const auto base = uint32_t(s.positions.size());
+      s.positions.insert(s.positions.end(), box.positions.begin(), box.positions.end());
+      for (scene::Triangle t : box.triangles) {
+        for (uint32_t& v : t.v) v += base;
+        t.material = white;
+        s.triangles.push_back(t);
+      }
+    }
+  s.normals.clear();  // the boxes come without: geometric normals everywhere
+  s.uvs.clear();
+  for (const glm::vec3& p : s.positions) s.bounds.extend(p);
+  scene::PunctualLight light;
+  light.type = scene::LightType::Point;
+  light.position = glm::vec3(0.5f, 8.0f, 0.5f);
+  light.color = glm::vec3(1.0f);
+  light.intensity = 50.0f;
+  s.lights.push_back(light);
+  const scene::Camera cam = test::topDownOrtho(10.0f, 2.5f);
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 2);
+  const image::Image reference = test::renderSequential(s, cam, kW, kW, opt);
+  CHECK(std::any_of(reference.pixels.begin(), reference.pixels.end(),
+                    [](const glm::vec3& c) { return c.x + c.y + c.z > 0.0f; }));
+  for (int p : {2, 3, 4, 8}) {
+    CAPTURE(p);
+    rt::ObjectSpacePartition partition;
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, kW, kW, opt, p);
+    CHECK(run.image.pixels == reference.pixels);
+    test::checkTraffic(run, p);
+  }
+}
+
+TEST_CASE("ObjectSpace: two walls, one tile: exactly one ray message") {
+  // Walls x = -3 and x = +3; the eye at the origin lies on the split plane x = 0 between
+  // them. Pixel 0's ray goes left and stays in voxel 0, pixel 1's goes right and stays in
+  // voxel 1. One tile makes both rays on one PE: the ray of the other PE's voxel is sent
+  // once, traced there, and (diffuse, no lights, Whitted) spawns nothing. P = 1: no message.
+  scene::Scene s = test::emptyScene();
+  for (float x : {-3.0f, 3.0f}) {
+    test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
+    test::addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
+  }
+  const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
+  for (int p : {1, 2}) {
+    CAPTURE(p);
+    rt::ObjectSpacePartition partition;
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 2, 1, opt, p);
+    test::checkTraffic(run, p);
+    CHECK(run.result.rays.total() == 2);
+    CHECK(run.figures.rayMessages == (p == 1 ? 0u : 1u));
+    uint64_t bytes = 0;
+    for (const par::PeStageRecord& pe : test::traceStage(run.record).pes) bytes += pe.bytesSent;
+    CHECK(bytes == (p == 1 ? 0u : 60u));  // one TravellingRay: RayMessage (56) + span index (4)
+    CHECK(run.figures.triangles == std::vector<uint64_t>(p == 1 ? std::vector<uint64_t>{4} : std::vector<uint64_t>{2, 2}));
+  }
+}
+
+TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::ObjectSpacePartition partition;
+  const test::PartitionedRun run =
+      test::renderPartitioned(partition, s, cam, 8, 8, test::partitionedOptions(rt::IntegratorKind::Whitted, 1), 4);
+  uint64_t triangles = 0;
+  for (int p = 0; p < 4; ++p) {
+    CHECK(run.figures.triangles[p] > 0);
+    CHECK(run.figures.triangles[p] < s.triangles.size() * 6 / 10);  // a balanced share, not the world
+    CHECK(run.figures.geometryBytes[p] > run.figures.triangles[p] * rt::kTriangleVertexBytes);
+    triangles += run.figures.triangles[p];
+  }
+  CHECK(triangles >= s.triangles.size());
+  CHECK(triangles < s.triangles.size() * 11 / 10);  // few straddlers
+  test::checkTraffic(run, 4);
+  CHECK(run.figures.rayMessages > 0);
+}
+
+TEST_CASE("ObjectSpace: renders terminate (timeout guard)") {
+  // Deep glass and mirror paths at P = 8 with spp 2: if termination detection failed, the
+  // stage would never end; the guard turns a hang into a failure.
+  const scene::Scene s = scene::loadGltf(test::bundledScene("cornell.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 2, 16);
+  auto done = std::async(std::launch::async, [&] {
+    rt::ObjectSpacePartition partition;
+    return test::renderPartitioned(partition, s, cam, 12, 12, opt, 8).result.rays.total();
+  });
+  if (done.wait_for(std::chrono::seconds(60)) != std::future_status::ready) {
+    FAIL_CHECK("object-space render did not terminate within 60 s");
+    std::quick_exit(1);
+  }
+  CHECK(done.get() >= 12u * 12u * 2u);
+}

@@ -1,0 +1,103 @@
+// Helpers of the object-space and object-partitioning tests: render a scene with one of the
+// partitioned tracers (returning image, run record and the tracer's figures), render the
+// sequential reference, and check the run record's traffic invariants.
+#pragma once
+
+#include <cstdint>
+#include <filesystem>
+#include <memory>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "common/parallel/runtime.h"
+#include "common/scene/camera_select.h"
+#include "common/scene/gltf_loader.h"
+#include "raytrace/partition/object_partition.h"
+#include "raytrace/partition/object_space.h"
+#include "raytrace/partition/partition.h"
+#include "test_support.h"
+
+namespace pr::test {
+
+struct PartitionedRun {
+  image::Image image;
+  rt::TraceResult result;
+  par::RunRecord record;
+  rt::PartitionFigures figures;
+};
+
+inline rt::TraceOptions partitionedOptions(rt::IntegratorKind kind, int spp, int maxDepth = 5) {
+  rt::TraceOptions opt;
+  opt.integrator.kind = kind;
+  opt.integrator.spp = spp;
+  opt.integrator.maxDepth = maxDepth;
+  opt.integrator.seed = 7;
+  opt.tileSizePx = 8;
+  return opt;
+}
+
+// partition: an rt::ObjectSpacePartition or rt::ObjectPartition.
+template <class P>
+PartitionedRun renderPartitioned(P& partition, const scene::Scene& s, const scene::Camera& cam, int w, int h,
+                                 const rt::TraceOptions& opt, int pes, const std::string& schedule = "demand") {
+  par::Runtime runtime(pes, schedule);
+  PartitionedRun run;
+  run.result = partition.render(rt::TraceJob{s, cam, w, h, opt}, runtime);
+  run.image = run.result.image;
+  run.record = runtime.record();
+  run.figures = partition.figures();
+  return run;
+}
+
+inline image::Image renderSequential(const scene::Scene& s, const scene::Camera& cam, int w, int h,
+                                     const rt::TraceOptions& opt) {
+  par::Runtime runtime(1, "demand");
+  return rt::renderRays(s, cam, w, h, opt, "sequential", runtime).image;
+}
+
+inline const par::StageRecord& traceStage(const par::RunRecord& record) {
+  for (const par::StageRecord& st : record.stages)
+    if (st.name == "trace") return st;
+  FAIL("no trace stage in the run record");
+  return record.stages.front();
+}
+
+// Bytes sent = bytes received, P = 1 moves nothing, and the tracer's per-kind message
+// counters add up to what the Channels counted.
+inline void checkTraffic(const PartitionedRun& run, int pes) {
+  const par::StageRecord& st = traceStage(run.record);
+  uint64_t sent = 0, received = 0, bytesSent = 0, bytesReceived = 0;
+  for (const par::PeStageRecord& pe : st.pes) {
+    sent += pe.messagesSent;
+    received += pe.messagesReceived;
+    bytesSent += pe.bytesSent;
+    bytesReceived += pe.bytesReceived;
+    CHECK(pe.busySeconds <= st.wallSeconds * 1.0001 + 1e-4);
+  }
+  CHECK(sent == received);
+  CHECK(bytesSent == bytesReceived);
+  CHECK(sent == run.figures.rayMessages + run.figures.hitMessages);
+  for (const par::Traffic& t : st.traffic) CHECK(t.from != t.to);
+  if (pes == 1) {
+    CHECK(sent == 0);
+    CHECK(bytesSent == 0);
+    CHECK(st.traffic.empty());
+  }
+  CHECK(int(run.figures.geometryBytes.size()) == pes);
+}
+
+// Models without lights (Duck, BoxTextured) would render black, and a black frame proves no
+// equivalence: a point light at the eye, bright enough for the scene's size, lights them.
+inline void addHeadlightIfUnlit(scene::Scene& s, const scene::Camera& cam) {
+  if (!s.lights.empty() || !s.areaLights.empty()) return;
+  scene::PunctualLight light;
+  light.position = cam.position();
+  const float d = glm::length(s.bounds.extent()) + glm::length(cam.position() - s.bounds.center());
+  light.intensity = 2.0f * d * d;
+  s.lights.push_back(light);
+}
+
+inline std::filesystem::path bundledScene(const char* name) { return sourceDir() / "scenes" / name; }
+
+}  // namespace pr::test
