@@ -1,0 +1,81 @@
+// Binary-swap compositing (sort-last; Ma, Painter, Hansen, Krogh 1994): in round k PE p pairs
+// with p XOR 2^k; both hold the same rectangle, cut it in half (across its longer side), keep
+// one half and send the other to the partner, then depth-composite the partner's half into
+// theirs. After log2 P rounds each PE owns a disjoint 1/P of the screen; in the full-frame
+// variant each PE sent A/2 + A/4 + ... + A/P = A (1 - 1/P) pixels in log2 P messages.
+#include <bit>
+#include <string>
+#include <utility>
+
+#include "common/parallel/channel.h"
+#include "common/util/error.h"
+#include "raster/composite/compositor.h"
+#include "raster/sort/region_assignment.h"
+
+namespace pr::raster {
+namespace {
+
+// The two halves of r; both partners compute the same cut.
+std::pair<Rect, Rect> halves(const Rect& r) {
+  if (r.height() >= r.width()) {
+    const int mid = r.y0 + r.height() / 2;
+    return {Rect{r.x0, r.y0, r.x1, mid}, Rect{r.x0, mid, r.x1, r.y1}};
+  }
+  const int mid = r.x0 + r.width() / 2;
+  return {Rect{r.x0, r.y0, mid, r.y1}, Rect{mid, r.y0, r.x1, r.y1}};
+}
+
+class BinarySwap : public Compositor {
+ public:
+  std::string_view name() const override { return "binary-swap"; }
+
+  std::vector<RegionFramebuffer> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
+                                           std::vector<CompositeCounters>& counters) override {
+    const int pes = rt.pes();
+    if (!std::has_single_bit(static_cast<unsigned>(pes)))
+      throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +
+                       " (use direct-send)");
+    const int rounds = std::countr_zero(static_cast<unsigned>(pes));
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+
+    // current[p]: PE p's composited rectangle so far (its own data only).
+    std::vector<RegionFramebuffer> current = std::move(buffers);
+    buffers.assign(pes, RegionFramebuffer());
+    std::vector<std::vector<PixelMessage>> inbox(pes);
+    for (int k = 0; k < rounds; ++k) {
+      par::Channel<PixelMessage> pixels(rt, "binary-swap pixels");
+      auto owned = makeOwnerScheduler(self);
+      rt.runStage("binary-swap round " + std::to_string(k), par::TaskSet::uniform(pes), *owned,
+                  [&](par::Pe& pe, par::TaskId) {
+                    const int p = pe.id();
+                    for (const PixelMessage& m : inbox[p]) mergePixels(m, current[p]);
+                    inbox[p].clear();
+                    const auto [lower, upper] = halves(current[p].rect());
+                    const bool keepLower = ((p >> k) & 1) == 0;
+                    const Rect give = keepLower ? upper : lower;
+                    PixelMessage m = packPixels(current[p], give, sparse);
+                    current[p] = crop(current[p], keepLower ? lower : upper);
+                    if (sparse && m.pixels() == 0) return;  // nothing covered there: no message
+                    const size_t bytes = m.bytes(sparse);
+                    CompositeCounters& c = counters[p];
+                    c.pixelsSent += m.pixels();
+                    c.messages += 1;
+                    c.bytes += bytes;
+                    pixels.send(pe, p ^ (1 << k), std::move(m), bytes);
+                  });
+      for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
+    }
+    auto owned = makeOwnerScheduler(self);
+    rt.runStage("binary-swap merge", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, current[pe.id()]);
+    });
+    return current;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Compositor> makeBinarySwap() { return std::make_unique<BinarySwap>(); }
+
+}  // namespace pr::raster

@@ -1,0 +1,108 @@
+// Direct-send compositing (sort-last): the screen is cut into P strips, PE i owns strip i; each
+// PE sends every other owner the part of its framebuffer inside that owner's strip (P - 1
+// messages of A / P pixels in the full-frame variant: b * A * (1 - 1/P) bytes per PE), then
+// each owner depth-composites what it received into its own strip. Also the pixel packing
+// shared with binary swap.
+#include <algorithm>
+
+#include "common/parallel/channel.h"
+#include "common/util/error.h"
+#include "raster/composite/compositor.h"
+#include "raster/sort/region_assignment.h"
+#include "raster/stages/depth_resolve.h"
+
+namespace pr::raster {
+
+PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool sparse) {
+  PixelMessage m;
+  m.rect = intersect(fb.rect(), rect);
+  const Rect& r = m.rect;
+  if (!sparse) {
+    m.keys.reserve(static_cast<size_t>(r.area()));
+    m.colours.reserve(static_cast<size_t>(r.area()));
+  }
+  for (int y = r.y0; y < r.y1; ++y) {
+    for (int x = r.x0; x < r.x1; ++x) {
+      const size_t i = fb.index(x, y);
+      if (sparse && !keyCovered(fb.keys()[i])) continue;
+      if (sparse) m.index.push_back(static_cast<uint32_t>((y - r.y0) * r.width() + (x - r.x0)));
+      m.keys.push_back(fb.keys()[i]);
+      m.colours.push_back(fb.colours()[i]);
+    }
+  }
+  return m;
+}
+
+void mergePixels(const PixelMessage& m, RegionFramebuffer& dst) {
+  const Rect& r = m.rect;
+  for (size_t k = 0; k < m.pixels(); ++k) {
+    const uint32_t local = m.index.empty() ? static_cast<uint32_t>(k) : m.index[k];
+    const int x = r.x0 + static_cast<int>(local % static_cast<uint32_t>(r.width()));
+    const int y = r.y0 + static_cast<int>(local / static_cast<uint32_t>(r.width()));
+    if (!dst.rect().contains(x, y)) continue;
+    const size_t i = dst.index(x, y);
+    if (depthTest(dst.keys()[i], m.keys[k])) {
+      dst.keys()[i] = m.keys[k];
+      dst.colours()[i] = m.colours[k];
+      dst.triangles()[i] = kNoTriangle;
+    }
+  }
+}
+
+namespace {
+
+class DirectSend : public Compositor {
+ public:
+  std::string_view name() const override { return "direct-send"; }
+
+  std::vector<RegionFramebuffer> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
+                                           std::vector<CompositeCounters>& counters) override {
+    const int pes = rt.pes();
+    const Rect screen = buffers[0].rect();
+    // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
+    const std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
+    const int owners = static_cast<int>(strips.size());
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+
+    par::Channel<PixelMessage> pixels(rt, "composite pixels");
+    auto owned = makeOwnerScheduler(self);
+    rt.runStage("direct-send", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+      CompositeCounters& c = counters[pe.id()];
+      for (int o = 0; o < owners; ++o) {
+        if (o == pe.id()) continue;
+        PixelMessage m = packPixels(buffers[pe.id()], strips[o], sparse);
+        if (sparse && m.pixels() == 0) continue;  // nothing covered there: no message
+        const size_t bytes = m.bytes(sparse);
+        c.pixelsSent += m.pixels();
+        c.messages += 1;
+        c.bytes += bytes;
+        pixels.send(pe, o, std::move(m), bytes);
+      }
+    });
+
+    std::vector<std::vector<PixelMessage>> inbox(pes);
+    for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
+    std::vector<RegionFramebuffer> result(owners);
+    auto merge = makeOwnerScheduler(self);
+    rt.runStage("direct-send merge", par::TaskSet::uniform(pes), *merge, [&](par::Pe& pe, par::TaskId) {
+      const int p = pe.id();
+      if (p >= owners) return;
+      result[p] = crop(buffers[p], strips[p]);
+      for (const PixelMessage& m : inbox[p]) mergePixels(m, result[p]);
+    });
+    return result;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<Compositor> makeDirectSend() { return std::make_unique<DirectSend>(); }
+
+std::unique_ptr<Compositor> makeCompositor(std::string_view name) {
+  if (name == "direct-send") return makeDirectSend();
+  if (name == "binary-swap") return makeBinarySwap();
+  throw InputError("unknown compositor '" + std::string(name) + "' (expected direct-send or binary-swap)");
+}
+
+}  // namespace pr::raster

@@ -1,0 +1,32 @@
+// Parallel raster entry point: a frame is a cleared full-screen image plus one renderFrame of
+// the chosen sort point; the orbit camera for multi-frame runs.
+#include "raster/parallel_pipeline.h"
+
+#include <glm/gtc/matrix_transform.hpp>
+
+namespace pr::raster {
+
+RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
+                              const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
+  RegionFramebuffer image(Rect{0, 0, view.width, view.height});
+  const SortCounters c = sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
+  if (counters) *counters += c;
+  return image;
+}
+
+RegionFramebuffer renderParallel(const scene::Scene& scene, const FrameView& view, std::string_view method,
+                                 const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
+  std::unique_ptr<SortPoint> sortPoint = makeSortPoint(method);
+  return renderFrame(*sortPoint, scene, view, options, runtime, counters);
+}
+
+scene::Camera orbitCamera(const scene::Camera& camera, glm::vec3 centre, float angleRadians) {
+  scene::Camera c = camera;
+  const glm::mat4 turn = glm::translate(glm::mat4(1.0f), centre) *
+                         glm::rotate(glm::mat4(1.0f), angleRadians, glm::vec3(0.0f, 1.0f, 0.0f)) *
+                         glm::translate(glm::mat4(1.0f), -centre);
+  c.cameraToWorld = turn * camera.cameraToWorld;
+  return c;
+}
+
+}  // namespace pr::raster

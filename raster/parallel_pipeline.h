@@ -1,0 +1,29 @@
+// The parallel raster pipelines' entry point: renders frames of a scene with one SortPoint on
+// a par::Runtime, for the render command and the tests. A camera orbit (--frames N --orbit)
+// renders N frames with the camera circling the scene centre, reusing the sort point between
+// frames (sort-first's frame coherence).
+#pragma once
+
+#include <string_view>
+
+#include "common/parallel/runtime.h"
+#include "common/scene/camera.h"
+#include "common/scene/scene.h"
+#include "raster/framebuffer.h"
+#include "raster/sort/sort_point.h"
+
+namespace pr::raster {
+
+// One frame with the named sort point (pr::InputError for an unknown name).
+RegionFramebuffer renderParallel(const scene::Scene& scene, const FrameView& view, std::string_view method,
+                                 const SortOptions& options, par::Runtime& runtime, SortCounters* counters = nullptr);
+
+// One frame with a sort point kept by the caller across frames.
+RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
+                              const SortOptions& options, par::Runtime& runtime, SortCounters* counters = nullptr);
+
+// The camera turned by angleRadians about the vertical (+y) axis through centre: frame i of an
+// N-frame orbit uses angle 2 pi i / N.
+scene::Camera orbitCamera(const scene::Camera& camera, glm::vec3 centre, float angleRadians);
+
+}  // namespace pr::raster

@@ -1,0 +1,221 @@
+// Sort-first: the sort sits before geometry. Scene primitives start on PEs in contiguous
+// batches (or, from the second frame of a sequence, where the previous frame left them: frame
+// coherence); each PE pre-transforms the primitives it holds just enough to find the screen
+// regions they overlap and sends their ids to the region owners, who run the whole pipeline
+// (geometry again, rasterize, shade) on their regions. The scene itself is replicated
+// read-only data (world model); a message carries 4-byte primitive ids.
+#include <algorithm>
+#include <optional>
+
+#include "common/parallel/channel.h"
+#include "raster/sort/bins.h"
+#include "raster/sort/sort_point.h"
+#include "raster/sort/tile_pull.h"
+#include "raster/stages/rasterize.h"
+#include "raster/stages/shade.h"
+#include "raster/stages/setup.h"
+
+namespace pr::raster {
+namespace {
+
+// Pixel bounds of all pieces of scene triangle `index` (empty when it is culled or clipped
+// away): the pre-transform, the same geometry function the owners run in full.
+Rect primitiveBounds(const scene::Scene& scene, const FrameView& view, uint32_t index) {
+  ScreenTriangle pieces[kMaxSubTriangles];
+  const int n = processTriangle(scene, view, index, pieces);
+  Rect b;
+  for (int i = 0; i < n; ++i) {
+    const Rect r = pixelBounds(pieces[i]);
+    if (r.empty()) continue;
+    b = b.empty() ? r : Rect{std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
+  }
+  return b;
+}
+
+class SortFirst : public SortPoint {
+ public:
+  std::string_view name() const override { return "sort-first"; }
+
+  SortCounters renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
+    const int pes = rt.pes();
+    const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
+    const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    if (grid.dynamic()) {
+      previous_.reset();  // no owner to keep primitives on between frames
+      return renderDynamic(f, rt, grid, ctx, image);
+    }
+
+    // Frame coherence holds only for the same scene, PE count and region assignment.
+    const bool coherent = previous_.has_value() && scene_ == &f.scene && triangles_ == total &&
+                          previous_->grid.owners() == grid.owners() && held_.size() == size_t(pes) &&
+                          previous_->view.width == f.view.width && previous_->view.height == f.view.height;
+    if (!coherent) {
+      // First frame: contiguous batches of primitive ids, one per PE.
+      held_.assign(pes, {});
+      for (int p = 0; p < pes; ++p) {
+        const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);
+        const uint32_t hi = static_cast<uint32_t>(uint64_t(total) * (p + 1) / pes);
+        for (uint32_t i = lo; i < hi; ++i) held_[p].push_back(i);
+      }
+      previous_.reset();
+    }
+
+    std::vector<SortCounters> counters(pes);
+    std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
+    par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives");
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+
+    // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
+    // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
+    // the lowest of its previous owners (its primary); an unseen primitive has one holder.
+    auto owned = makeOwnerScheduler(self);
+    rt.runStage("sort-first pre-transform", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+      const int p = pe.id();
+      SortCounters& c = counters[p];
+      std::vector<std::vector<uint32_t>> out(pes);
+      std::vector<char> scratch(pes, 0);
+      std::vector<int> owners, before;
+      for (uint32_t id : held_[p]) {
+        ownersOf(grid, primitiveBounds(f.scene, f.view, id), scratch, owners);
+        c.preTransforms += 1;
+        before.clear();
+        if (previous_) {
+          ownersOf(previous_->grid, primitiveBounds(f.scene, previous_->view, id), scratch, before);
+          c.preTransforms += 1;
+        }
+        const bool primary = before.empty() || before.front() == p;
+        const bool ownNow = std::binary_search(owners.begin(), owners.end(), p);
+        if (ownNow || (primary && owners.empty())) kept[p].push_back(id);  // keeper of an unseen one
+        if (!primary) continue;
+        c.primitivesRouted += owners.size();
+        if (!owners.empty()) c.primitivesDuplicated += owners.size() - 1;
+        for (int o : owners) {
+          if (std::binary_search(before.begin(), before.end(), o)) continue;  // already holds it
+          if (o == p) continue;
+          out[o].push_back(id);
+          c.primitivesSent += 1;
+          if (previous_) c.primitivesMigrated += 1;
+        }
+      }
+      for (int o = 0; o < pes; ++o) {
+        if (out[o].empty()) continue;
+        const size_t bytes = out[o].size() * sizeof(uint32_t);
+        primitives.send(pe, o, std::move(out[o]), bytes);
+      }
+    });
+
+    std::vector<std::vector<uint32_t>> received(pes);
+    for (int p = 0; p < pes; ++p)
+      for (std::vector<uint32_t>& m : primitives.drain(p)) received[p].insert(received[p].end(), m.begin(), m.end());
+
+    // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
+    // it holds, then rasterize and shade.
+    std::vector<std::vector<RegionFramebuffer>> drawn(pes);
+    auto owned2 = makeOwnerScheduler(self);
+    rt.runStage("sort-first render", par::TaskSet::uniform(pes), *owned2, [&](par::Pe& pe, par::TaskId) {
+      const int p = pe.id();
+      std::vector<uint32_t>& mine = kept[p];
+      mine.insert(mine.end(), received[p].begin(), received[p].end());
+      std::sort(mine.begin(), mine.end());
+      mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+      std::vector<ScreenTriangle> tris;
+      ScreenTriangle pieces[kMaxSubTriangles];
+      for (uint32_t id : mine) {
+        const int n = processTriangle(f.scene, f.view, id, pieces);
+        tris.insert(tris.end(), pieces, pieces + n);
+      }
+      counters[p].geometryRepeated += mine.size();
+      drawn[p] = drawOwnedRegions(ctx, tris, grid, p);
+    });
+
+    for (const auto& regions : drawn)
+      for (const RegionFramebuffer& fb : regions) resolveInto(fb, image);
+
+    held_ = std::move(kept);
+    previous_.emplace(Previous{f.view, grid});
+    scene_ = &f.scene;
+    triangles_ = total;
+    SortCounters sum;
+    for (const SortCounters& c : counters) sum += c;
+    return sum;
+  }
+
+ private:
+  // Dynamic regions: each PE pre-transforms its contiguous share and keeps the ids binned per
+  // tile; tiles are handed out on demand and the PE taking a tile pulls the ids from every PE
+  // and runs the whole pipeline on that tile (so a primitive's geometry runs once per tile).
+  SortCounters renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid,
+                             const ShadingContext& ctx, RegionFramebuffer& image) {
+    const int pes = rt.pes();
+    const int tiles = grid.regionCount();
+    const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
+    std::vector<SortCounters> counters(pes);
+    std::vector<std::vector<std::vector<uint32_t>>> bins(pes, std::vector<std::vector<uint32_t>>(tiles));
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+    auto owned = makeOwnerScheduler(self);
+    rt.runStage("sort-first pre-transform", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+      const int p = pe.id();
+      SortCounters& c = counters[p];
+      const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);
+      const uint32_t hi = static_cast<uint32_t>(uint64_t(total) * (p + 1) / pes);
+      for (uint32_t id = lo; id < hi; ++id) {
+        uint64_t n = 0;
+        grid.forEachOverlapped(primitiveBounds(f.scene, f.view, id), [&](int r) {
+          bins[p][r].push_back(id);
+          ++n;
+        });
+        c.preTransforms += 1;
+        c.primitivesRouted += n;
+        if (n > 0) c.primitivesDuplicated += n - 1;
+      }
+    });
+
+    std::vector<RegionFramebuffer> drawn(tiles);
+    {
+      TilePull<uint32_t> pull(rt, "sort-first tile", bins);
+      par::TaskSet set = par::TaskSet::uniform(tiles);
+      for (int r = 0; r < tiles; ++r) {
+        set.tasks[r].x = 0.5f * float(grid.region(r).x0 + grid.region(r).x1);
+        set.tasks[r].y = 0.5f * float(grid.region(r).y0 + grid.region(r).y1);
+      }
+      rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
+        const std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
+        std::vector<ScreenTriangle> tris;
+        ScreenTriangle pieces[kMaxSubTriangles];
+        for (uint32_t id : ids) {
+          const int n = processTriangle(f.scene, f.view, id, pieces);
+          tris.insert(tris.end(), pieces, pieces + n);
+        }
+        counters[pe.id()].geometryRepeated += ids.size();
+        RegionFramebuffer fb(grid.region(static_cast<int>(t)));
+        rasterizeTriangles(tris, fb);
+        shadeRegion(ctx, tris, fb);
+        drawn[t] = std::move(fb);
+      });
+      for (int p = 0; p < pes; ++p) counters[p].primitivesSent += pull.itemsSent(p);
+    }
+    for (const RegionFramebuffer& fb : drawn) resolveInto(fb, image);
+    SortCounters sum;
+    for (const SortCounters& c : counters) sum += c;
+    return sum;
+  }
+
+  struct Previous {
+    FrameView view;
+    RegionGrid grid;
+  };
+  // Between frames: the primitives each PE holds, and the view and regions they were sorted by.
+  std::vector<std::vector<uint32_t>> held_;
+  std::optional<Previous> previous_;
+  const scene::Scene* scene_ = nullptr;
+  uint32_t triangles_ = 0;
+};
+
+}  // namespace
+
+std::unique_ptr<SortPoint> makeSortFirst() { return std::make_unique<SortFirst>(); }
+
+}  // namespace pr::raster

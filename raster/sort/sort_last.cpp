@@ -1,0 +1,70 @@
+// Sort-last: the sort sits after rasterization. Each PE renders its own primitives (geometry
+// batches under the runtime's schedule) over the whole screen into its own full-screen colour
+// and depth buffers, shades them, and the Compositor (direct-send or binary-swap, full frame
+// or sparse) redistributes pixels by screen region and keeps the nearest fragment per pixel.
+#include <algorithm>
+
+#include "raster/composite/compositor.h"
+#include "raster/sort/sort_point.h"
+#include "raster/stages/rasterize.h"
+#include "raster/stages/shade.h"
+
+namespace pr::raster {
+namespace {
+
+class SortLast : public SortPoint {
+ public:
+  std::string_view name() const override { return "sort-last"; }
+
+  SortCounters renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
+    const int pes = rt.pes();
+    // The compositor is chosen (and a bad name rejected) before any work is done.
+    std::unique_ptr<Compositor> compositor = makeCompositor(f.options.compositor);
+    const Rect screen{0, 0, f.view.width, f.view.height};
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+
+    // Stage 1, geometry and rasterization of a PE's batches into its own full-screen buffer;
+    // the triangle list stays with the PE for deferred shading (triangle index = list position).
+    std::vector<RegionFramebuffer> buffers;
+    buffers.reserve(pes);
+    for (int p = 0; p < pes; ++p) buffers.emplace_back(screen);
+    std::vector<std::vector<ScreenTriangle>> tris(pes);
+    const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
+    const uint32_t batch = f.options.batchSize;
+    const size_t batches = (total + batch - 1) / batch;
+    rt.runStage("sort-last render", par::TaskSet::uniform(batches), [&](par::Pe& pe, par::TaskId t) {
+      std::vector<ScreenTriangle>& mine = tris[pe.id()];
+      const size_t before = mine.size();
+      const uint32_t first = static_cast<uint32_t>(t) * batch;
+      processTriangles(f.scene, f.view, first, std::min(batch, total - first), mine);
+      for (size_t i = before; i < mine.size(); ++i)
+        rasterizeTriangle(mine[i], static_cast<uint32_t>(i), buffers[pe.id()]);
+    });
+
+    // Stage 2, shading of each PE's visible pixels, in its own buffer.
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+    auto owned = makeOwnerScheduler(self);
+    rt.runStage("sort-last shade", par::TaskSet::uniform(pes), *owned,
+                [&](par::Pe& pe, par::TaskId) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
+
+    // Stage 3, the sort: depth compositing by screen region.
+    std::vector<CompositeCounters> traffic(pes);
+    std::vector<RegionFramebuffer> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
+    for (const RegionFramebuffer& fb : regions) resolveInto(fb, image);
+
+    SortCounters sum;
+    for (const CompositeCounters& c : traffic) {
+      sum.pixelsSent += c.pixelsSent;
+      sum.compositeMessages += c.messages;
+      sum.compositeBytes += c.bytes;
+    }
+    return sum;
+  }
+};
+
+}  // namespace
+
+std::unique_ptr<SortPoint> makeSortLast() { return std::make_unique<SortLast>(); }
+
+}  // namespace pr::raster

@@ -1,0 +1,85 @@
+// SortPoint: where a parallel raster pipeline redistributes its work to screen-region owners
+// (Molnar et al. 1994; seed section 5.1.1). Sort-first sends scene primitives before geometry,
+// sort-middle sends screen triangles between geometry and rasterization, sort-last sends
+// shaded pixels after rasterization. All three call the stage functions of raster/stages and
+// move data between PEs only through counted par::Channels (shared/DESIGN.md rules 1 and 4).
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/parallel/runtime.h"
+#include "common/scene/scene.h"
+#include "raster/framebuffer.h"
+#include "raster/sort/region_assignment.h"
+#include "raster/stages/geometry.h"
+
+namespace pr::raster {
+
+struct SortOptions {
+  RegionStrategy regions = RegionStrategy::StaticTiles;  // --regions
+  int tileSizePx = 32;                                   // --tile
+  uint32_t batchSize = 4096;                             // scene triangles per geometry task
+  std::string compositor = "direct-send";                // sort-last: --compositor
+  bool sparse = false;                                   // sort-last: --sparse (covered pixels only)
+};
+
+// The algorithm counters of one frame (Sort/...), summed over PEs. Messages and bytes
+// themselves are in the runtime's RunRecord (counted by the Channels); these say what they were.
+struct SortCounters {
+  // sort-first
+  uint64_t primitivesRouted = 0;      // (primitive, owner) deliveries, the sender's own included
+  uint64_t primitivesSent = 0;        // deliveries to another PE (Channel messages carry them)
+  uint64_t primitivesDuplicated = 0;  // deliveries beyond the first owner of a primitive
+  uint64_t primitivesMigrated = 0;    // sent to an owner that did not hold them last frame
+  uint64_t preTransforms = 0;         // primitives pre-transformed to find their regions
+  uint64_t geometryRepeated = 0;      // primitives whose geometry an owner ran again
+  // sort-middle
+  uint64_t trianglesRouted = 0;       // (screen triangle, owner) deliveries
+  uint64_t trianglesSent = 0;         // deliveries to another PE
+  uint64_t trianglesDuplicated = 0;   // deliveries beyond the first owner of a triangle
+  // sort-last
+  uint64_t pixelsSent = 0;            // pixels in compositing messages
+  uint64_t compositeMessages = 0;
+  uint64_t compositeBytes = 0;
+
+  SortCounters& operator+=(const SortCounters& o);
+};
+
+// One frame to render.
+struct FrameInputs {
+  const scene::Scene& scene;
+  const FrameView& view;
+  const SortOptions& options;
+};
+
+class SortPoint {
+ public:
+  virtual ~SortPoint() = default;
+  virtual std::string_view name() const = 0;  // "sort-first" | "sort-middle" | "sort-last"
+  // Renders one frame on the runtime's PEs into image (full screen, cleared by the caller).
+  // Called by the controlling thread; runs one or more stages; may keep state between frames
+  // (sort-first's frame coherence).
+  virtual SortCounters renderFrame(const FrameInputs& frame, par::Runtime& runtime, RegionFramebuffer& image) = 0;
+};
+
+std::unique_ptr<SortPoint> makeSortFirst();
+std::unique_ptr<SortPoint> makeSortMiddle();
+std::unique_ptr<SortPoint> makeSortLast();
+
+// Registry: name -> factory -> description (feeds --help and validation).
+struct SortPointInfo {
+  std::string_view name;
+  std::string_view description;
+  std::unique_ptr<SortPoint> (*make)();
+};
+const std::vector<SortPointInfo>& sortPoints();
+// Throws pr::InputError naming the unknown method and listing the valid ones.
+std::unique_ptr<SortPoint> makeSortPoint(std::string_view name);
+bool isSortPoint(std::string_view name);
+
+}  // namespace pr::raster

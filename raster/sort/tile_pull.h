@@ -1,0 +1,74 @@
+// Demand-driven (dynamic) region assignment: tiles are handed to PEs by the runtime's
+// scheduler as they ask for work, so no owner is known when the sort happens. Each PE keeps
+// what it binned per tile; the PE that takes a tile asks every other PE for its bin of that
+// tile (a request message each) and receives it as a reply message. Used by sort-first
+// (primitive ids) and sort-middle (screen triangles); all traffic goes through Channels.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include "common/parallel/channel.h"
+
+namespace pr::raster {
+
+template <class Item>
+class TilePull {
+ public:
+  // bins[pe][tile]: what PE pe binned for each tile; a PE reads and moves out its own only.
+  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins)
+      : runtime_(runtime),
+        bins_(bins),
+        sent_(runtime.pes(), 0),
+        replies_(runtime, name + " replies"),
+        requests_(runtime, name + " requests", [this](par::Pe& pe, Request&& r) {
+          std::vector<Item>& bin = bins_[pe.id()][r.tile];
+          const size_t bytes = bin.size() * sizeof(Item);
+          sent_[pe.id()] += bin.size();
+          replies_.send(pe, r.pe, std::move(bin), bytes);
+        }) {}
+
+  // Inside the task for `tile` on pe: its own bin plus every other PE's, in PE order. While it
+  // waits for replies the PE answers the requests sent to it, so PEs waiting on each other
+  // always make progress.
+  std::vector<Item> gather(par::Pe& pe, int tile) {
+    const int pes = runtime_.pes();
+    std::vector<std::vector<Item>> parts(pes);
+    parts[pe.id()] = std::move(bins_[pe.id()][tile]);
+    for (int p = 0; p < pes; ++p)
+      if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()}, sizeof(Request));
+    std::vector<Item> reply;
+    for (int got = 0; got < pes - 1;) {
+      if (replies_.tryReceive(pe, reply)) {
+        for (Item& item : reply) parts[pe.id()].push_back(std::move(item));
+        ++got;
+      } else if (requests_.handleOne(pe)) {
+        pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+        runtime_.outstanding().done();  // this task is still counted, so never the last unit
+      } else {
+        std::this_thread::yield();
+      }
+    }
+    return std::move(parts[pe.id()]);
+  }
+
+  // Items each PE sent to another PE (sum over its replies).
+  uint64_t itemsSent(int pe) const { return sent_[pe]; }
+
+ private:
+  struct Request {
+    int32_t tile;
+    int32_t pe;
+  };
+
+  par::Runtime& runtime_;
+  std::vector<std::vector<std::vector<Item>>>& bins_;
+  std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
+  par::Channel<std::vector<Item>> replies_;
+  par::Channel<Request> requests_;
+};
+
+}  // namespace pr::raster

@@ -1,0 +1,67 @@
+// RegionAssignment: the region grids cover the screen exactly once, owners are dealt as
+// documented, overlap queries find exactly the regions a rectangle touches, and bad names and
+// tile sizes are input errors.
+#include <doctest/doctest.h>
+
+#include <set>
+#include <vector>
+
+#include "common/util/error.h"
+#include "raster/sort/bins.h"
+#include "raster/sort/region_assignment.h"
+
+namespace pr::raster {
+namespace {
+
+void checkCover(const RegionGrid& g, int w, int h) {
+  std::vector<int> hits(size_t(w) * h, 0);
+  for (int r = 0; r < g.regionCount(); ++r)
+    for (int y = g.region(r).y0; y < g.region(r).y1; ++y)
+      for (int x = g.region(r).x0; x < g.region(r).x1; ++x) hits[size_t(y) * w + x] += 1;
+  for (int v : hits) REQUIRE(v == 1);
+}
+
+TEST_CASE("RegionAssignment: strips and tiles cover the screen once with the documented owners") {
+  RegionGrid strips(50, 30, RegionStrategy::StaticStrips, 16, 4);
+  CHECK(strips.regionCount() == 4);
+  checkCover(strips, 50, 30);
+  for (int r = 0; r < 4; ++r) CHECK(strips.owner(r) == r);
+  RegionGrid tiles(50, 30, RegionStrategy::StaticTiles, 16, 3);
+  CHECK(tiles.regionCount() == 4 * 2);  // ceil(50/16) x ceil(30/16)
+  checkCover(tiles, 50, 30);
+  for (int r = 0; r < tiles.regionCount(); ++r) CHECK(tiles.owner(r) == r % 3);
+  CHECK(tiles.regionsOf(1) == std::vector<int>{1, 4, 7});
+  // More PEs than rows: one strip per row, the extra PEs own nothing.
+  RegionGrid thin(8, 3, RegionStrategy::StaticStrips, 16, 7);
+  CHECK(thin.regionCount() == 3);
+  CHECK(thin.regionsOf(5).empty());
+}
+
+TEST_CASE("RegionAssignment: overlap queries match a brute-force scan") {
+  RegionGrid tiles(50, 30, RegionStrategy::StaticTiles, 8, 3);
+  const Rect probes[] = {{0, 0, 1, 1}, {7, 7, 9, 9}, {-100, -5, 3, 40}, {49, 29, 60, 60}, {8, 8, 16, 16}, {60, 0, 70, 5}};
+  for (const Rect& b : probes) {
+    std::set<int> fast, brute;
+    tiles.forEachOverlapped(b, [&](int r) { fast.insert(r); });
+    for (int r = 0; r < tiles.regionCount(); ++r)
+      if (overlaps(tiles.region(r), b)) brute.insert(r);
+    CHECK(fast == brute);
+  }
+  std::vector<char> scratch(3, 0);
+  std::vector<int> owners;
+  ownersOf(tiles, Rect{0, 0, 50, 30}, scratch, owners);
+  CHECK(owners == std::vector<int>{0, 1, 2});
+  ownersOf(tiles, Rect{9, 1, 10, 2}, scratch, owners);  // tile 1 only
+  CHECK(owners == std::vector<int>{1});
+}
+
+TEST_CASE("RegionAssignment: unknown strategy and bad tile size are input errors") {
+  CHECK(parseRegionStrategy("static-tiles") == RegionStrategy::StaticTiles);
+  CHECK_THROWS_WITH_AS(parseRegionStrategy("diagonal"), doctest::Contains("unknown region assignment 'diagonal'"),
+                       InputError);
+  CHECK_THROWS_WITH_AS(RegionGrid(10, 10, RegionStrategy::StaticTiles, 0, 2), doctest::Contains("tile size 0"),
+                       InputError);
+}
+
+}  // namespace
+}  // namespace pr::raster

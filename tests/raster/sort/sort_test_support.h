@@ -1,0 +1,47 @@
+// Helpers for the sort-point tests: the hand-checked three-triangle scene and sums over the
+// runtime's run record.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "common/parallel/runtime.h"
+#include "raster/raster_test_scenes.h"
+#include "raster/stages/geometry.h"
+
+namespace pr::test {
+
+// 16 x 16 pixels through pixelOrthoCamera (pixel row j has its sample at world y = 7.5 - j).
+// Triangle 0 covers rows 2..5 only (top strip), triangle 1 rows 10..13 only (bottom strip),
+// triangle 2 rows 2..13 (both strips). All counter-clockwise, facing the camera.
+inline constexpr int kTinySize = 16;
+inline scene::Scene threeTriangles() {
+  scene::Scene s = emptyScene();
+  addTriangle(s, {-6, 6, 0}, {-6, 2, 0}, {-2, 6, 0});
+  addTriangle(s, {-6, -2, 0}, {-6, -6, 0}, {-2, -2, 0});
+  addTriangle(s, {2, 6, 0}, {2, -6, 0}, {6, 6, 0});
+  return s;
+}
+inline raster::FrameView tinyView() { return raster::makeFrameView(pixelOrthoCamera(kTinySize), kTinySize, kTinySize); }
+
+struct StageTraffic {
+  uint64_t messagesSent = 0, bytesSent = 0, messagesReceived = 0, bytesReceived = 0;
+};
+
+// Sums over the stages whose name starts with prefix (all stages for ""), over all PEs or one.
+inline StageTraffic stageTraffic(const par::RunRecord& record, const std::string& prefix, int pe = -1) {
+  StageTraffic t;
+  for (const par::StageRecord& s : record.stages) {
+    if (s.name.rfind(prefix, 0) != 0) continue;
+    for (size_t p = 0; p < s.pes.size(); ++p) {
+      if (pe >= 0 && int(p) != pe) continue;
+      t.messagesSent += s.pes[p].messagesSent;
+      t.bytesSent += s.pes[p].bytesSent;
+      t.messagesReceived += s.pes[p].messagesReceived;
+      t.bytesReceived += s.pes[p].bytesReceived;
+    }
+  }
+  return t;
+}
+
+}  // namespace pr::test
