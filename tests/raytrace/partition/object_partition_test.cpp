@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <future>
 
+#include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/integrators/integrator_scenes.h"
 #include "raytrace/partition/partitioned_test_support.h"
@@ -59,6 +60,24 @@ TEST_CASE("ObjectPartition: hot-spot scene = sequential for P = 8") {
 
 TEST_CASE("ObjectPartition: pieces of two triangles = sequential") {
   checkScene(test::bundledScene("cornell.gltf"), rt::IntegratorKind::Path, 1, {2, 3}, 2);
+}
+
+TEST_CASE("ObjectPartition: every schedule at P = 3 and 4 = sequential") {
+  // Schedules decide which PE makes which tile's camera rays; the rays' paths through the
+  // owners, and so the image, must not depend on it.
+  const scene::Scene s = scene::loadGltf(test::bundledScene("cornell.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 1);
+  const image::Image reference = test::renderSequential(s, cam, kW, kH, opt);
+  for (const par::ScheduleInfo& info : par::schedules())
+    for (int p : {3, 4}) {
+      CAPTURE(info.name);
+      CAPTURE(p);
+      rt::ObjectPartition partition;
+      const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, kW, kH, opt, p, std::string(info.name));
+      CHECK(run.image.pixels == reference.pixels);
+      test::checkTraffic(run, p);
+    }
 }
 
 TEST_CASE("ObjectPartition: shared glTF models = sequential") {
