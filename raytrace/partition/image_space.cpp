@@ -39,7 +39,10 @@ class ImageSpacePartition final : public Partition {
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
     std::vector<TileTask> tiles = makeTiles(job);
-    if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles);
+    // World model: the scene is replicated on every PE (DESIGN.md rule 1), counted in the
+    // first stage that reads it.
+    rt.recordBroadcast(job.scene.memoryBytes());
+    if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 
     par::TaskSet set;
@@ -50,8 +53,6 @@ class ImageSpacePartition final : public Partition {
     TraceCounters counters;
     std::atomic<int64_t> done{0};
     const int64_t total = int64_t(tiles.size());
-    // World model: the scene is replicated on every PE (DESIGN.md rule 1).
-    rt.recordBroadcast(job.scene.memoryBytes());
     rt.runStage("trace", set, [&](par::Pe&, par::TaskId id) {
       TraceStats stats;
       std::vector<RayMessage> queue;
@@ -77,15 +78,18 @@ class ImageSpacePartition final : public Partition {
     return tiles;
   }
 
-  // Low-resolution pre-pass on the controlling thread: rays traced per sampled pixel, scaled
-  // to the tile's pixel count. Its film is thrown away.
-  static void estimateCosts(const TraceJob& job, const Bvh& bvh, std::vector<TileTask>& tiles) {
+  // Low-resolution pre-pass, its own stage ("cost pre-pass", one task per tile, balanced split)
+  // so its time is measured with the render: rays traced per sampled pixel, scaled to the
+  // tile's pixel count. Each task writes only its tile's estimate; the scratch film is thrown away.
+  static void estimateCosts(const TraceJob& job, const Bvh& bvh, std::vector<TileTask>& tiles, par::Runtime& rt) {
     IntegratorOptions pre = job.options.integrator;
     pre.spp = 1;
     const Integrator integrator(job.scene, job.camera, job.width, job.height, pre);
     Film scratch(job.width, job.height, 1);
-    std::vector<RayMessage> queue;
-    for (TileTask& t : tiles) {
+    const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
+    rt.runStage("cost pre-pass", par::TaskSet::uniform(tiles.size()), *balanced, [&](par::Pe&, par::TaskId id) {
+      TileTask& t = tiles[size_t(id)];
+      std::vector<RayMessage> queue;
       TraceStats stats;
       int64_t sampled = 0;
       for (int y = t.rect.y0; y < t.rect.y1; y += kPrePassStride)
@@ -96,7 +100,7 @@ class ImageSpacePartition final : public Partition {
         }
       t.cost = sampled > 0 ? double(stats.total()) * double(t.rect.pixels()) / double(sampled) : 1.0;
       t.cost = std::max(t.cost, 1.0);
-    }
+    });
   }
 
   // Splits each tile costing more than kAdaptiveSplitFactor x the mean into four quarters

@@ -49,7 +49,10 @@ TEST_CASE("ImageSpace: cost estimates from the pre-pass reach cost-driven schedu
   opt.tileSizePx = 8;
   par::Runtime runtime(2, "hot-spots");
   rt::renderRays(f.s, f.cam, 32, 32, opt, "image-space", runtime);
-  const std::vector<par::TaskInfo>& tasks = runtime.record().stages[0].tasks;
+  // Two stages: the cost pre-pass, then the trace whose TaskSet carries the estimates.
+  REQUIRE(runtime.record().stages.size() == 2);
+  CHECK(runtime.record().stages[0].name == "cost pre-pass");
+  const std::vector<par::TaskInfo>& tasks = runtime.record().stages[1].tasks;
   REQUIRE(tasks.size() == 16u);
   double lo = tasks[0].costEstimate, hi = lo;
   for (const par::TaskInfo& t : tasks) lo = std::min(lo, t.costEstimate), hi = std::max(hi, t.costEstimate);
