@@ -58,7 +58,7 @@ class ProgressBar {
     lastPercent_ = percent;
     constexpr int kWidth = 40;
     const int filled = int(kWidth * done / total);
-    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %lld/%lld tasks %.1fs", filled, "########################################",
+    std::fprintf(stderr, "\r[%.*s%*s] %3d%% %lld/%lld %.1fs", filled, "########################################",
                  kWidth - filled, "", percent, (long long)done, (long long)total, elapsed);
     std::fflush(stderr);
     drawn_ = true;

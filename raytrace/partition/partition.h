@@ -31,8 +31,9 @@ struct TraceOptions {
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.
   const Bvh* worldBvh = nullptr;
-  // Called after each task with (tasks done, tasks total), from the PE that ran it: must be
-  // thread-safe and cheap. Empty = no progress reports.
+  // Called after each task with (tasks done, tasks total), from the PE that ran it (a
+  // single-task tracer may report finer units, e.g. rows): must be thread-safe and cheap.
+  // Empty = no progress reports.
   std::function<void(int64_t, int64_t)> progress;
 };
 

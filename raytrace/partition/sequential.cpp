@@ -44,13 +44,14 @@ class SequentialPartition final : public Partition {
     rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
       TraceStats stats;
       std::vector<RayMessage> queue;
-      // Row by row keeps the queue at one row of camera rays plus one path's messages.
+      // Row by row keeps the queue at one row of camera rays plus one path's messages; the
+      // single task reports its progress in rows.
       for (int y = 0; y < job.height; ++y) {
         integrator.cameraRays(PixelRect{0, y, job.width, y + 1}, queue);
         traceToCompletion(job.scene, bvh, integrator, queue, film, stats);
+        if (job.options.progress) job.options.progress(y + 1, job.height);
       }
       counters.add(stats);
-      if (job.options.progress) job.options.progress(1, 1);
     });
     return TraceResult{film.toImage(), counters.stats(), 1};
   }
