@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <bit>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -44,12 +45,16 @@ const Row kRows[] = {
     {"sort-last", RegionStrategy::StaticTiles, "binary-swap", true},
 };
 
-void checkScene(const scene::Scene& s, const FrameView& view) {
+// only / strategy: run the rows of this method and region assignment alone (empty: all), to
+// keep big scenes under a second per test case.
+void checkScene(const scene::Scene& s, const FrameView& view, const std::string& only = "", std::optional<RegionStrategy> strategy = {}) {
   const RegionFramebuffer reference = renderSequential(s, view);
   for (int pes : {1, 2, 3, 4, 7, 8}) {
     // Small batches and tiles so that every PE gets primitives and regions.
     const uint32_t batch = std::max<uint32_t>(1, uint32_t(s.triangles.size() / (2 * pes) + 1));
     for (const Row& row : kRows) {
+      if (!only.empty() && only != row.method) continue;
+      if (strategy && row.regions != *strategy) continue;
       if (std::string(row.compositor) == "binary-swap" && !std::has_single_bit(unsigned(pes))) continue;
       CAPTURE(pes);
       CAPTURE(row.method);
@@ -74,16 +79,38 @@ void checkScene(const scene::Scene& s, const FrameView& view) {
   }
 }
 
-void checkFile(const std::filesystem::path& path) {
+void checkFile(const std::filesystem::path& path, const std::string& only = "", std::optional<RegionStrategy> strategy = {}) {
   CAPTURE(path.string());
   setQuiet(true);
   const scene::Scene s = scene::loadGltf(path);
-  checkScene(s, makeFrameView(scene::selectCamera(s, "", float(kW) / kH), kW, kH));
+  checkScene(s, makeFrameView(scene::selectCamera(s, "", float(kW) / kH), kW, kH), only, strategy);
 }
 
-TEST_CASE("SortEquivalence: bundled Cornell box") { checkFile(test::sourceDir() / "scenes" / "cornell.gltf"); }
+TEST_CASE("SortEquivalence: bundled Cornell boxes") {
+  checkFile(test::sourceDir() / "scenes" / "cornell.gltf");
+  checkFile(test::sourceDir() / "scenes" / "cornell-diffuse.gltf");
+}
 
-TEST_CASE("SortEquivalence: bundled hot-spot scene") { checkFile(test::sourceDir() / "scenes" / "hotspot.gltf"); }
+// The hot-spot scene has 177k triangles: one test case per sort point.
+TEST_CASE("SortEquivalence: bundled hot-spot scene, sort-first static strips") {
+  checkFile(test::sourceDir() / "scenes" / "hotspot.gltf", "sort-first", RegionStrategy::StaticStrips);
+}
+
+TEST_CASE("SortEquivalence: bundled hot-spot scene, sort-first static tiles") {
+  checkFile(test::sourceDir() / "scenes" / "hotspot.gltf", "sort-first", RegionStrategy::StaticTiles);
+}
+
+TEST_CASE("SortEquivalence: bundled hot-spot scene, sort-first dynamic") {
+  checkFile(test::sourceDir() / "scenes" / "hotspot.gltf", "sort-first", RegionStrategy::Dynamic);
+}
+
+TEST_CASE("SortEquivalence: bundled hot-spot scene, sort-middle") {
+  checkFile(test::sourceDir() / "scenes" / "hotspot.gltf", "sort-middle");
+}
+
+TEST_CASE("SortEquivalence: bundled hot-spot scene, sort-last") {
+  checkFile(test::sourceDir() / "scenes" / "hotspot.gltf", "sort-last");
+}
 
 TEST_CASE("SortEquivalence: shared models with plain geometry and textures") {
   if (!test::haveSharedScenes()) return;
@@ -91,12 +118,16 @@ TEST_CASE("SortEquivalence: shared models with plain geometry and textures") {
     checkFile(test::sharedScenes() / m);
 }
 
-TEST_CASE("SortEquivalence: shared models with mirroring, lights and emission") {
+TEST_CASE("SortEquivalence: shared models with mirroring and emission") {
   if (!test::haveSharedScenes()) return;
   for (const char* m : {"NegativeScaleTest/glTF-Binary/NegativeScaleTest.glb",
-                        "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf",
                         "EmissiveStrengthTest/glTF-Binary/EmissiveStrengthTest.glb"})
     checkFile(test::sharedScenes() / m);
+}
+
+TEST_CASE("SortEquivalence: shared model with punctual lights") {
+  if (!test::haveSharedScenes()) return;
+  checkFile(test::sharedScenes() / "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf");
 }
 
 TEST_CASE("SortEquivalence: a near-plane-crossing triangle and a huge one") {
