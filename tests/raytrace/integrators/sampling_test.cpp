@@ -20,7 +20,7 @@ TEST_CASE("Sampling: a number depends only on (seed, pixel, sample, depth, dimen
   CHECK(a != sample1D(7, 123, 4, 2, Dim::kBsdfV));
 }
 
-TEST_CASE("Sampling: numbers lie in [0, 1) with mean 1/2 and variance 1/12") {
+TEST_CASE("Sampling: numbers lie in the half-open unit interval with mean 1/2 and variance 1/12") {
   double sum = 0.0, sum2 = 0.0;
   const int n = 100000;
   for (int i = 0; i < n; ++i) {

@@ -41,3 +41,18 @@ TEST_CASE("Sequential: Cornell box renders finite, lit and repeatable") {
     CHECK(brightest >= 30.0f);
   }
 }
+
+TEST_CASE("Sequential: the seed selects the random streams; the same seed gives the same image") {
+  const scene::Scene s = scene::loadGltf(test::sourceDir() / "scenes" / "cornell-diffuse.gltf");
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  auto render = [&](uint64_t seed) {
+    rt::TraceOptions opt;
+    opt.integrator.kind = rt::IntegratorKind::Path;
+    opt.integrator.seed = seed;
+    par::Runtime runtime(1);
+    return rt::renderRays(s, cam, 16, 16, opt, "sequential", runtime).image;
+  };
+  const image::Image a = render(1), b = render(1), c = render(2);
+  CHECK(a.pixels == b.pixels);
+  CHECK(a.pixels != c.pixels);
+}
