@@ -1,11 +1,15 @@
 // Shading stage: perspective-correct attribute interpolation and the metallic-roughness BRDF
 // under the scene's punctual lights (no shadows). Deferred: called once per visible pixel by
 // shadeRegion on the framebuffer owner, after all its triangles were rasterized, so overdraw
-// costs only depth tests.
+// costs only depth tests. Headlit untextured pixels go through four SSE lanes per step, each
+// lane repeating the scalar operations exactly, so the images do not change.
 #include "raster/stages/shade.h"
+
+#include <xmmintrin.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
 
 #include "common/scene/texture.h"
@@ -202,15 +206,229 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
   return radiance;
 }
 
+namespace {
+
+// ---- Four pixels at a time ------------------------------------------------------------------
+// The common case (headlight, untextured materials, no vertex colours) is shaded in SSE lanes.
+// Each lane performs exactly the scalar operations of barycentricsFromEdges, surfaceAt and
+// shadeSurface, in the same order and without contraction (IEEE add, mul, div and sqrt are
+// correctly rounded in scalar and vector form alike), so a pixel's colour does not depend on
+// which pixels share its batch, nor on the region split: the images stay bit-identical to the
+// scalar path. SSE2 is part of x86-64, so no -march is needed.
+constexpr int kLanes = 4;
+using F4 = float __attribute__((vector_size(16)));
+using I4 = int32_t __attribute__((vector_size(16)));
+
+inline F4 splat(float v) { return F4{v, v, v, v}; }
+inline F4 load(const float* p) {
+  F4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline F4 sqrt4(F4 v) { return (F4)_mm_sqrt_ps((__m128)v); }
+// std::max(a, b) is (a < b) ? b : a; the same comparison keeps NaN and -0 behaviour.
+inline F4 max4(F4 a, F4 b) { return (a < b) ? b : a; }
+
+struct V3 {
+  F4 x, y, z;
+};
+inline F4 dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// Shading constants of one material under the headlight (headlightBrdf's per-material terms).
+struct HeadlightMaterial {
+  bool fast = false;  // no texture slot: every term below is a constant of the material
+  float alpha2 = 0.0f, k = 0.0f, oneMinusK = 0.0f;
+  glm::vec3 f0{0.0f}, diffuse{0.0f}, emission{0.0f};
+};
+
+HeadlightMaterial headlightMaterial(const scene::Material& m) {
+  HeadlightMaterial h;
+  h.fast = !m.baseColorTexture.present() && !m.metallicRoughnessTexture.present() && !m.emissiveTexture.present();
+  // As shadeSurface and headlightBrdf compute them (sp.colour = 1 without vertex colours).
+  glm::vec3 base(m.baseColorFactor * glm::vec4(1.0f));
+  float r = std::max(m.roughnessFactor, kMinRoughness);
+  float alpha = r * r;
+  h.alpha2 = alpha * alpha;
+  h.k = 0.5f * alpha;
+  h.oneMinusK = 1.0f - h.k;
+  h.f0 = glm::mix(glm::vec3(0.04f), base, m.metallicFactor);
+  h.diffuse = ((1.0f - m.metallicFactor) / kPi) * base;
+  h.emission = m.emission();
+  return h;
+}
+
+// The fields of one triangle's lane inputs: what barycentrics, surface point and BRDF read.
+enum Field : int {
+  kInvW0, kInvW1, kInvW2,
+  kBary0X, kBary0Y, kBary1X, kBary1Y, kBary2X, kBary2Y,
+  kP0X, kP0Y, kP0Z, kP1X, kP1Y, kP1Z, kP2X, kP2Y, kP2Z,
+  // Vertex normals, or (without them) the triangle's finished face normal in kN0*.
+  kN0X, kN0Y, kN0Z, kN1X, kN1Y, kN1Z, kN2X, kN2Y, kN2Z,
+  kBack, kAlpha2, kK, kOneMinusK, kF0X, kF0Y, kF0Z, kDiffX, kDiffY, kDiffZ, kEmitX, kEmitY, kEmitZ,
+  kTriangleFields
+};
+
+// kLanes pixels waiting to be shaded: their edge values and where their triangle's fields are.
+struct LaneBatch {
+  alignas(16) float e[3][kLanes];
+  const float* tri[kLanes];
+  size_t pixel[kLanes];
+  int count = 0;
+};
+
+// The lane fields of one screen triangle: its vertices' attributes and its material's constants.
+void triangleFields(const scene::Scene& scene, const ScreenTriangle& tri, const HeadlightMaterial& hm,
+                    float* out) {
+  const scene::Triangle& t = scene.triangles[tri.primitive];
+  float* o = out;
+  for (int k = 0; k < 3; ++k) *o++ = tri.invW[k];
+  for (int k = 0; k < 3; ++k) {
+    *o++ = tri.bary[k].x;
+    *o++ = tri.bary[k].y;
+  }
+  for (int k = 0; k < 3; ++k) {
+    const glm::vec3& p = scene.positions[t.v[k]];
+    *o++ = p.x;
+    *o++ = p.y;
+    *o++ = p.z;
+  }
+  if (!scene.normals.empty()) {
+    for (int k = 0; k < 3; ++k) {
+      const glm::vec3& n = scene.normals[t.v[k]];
+      *o++ = n.x;
+      *o++ = n.y;
+      *o++ = n.z;
+    }
+  } else {
+    // surfaceAt's face normal, finished once per triangle.
+    const glm::vec3& p0 = scene.positions[t.v[0]];
+    glm::vec3 n = glm::cross(scene.positions[t.v[1]] - p0, scene.positions[t.v[2]] - p0);
+    float len2 = glm::dot(n, n);
+    n = len2 > 0.0f ? n / std::sqrt(len2) : glm::vec3(0.0f, 0.0f, 1.0f);
+    if (tri.backFacing) n = -n;
+    for (int k = 0; k < 9; ++k) *o++ = k < 3 ? n[k] : 0.0f;
+  }
+  *o++ = tri.backFacing ? 1.0f : 0.0f;
+  *o++ = hm.alpha2;
+  *o++ = hm.k;
+  *o++ = hm.oneMinusK;
+  for (int k = 0; k < 3; ++k) *o++ = hm.f0[k];
+  for (int k = 0; k < 3; ++k) *o++ = hm.diffuse[k];
+  for (int k = 0; k < 3; ++k) *o++ = hm.emission[k];
+}
+
+// barycentricsFromEdges + surfaceAt + shadeSurface (headlight) on kLanes pixels.
+// kUniform: all lanes show one triangle, whose fields are then broadcast instead of gathered.
+template <bool kVertexNormals, bool kUniform>
+void shadeBatch(const ShadingContext& ctx, const LaneBatch& b, glm::vec3* colours) {
+  auto f = [&b](int k) {
+    if constexpr (kUniform) return splat(b.tri[0][k]);
+    else return F4{b.tri[0][k], b.tri[1][k], b.tri[2][k], b.tri[3][k]};
+  };
+  // Perspective-correct barycentrics (barycentricsFromEdges).
+  F4 w0 = load(b.e[0]) * f(kInvW0), w1 = load(b.e[1]) * f(kInvW1), w2 = load(b.e[2]) * f(kInvW2);
+  F4 inv = splat(1.0f) / (w0 + w1 + w2);
+  F4 s0 = w0 * inv, s1 = w1 * inv, s2 = w2 * inv;
+  F4 bx = s0 * f(kBary0X) + s1 * f(kBary1X) + s2 * f(kBary2X);
+  F4 by = s0 * f(kBary0Y) + s1 * f(kBary1Y) + s2 * f(kBary2Y);
+  F4 c0 = splat(1.0f) - bx - by, c1 = bx, c2 = by;
+  // Surface point (surfaceAt).
+  V3 p{c0 * f(kP0X) + c1 * f(kP1X) + c2 * f(kP2X), c0 * f(kP0Y) + c1 * f(kP1Y) + c2 * f(kP2Y),
+       c0 * f(kP0Z) + c1 * f(kP1Z) + c2 * f(kP2Z)};
+  V3 n{f(kN0X), f(kN0Y), f(kN0Z)};
+  if constexpr (kVertexNormals) {
+    V3 m{c0 * f(kN0X) + c1 * f(kN1X) + c2 * f(kN2X), c0 * f(kN0Y) + c1 * f(kN1Y) + c2 * f(kN2Y),
+         c0 * f(kN0Z) + c1 * f(kN1Z) + c2 * f(kN2Z)};
+    F4 len2 = dot(m, m);
+    F4 len = sqrt4(len2);
+    I4 ok = len2 > splat(0.0f);
+    n = V3{ok ? m.x / len : splat(0.0f), ok ? m.y / len : splat(0.0f), ok ? m.z / len : splat(1.0f)};
+    I4 back = f(kBack) != splat(0.0f);
+    n = V3{back ? -n.x : n.x, back ? -n.y : n.y, back ? -n.z : n.z};
+  }
+  // View vector (shadeSurface): normalize(eye - p) = d * (1 / sqrt(dot(d, d))), as glm does.
+  V3 v;
+  if (ctx.view.perspective) {
+    V3 d{splat(ctx.view.eye.x) - p.x, splat(ctx.view.eye.y) - p.y, splat(ctx.view.eye.z) - p.z};
+    F4 is = splat(1.0f) / sqrt4(dot(d, d));
+    v = V3{d.x * is, d.y * is, d.z * is};
+  } else {
+    v = V3{splat(-ctx.view.forward.x), splat(-ctx.view.forward.y), splat(-ctx.view.forward.z)};
+  }
+  // headlightBrdf.
+  F4 ndotv = dot(n, v);
+  F4 c = max4(ndotv, splat(1e-4f));
+  V3 nxv{n.y * v.z - v.y * n.z, n.z * v.x - v.z * n.x, n.x * v.y - v.x * n.y};
+  F4 alpha2 = f(kAlpha2);
+  F4 denom = dot(nxv, nxv) + c * c * alpha2;
+  F4 g = c * f(kOneMinusK) + f(kK);
+  F4 spec = alpha2 / (splat(4.0f * kPi) * denom * denom * g * g);
+  F4 scale = splat(kHeadlightLux) * ndotv;
+  I4 lit = ndotv > splat(0.0f);
+  F4 rx = f(kEmitX), ry = f(kEmitY), rz = f(kEmitZ);
+  rx = lit ? rx + (f(kDiffX) + f(kF0X) * spec) * scale : rx;
+  ry = lit ? ry + (f(kDiffY) + f(kF0Y) * spec) * scale : ry;
+  rz = lit ? rz + (f(kDiffZ) + f(kF0Z) * spec) * scale : rz;
+  for (int l = 0; l < b.count; ++l) colours[b.pixel[l]] = glm::vec3(rx[l], ry[l], rz[l]);
+}
+
+}  // namespace
+
 void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
                  ShadeCounters* counters) {
+  const scene::Scene& scene = *ctx.scene;
   const Rect rect = fb.rect();
   const uint64_t* keys = fb.keys();
   const uint32_t* triangles = fb.triangles();
   glm::vec3* colours = fb.colours();
-  // Neighbouring pixels mostly show the same triangle: keep its setup.
+
+  // Lanes take the headlight path with per-material constants; anything else (punctual lights,
+  // textures, vertex colours) is shaded one pixel at a time by shadeSurface.
+  const bool lanes = ctx.usesHeadlight && scene.colors.empty();
+  std::vector<HeadlightMaterial> materials;
+  if (lanes) {
+    materials.reserve(scene.materials.size());
+    for (const scene::Material& m : scene.materials) materials.push_back(headlightMaterial(m));
+  }
+  const bool vertexNormals = !scene.normals.empty();
+  LaneBatch batch;
+  auto flush = [&] {
+    if (batch.count == 0) return;
+    // Unused lanes repeat lane 0 (finite inputs); only batch.count colours are written.
+    for (int l = batch.count; l < kLanes; ++l) {
+      for (int k = 0; k < 3; ++k) batch.e[k][l] = batch.e[k][0];
+      batch.tri[l] = batch.tri[0];
+    }
+    const bool uniform = batch.tri[1] == batch.tri[0] && batch.tri[2] == batch.tri[0] && batch.tri[3] == batch.tri[0];
+    static_assert(kLanes == 4);
+    if (vertexNormals) {
+      if (uniform) shadeBatch<true, true>(ctx, batch, colours);
+      else shadeBatch<true, false>(ctx, batch, colours);
+    } else {
+      if (uniform) shadeBatch<false, true>(ctx, batch, colours);
+      else shadeBatch<false, false>(ctx, batch, colours);
+    }
+    batch.count = 0;
+  };
+
+  // Neighbouring pixels mostly show the same triangle: keep its setup and lane fields. The
+  // fields live in a ring of kLanes + 1 slots: a batch's lanes refer to at most the kLanes most
+  // recent triangles, so the slot overwritten next is never one the pending batch reads.
   uint32_t cached = kNoTriangle;
+  const float* cachedFields = nullptr;
   EdgeFunctions s{};
+  float ring[kLanes + 1][kTriangleFields];
+  int slot = 0;
+  // Pixels i + 1 .. i + kLanes - 1 are covered by the triangle of pixel i.
+  auto sameTriangleRun = [&](size_t i) {
+    for (int l = 1; l < kLanes; ++l) {
+      if (!keyCovered(keys[i + l]) || triangles[i + l] != triangles[i]) return false;
+    }
+    return true;
+  };
+  uint32_t runTriangle = kNoTriangle;
+  int runX = 0, runY = 0;
+  int64_t e[3] = {0, 0, 0};
   uint64_t shaded = 0;
   size_t i = 0;
   for (int y = rect.y0; y < rect.y1; ++y) {
@@ -220,12 +438,58 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
       if (triangles[i] != cached) {
         edgeFunctions(tri, s);
         cached = triangles[i];
+        cachedFields = nullptr;
+        if (lanes) {
+          const HeadlightMaterial& hm = materials[scene.triangles[tri.primitive].material];
+          if (hm.fast) {
+            slot = slot == kLanes ? 0 : slot + 1;
+            triangleFields(scene, tri, hm, ring[slot]);
+            cachedFields = ring[slot];
+          }
+        }
       }
-      glm::vec3 b = barycentricsFromEdges(tri, edgeAt(s, 0, x, y), edgeAt(s, 1, x, y), edgeAt(s, 2, x, y));
-      colours[i] = shadeSurface(ctx, surfaceAt(*ctx.scene, tri, b));
+      // Along a run of one triangle the edge values step by a * 256 (exact integers, equal to
+      // edgeAt); a new triangle or row starts from edgeAt.
+      if (triangles[i] == runTriangle && y == runY && x == runX + 1) {
+        for (int k = 0; k < 3; ++k) e[k] += s.a[k] * kSubpixelScale;
+      } else {
+        for (int k = 0; k < 3; ++k) e[k] = edgeAt(s, k, x, y);
+        runTriangle = triangles[i];
+        runY = y;
+      }
+      runX = x;
+      const int64_t e0 = e[0], e1 = e[1], e2 = e[2];
       ++shaded;
+      if (!cachedFields) {
+        colours[i] = shadeSurface(ctx, surfaceAt(scene, tri, barycentricsFromEdges(tri, e0, e1, e2)));
+        continue;
+      }
+      // A run of kLanes pixels of this triangle starting a batch fills it at once.
+      if (batch.count == 0 && x + kLanes <= rect.x1 && sameTriangleRun(i)) {
+        for (int l = 0; l < kLanes; ++l) {
+          for (int k = 0; k < 3; ++k) batch.e[k][l] = float(e[k] + l * s.a[k] * kSubpixelScale);
+          batch.tri[l] = cachedFields;
+          batch.pixel[l] = i + static_cast<size_t>(l);
+        }
+        batch.count = kLanes;
+        flush();
+        for (int k = 0; k < 3; ++k) e[k] += (kLanes - 1) * s.a[k] * kSubpixelScale;
+        x += kLanes - 1;
+        i += kLanes - 1;
+        runX = x;
+        shaded += kLanes - 1;
+        continue;
+      }
+      const int l = batch.count;
+      batch.e[0][l] = float(e0);
+      batch.e[1][l] = float(e1);
+      batch.e[2][l] = float(e2);
+      batch.tri[l] = cachedFields;
+      batch.pixel[l] = i;
+      if (++batch.count == kLanes) flush();
     }
   }
+  flush();
   if (counters) counters->pixelsShaded += shaded;
 }
 
