@@ -143,6 +143,7 @@ void addRenderCommand(CLI::App& app) {
   par::addScheduleOptions(*cmd, args->schedule);
   par::addRunOutputOptions(*cmd, args->outputs);
   addRayOptions(*cmd, args->settings, args->family);
+  addRasterOptions(*cmd, args->settings, args->family);
   cmd->callback([args] { run(*args); });
 }
 

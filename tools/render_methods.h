@@ -34,9 +34,20 @@ struct RayOptions {
   bool adaptive = false;
 };
 
+// Options of the rasterization family (raster/sort/sort_point.h SortOptions, plus frames).
+struct RasterOptions {
+  int tileSizePx = 32;
+  std::string regions = "static-tiles";
+  std::string compositor = "direct-send";
+  bool sparse = false;
+  int frames = 1;
+  bool orbit = false;
+};
+
 // Every family's options, filled by CLI11.
 struct RenderSettings {
   RayOptions ray;
+  RasterOptions raster;
 };
 
 // What a method needs for one render.
@@ -72,6 +83,7 @@ std::string describeRenderMethods();
 // Family-specific options as registered on the command: checked after parsing.
 using FamilyOptions = std::vector<std::pair<CLI::Option*, MethodFamily>>;
 void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family);
+void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family);
 // Throws pr::InputError when an option of another family than the method's was given.
 void checkFamilyOptions(const RenderMethod& method, const FamilyOptions& family);
 
