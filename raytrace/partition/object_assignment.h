@@ -45,6 +45,8 @@ class ObjectAssignment {
   std::span<const uint32_t> triangles(int pe) const { return perPe_[pe]; }
   // Indices into pieces() of the pieces PE `pe` owns.
   std::span<const uint32_t> piecesOf(int pe) const { return piecesOf_[pe]; }
+  // Bytes of the directory every PE keeps to route rays: each piece's bounds and owner.
+  size_t directoryBytes() const { return pieces_.size() * (sizeof(scene::Bounds) + sizeof(int)); }
 
   // The owners of pieces whose grown bounds the ray can reach for t in [tMin, tMax],
   // ascending, each once (cleared first). A pure function of the ray.

@@ -65,8 +65,9 @@ class ObjectFrame {
     });
     queries_ = &queries;
     hits_ = &hits;
-    // Materials, textures and lights are replicated on every PE; geometry is not.
-    rt_.recordBroadcast(shadingDataBytes(job_.scene));
+    // Materials, textures, lights and the directory of piece bounds and owners are replicated
+    // on every PE; geometry is not.
+    rt_.recordBroadcast(shadingDataBytes(job_.scene) + assignment_.directoryBytes());
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();

@@ -29,6 +29,4 @@ class ObjectPartition final : public Partition {
   PartitionFigures figures_;
 };
 
-std::unique_ptr<Partition> makeObjectPartition();
-
 }  // namespace pr::rt

@@ -59,8 +59,9 @@ class ObjectSpaceFrame {
     std::atomic<int64_t> done{0};
     par::Channel<TravellingRay> rays(rt_, "rays", [this](par::Pe& pe, TravellingRay&& r) { trace(pe, r); });
     rays_ = &rays;
-    // Materials, textures and lights are replicated on every PE; geometry is not.
-    rt_.recordBroadcast(shadingDataBytes(job_.scene));
+    // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
+    // every PE; geometry is not.
+    rt_.recordBroadcast(shadingDataBytes(job_.scene) + split_.treeBytes() + owners_.size() * sizeof(int));
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;

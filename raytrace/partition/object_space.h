@@ -27,6 +27,4 @@ class ObjectSpacePartition final : public Partition {
   PartitionFigures figures_;
 };
 
-std::unique_ptr<Partition> makeObjectSpacePartition();
-
 }  // namespace pr::rt

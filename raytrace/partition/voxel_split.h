@@ -52,6 +52,8 @@ class VoxelSplit {
   int voxelAt(glm::vec3 p) const;
   // Total triangles over all voxels (> the scene's when triangles straddle splits).
   size_t storedTriangles() const;
+  // Bytes of the kd tree itself, which every PE keeps a copy of to route rays.
+  size_t treeBytes() const { return nodes_.size() * sizeof(Node); }
 
   // Calls visit(const VoxelSpan&) for each voxel the ray passes through for t in
   // [tMin, tMax], nearest first, until visit returns false. A ray lying in a split plane
