@@ -90,6 +90,7 @@ bool refractDirection(const glm::vec3& w, const glm::vec3& n, float eta, glm::ve
 }
 
 float specularProbability(const ShadingMaterial& m, float cosO) {
+  if (!m.hasSpecular()) return 0.0f;
   const float ws = luminance(fresnelSchlick(m.specularF0(), cosO));
   const float wd = luminance(m.diffuseColor());
   return ws + wd > 0.0f ? ws / (ws + wd) : 0.0f;
@@ -98,7 +99,7 @@ float specularProbability(const ShadingMaterial& m, float cosO) {
 glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
   glm::vec3 f = m.diffuseColor() * kInvPi;
-  if (!m.deltaSpecular()) {
+  if (m.hasSpecular() && !m.deltaSpecular()) {
     const glm::vec3 h = glm::normalize(wo + wi);
     const float oh = glm::dot(wo, h);
     const float d = ggxD(m.alpha, h.z);
@@ -112,7 +113,7 @@ float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& 
   if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
   const float ps = specularProbability(m, wo.z);
   float pdf = (1.0f - ps) * wi.z * kInvPi;
-  if (!m.deltaSpecular()) pdf += ps * ggxPdf(m.alpha, wo, wi);
+  if (ps > 0.0f && !m.deltaSpecular()) pdf += ps * ggxPdf(m.alpha, wo, wi);
   return pdf;
 }
 

@@ -36,6 +36,12 @@ struct ShadingMaterial {
     const float dielectric = roughness < 1.0f ? 0.04f : 0.0f;
     return glm::mix(glm::vec3(dielectric) * (1.0f - transmission), baseColor, metallic);
   }
+  // No specular lobe at all when F0 is zero (a fully rough dielectric): Schlick's grazing
+  // term would otherwise add a little reflection on top of the Lambertian albedo.
+  bool hasSpecular() const {
+    const glm::vec3 f0 = specularF0();
+    return f0.x > 0.0f || f0.y > 0.0f || f0.z > 0.0f;
+  }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }
   // Share of the smooth dielectric (refracting) part.
   float dielectricWeight() const { return transmission * (1.0f - metallic); }
