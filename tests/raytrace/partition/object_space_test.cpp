@@ -81,6 +81,27 @@ TEST_CASE("ObjectSpace: every schedule at P = 3 and 4 = sequential") {
     }
 }
 
+TEST_CASE("ObjectSpace: scene scales 1e-4 and 1e5 = sequential") {
+  // The margins grow with the scene's coordinates (partition_margin.h): at every scale the
+  // partitioned hits must be the full BVH's.
+  for (float k : {1e-4f, 1e5f}) {
+    scene::Scene s = scene::loadGltf(test::bundledScene("cornell.gltf"));
+    test::scaleScene(s, k);
+    const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
+    const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 1);
+    const image::Image reference = test::renderSequential(s, cam, kW, kH, opt);
+    CHECK(std::any_of(reference.pixels.begin(), reference.pixels.end(),
+                      [](const glm::vec3& c) { return c.x + c.y + c.z > 0.0f; }));
+    for (int p : {3, 8}) {
+      CAPTURE(k);
+      CAPTURE(p);
+      rt::ObjectSpacePartition partition;
+      const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, kW, kH, opt, p);
+      CHECK(run.image.pixels == reference.pixels);
+    }
+  }
+}
+
 TEST_CASE("ObjectSpace: shared glTF models = sequential") {
   if (!test::haveSharedScenes()) return;
   for (const char* file : {"BoxTextured/glTF/BoxTextured.gltf", "LightsPunctualLamp/glTF/LightsPunctualLamp.gltf",

@@ -98,6 +98,28 @@ inline void addHeadlightIfUnlit(scene::Scene& s, const scene::Camera& cam) {
   s.lights.push_back(light);
 }
 
+// The scene and its cameras and punctual lights scaled by k about the origin (radiance from
+// area lights does not depend on scale; punctual intensities are scaled by k^2 to match).
+inline void scaleScene(scene::Scene& s, float k) {
+  for (glm::vec3& p : s.positions) p *= k;
+  s.bounds = scene::Bounds{};
+  for (const glm::vec3& p : s.positions) s.bounds.extend(p);
+  for (scene::Object& o : s.objects) o.bounds = scene::Bounds{k * o.bounds.min, k * o.bounds.max};
+  for (scene::AreaLight& a : s.areaLights) a.area *= k * k;
+  for (scene::PunctualLight& l : s.lights) {
+    l.position *= k;
+    l.intensity *= k * k;
+    l.range *= k;
+  }
+  for (scene::Camera& c : s.cameras) {
+    c.cameraToWorld[3] = glm::vec4(k * glm::vec3(c.cameraToWorld[3]), 1.0f);
+    c.znear *= k;
+    c.zfar *= k;
+    c.xmag *= k;
+    c.ymag *= k;
+  }
+}
+
 inline std::filesystem::path bundledScene(const char* name) { return sourceDir() / "scenes" / name; }
 
 }  // namespace pr::test
