@@ -139,5 +139,15 @@ TEST_CASE("SortEquivalence: a near-plane-crossing triangle and a huge one") {
   checkScene(s, makeFrameView(cam, kW, kH));
 }
 
+TEST_CASE("SortEquivalence: a screen with fewer rows and columns than PEs") {
+  // 5 x 3 pixels: strips and compositing regions run out before the PEs do, and binary-swap
+  // halves become empty; every PE still takes part and the image is unchanged.
+  scene::Scene s = test::threeTriangles();
+  test::addTriangle(s, {-1.5f, -1.5f, 0.5f}, {1.5f, -1.5f, 0.5f}, {0.0f, 1.5f, 0.5f});
+  const FrameView view = makeFrameView(test::pixelOrthoCamera(4), 5, 3);
+  REQUIRE(renderSequential(s, view).coveredPixels() > 0);
+  checkScene(s, view);
+}
+
 }  // namespace
 }  // namespace pr::raster
