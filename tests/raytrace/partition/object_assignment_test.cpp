@@ -44,7 +44,7 @@ pr::scene::Scene objectsScene(const std::vector<uint32_t>& sizes) {
 
 }  // namespace
 
-TEST_CASE("ObjectAssignment: every triangle has exactly one owner; pieces stay within objects") {
+TEST_CASE("ObjectAssignment: every triangle has exactly one owner and pieces stay within objects") {
   const pr::scene::Scene s = objectsScene({500, 40, 40, 10, 300});
   const ObjectAssignment a(s, {3, 100, 0.0f});
   REQUIRE(a.pes() == 3);

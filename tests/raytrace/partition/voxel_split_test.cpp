@@ -226,7 +226,7 @@ TEST_CASE("VoxelSplit: rays lying in split planes find the same hits as the full
   for (const VoxelSpan& span : split.spans(leave)) CHECK(split.cell(span.voxel).max.x <= leave.origin.x);
 }
 
-TEST_CASE("VoxelSplit: one voxel holds the whole scene; bad counts are input errors") {
+TEST_CASE("VoxelSplit: one voxel holds the whole scene, bad counts are input errors") {
   const pr::scene::Scene s = pr::test::randomSoup(50);
   const VoxelSplit one(s, {1, 0.0f});
   CHECK(one.voxels() == 1);
