@@ -5,9 +5,12 @@
 // (geometry again, rasterize, shade) on their regions. The scene itself is replicated
 // read-only data (world model); a message carries 4-byte primitive ids.
 #include <algorithm>
+#include <numeric>
 #include <optional>
+#include <span>
 
 #include "common/parallel/channel.h"
+#include "common/util/error.h"
 #include "raster/sort/bins.h"
 #include "raster/sort/sort_point.h"
 #include "raster/sort/tile_pull.h"
@@ -18,18 +21,41 @@
 namespace pr::raster {
 namespace {
 
-// Pixel bounds of all pieces of scene triangle `index` (empty when it is culled or clipped
-// away): the pre-transform, the same geometry function the owners run in full.
-Rect primitiveBounds(const scene::Scene& scene, const FrameView& view, uint32_t index) {
-  ScreenTriangle pieces[kMaxSubTriangles];
-  const int n = processTriangle(scene, view, index, pieces);
-  Rect b;
-  for (int i = 0; i < n; ++i) {
-    const Rect r = pixelBounds(pieces[i]);
-    if (r.empty()) continue;
-    b = b.empty() ? r : Rect{std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
+// Geometry for a sorted list of primitive ids, appended in id order: runs of consecutive ids
+// go through processTriangles (each shared vertex prepared once); the bits are the same as
+// one primitive at a time (geometry.h).
+void transformPrimitives(const scene::Scene& scene, const FrameView& view, std::span<const uint32_t> ids,
+                         std::vector<ScreenTriangle>& out) {
+  constexpr size_t kRun = 4096;
+  for (size_t i = 0; i < ids.size();) {
+    size_t j = i + 1;
+    while (j < ids.size() && ids[j] == ids[j - 1] + 1 && j - i < kRun) ++j;
+    processTriangles(scene, view, ids[i], static_cast<uint32_t>(j - i), out);
+    i = j;
   }
-  return b;
+}
+
+// The pre-transform: pixel bounds of all pieces of each primitive of a sorted id list (empty
+// when it is culled or clipped away), by the same geometry function the owners run in full.
+std::vector<Rect> primitiveBounds(const scene::Scene& scene, const FrameView& view, std::span<const uint32_t> ids) {
+  std::vector<Rect> bounds(ids.size());
+  std::vector<ScreenTriangle> pieces;
+  constexpr size_t kChunk = 4096;
+  for (size_t c0 = 0; c0 < ids.size(); c0 += kChunk) {
+    const size_t c1 = std::min(ids.size(), c0 + kChunk);
+    pieces.clear();
+    transformPrimitives(scene, view, ids.subspan(c0, c1 - c0), pieces);
+    size_t k = c0;
+    for (const ScreenTriangle& t : pieces) {
+      while (ids[k] != t.primitive) ++k;  // pieces come in id order
+      PR_DCHECK(k < c1, "sort-first: a piece of a primitive outside the chunk");
+      const Rect r = pixelBounds(t);
+      if (r.empty()) continue;
+      Rect& b = bounds[k];
+      b = b.empty() ? r : Rect{std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
+    }
+  }
+  return bounds;
 }
 
 class SortFirst : public SortPoint {
@@ -77,14 +103,15 @@ class SortFirst : public SortPoint {
       std::vector<std::vector<uint32_t>> out(pes);
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
-      for (uint32_t id : held_[p]) {
-        ownersOf(grid, primitiveBounds(f.scene, f.view, id), scratch, owners);
-        c.preTransforms += 1;
+      const std::vector<uint32_t>& held = held_[p];  // sorted
+      const std::vector<Rect> now = primitiveBounds(f.scene, f.view, held);
+      const std::vector<Rect> then = previous_ ? primitiveBounds(f.scene, previous_->view, held) : std::vector<Rect>();
+      c.preTransforms += held.size() + then.size();
+      for (size_t k = 0; k < held.size(); ++k) {
+        const uint32_t id = held[k];
+        ownersOf(grid, now[k], scratch, owners);
         before.clear();
-        if (previous_) {
-          ownersOf(previous_->grid, primitiveBounds(f.scene, previous_->view, id), scratch, before);
-          c.preTransforms += 1;
-        }
+        if (previous_) ownersOf(previous_->grid, then[k], scratch, before);
         const bool primary = before.empty() || before.front() == p;
         const bool ownNow = std::binary_search(owners.begin(), owners.end(), p);
         if (ownNow || (primary && owners.empty())) kept[p].push_back(id);  // keeper of an unseen one
@@ -121,11 +148,7 @@ class SortFirst : public SortPoint {
       std::sort(mine.begin(), mine.end());
       mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
       std::vector<ScreenTriangle> tris;
-      ScreenTriangle pieces[kMaxSubTriangles];
-      for (uint32_t id : mine) {
-        const int n = processTriangle(f.scene, f.view, id, pieces);
-        tris.insert(tris.end(), pieces, pieces + n);
-      }
+      transformPrimitives(f.scene, f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
       drawn[p] = drawOwnedRegions(ctx, tris, grid, p);
     });
@@ -161,9 +184,13 @@ class SortFirst : public SortPoint {
       SortCounters& c = counters[p];
       const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);
       const uint32_t hi = static_cast<uint32_t>(uint64_t(total) * (p + 1) / pes);
-      for (uint32_t id = lo; id < hi; ++id) {
+      std::vector<uint32_t> held(hi - lo);
+      std::iota(held.begin(), held.end(), lo);
+      const std::vector<Rect> bounds = primitiveBounds(f.scene, f.view, held);
+      for (size_t k = 0; k < held.size(); ++k) {
+        const uint32_t id = held[k];
         uint64_t n = 0;
-        grid.forEachOverlapped(primitiveBounds(f.scene, f.view, id), [&](int r) {
+        grid.forEachOverlapped(bounds[k], [&](int r) {
           bins[p][r].push_back(id);
           ++n;
         });
@@ -182,13 +209,10 @@ class SortFirst : public SortPoint {
         set.tasks[r].y = 0.5f * float(grid.region(r).y0 + grid.region(r).y1);
       }
       rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
-        const std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
+        std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
+        std::sort(ids.begin(), ids.end());  // arrival order -> id order, for runs of ids
         std::vector<ScreenTriangle> tris;
-        ScreenTriangle pieces[kMaxSubTriangles];
-        for (uint32_t id : ids) {
-          const int n = processTriangle(f.scene, f.view, id, pieces);
-          tris.insert(tris.end(), pieces, pieces + n);
-        }
+        transformPrimitives(f.scene, f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
         RegionFramebuffer fb(grid.region(static_cast<int>(t)));
         rasterizeTriangles(tris, fb);
