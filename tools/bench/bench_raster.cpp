@@ -1,8 +1,9 @@
 // bench_raster: frame time of the raster pipelines against Mesa's llvmpipe in the same run
-// (shared/ANCHORS.md). For the 1M-triangle landscape and the Cornell box: ms per frame by stage
-// (geometry, clear + rasterize, shade), Mtriangles/s and Mpixels/s of the sequential pipeline,
-// then llvmpipe drawing the same scene, camera and size (one child process per LP_NUM_THREADS
-// value, since a process can use only one) and the ratio parrender / llvmpipe. Not in ctest.
+// (shared/ANCHORS.md). For the 1M-triangle landscape and the Cornell box: the sequential pipeline
+// by stage (geometry, clear, rasterize, shade), then every sort point at P=1 and P=2 (speed-up
+// and efficiency), each with Mtriangles/s, Mpixels/s and its ratio to llvmpipe drawing the same
+// scene, camera and size (LP_NUM_THREADS=0 beside P=1, =1 beside P=2; one child process per
+// value, since a process can use only one). Wall and CPU time, medians. Not in ctest.
 //   bench_raster [--landscape FILE] [--cornell FILE] [--width 1920] [--height 1080] [--frames 7]
 //                [--anchor PATH/llvmpipe_anchor] [--no-anchor]
 #include <sys/resource.h>
@@ -18,14 +19,17 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/parallel/runtime.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
 #include "common/util/error.h"
 #include "raster/framebuffer.h"
+#include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
 #include "raster/stages/geometry.h"
 #include "raster/stages/rasterize.h"
 #include "raster/stages/shade.h"
+#include "raster/sort/sort_point.h"
 
 namespace {
 
@@ -54,6 +58,14 @@ uint64_t imageHash(const raster::RegionFramebuffer& fb) {
   return h;
 }
 
+// CPU time of the whole process (all PEs): on a shared machine the wall clock also counts the
+// time other jobs held the cores, the CPU time does not.
+double processCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return 1e3 * double(ts.tv_sec) + 1e-6 * double(ts.tv_nsec);
+}
+
 // CPU time of the calling thread: the sequential stages run on it alone.
 double threadCpuMs() {
   timespec ts{};
@@ -71,7 +83,7 @@ struct Span {
 };
 
 struct StageTimes {
-  Span geometry, raster, shade, total;
+  Span geometry, clear, raster, shade, total;
 };
 
 // One frame of the sequential pipeline over the whole screen (no regions), the stage calls of
@@ -87,12 +99,14 @@ void timedFrame(const pr::scene::Scene& scene, const raster::FrameView& view,
     raster::processTriangles(scene, view, first, std::min(kBatch, total - first), tris);
   const double c1 = threadCpuMs(), t1 = nowMs();
   fb.clear();
+  const double cc = threadCpuMs(), tc = nowMs();
   raster::rasterizeTriangles(tris, fb);
   const double c2 = threadCpuMs(), t2 = nowMs();
   raster::shadeRegion(raster::makeShadingContext(scene, view), tris, fb);
   const double c3 = threadCpuMs(), t3 = nowMs();
   t.geometry.add(t1 - t0, c1 - c0);
-  t.raster.add(t2 - t1, c2 - c1);
+  t.clear.add(tc - t1, cc - c1);
+  t.raster.add(t2 - tc, c2 - cc);
   t.shade.add(t3 - t2, c3 - c2);
   t.total.add(t3 - t0, c3 - c0);
 }
@@ -136,6 +150,29 @@ Anchor runAnchor(const std::string& program, const std::string& scenePath, int w
   return a;
 }
 
+// One sort point on P PEs: median wall and process CPU ms per frame (the sort point is kept
+// between frames, as in an animation), the image checked against the sequential reference.
+struct SortRow {
+  double ms = 0.0, cpuMs = 0.0;
+};
+
+SortRow timeSortPoint(const raster::SortPointInfo& info, int pes, const pr::scene::Scene& scene,
+                      const raster::FrameView& view, int frames, const raster::RegionFramebuffer& reference) {
+  pr::par::Runtime runtime(pes);
+  const raster::SortOptions options;
+  std::unique_ptr<raster::SortPoint> sortPoint = info.make();
+  raster::RegionFramebuffer image = raster::renderFrame(*sortPoint, scene, view, options, runtime);  // warm-up
+  PR_CHECK(raster::identical(image, reference), "bench_raster: parallel image differs from the sequential one");
+  std::vector<double> wall, cpu;
+  for (int f = 0; f < frames; ++f) {
+    const double c0 = processCpuMs(), t0 = nowMs();
+    image = raster::renderFrame(*sortPoint, scene, view, options, runtime);
+    wall.push_back(nowMs() - t0);
+    cpu.push_back(processCpuMs() - c0);
+  }
+  return SortRow{median(wall), median(cpu)};
+}
+
 struct Options {
   int width = 1920, height = 1080, frames = 7;
   std::string anchor;
@@ -164,31 +201,50 @@ void benchScene(const std::string& label, const std::string& path, const Options
   PR_CHECK(raster::identical(fb, reference), "bench_raster: timed stages differ from renderSequential");
 
   const double ms = median(t.total.wall), cpuMs = median(t.total.cpu);
-  std::printf("sequential P=1 wall: geometry %.1f ms, clear+raster %.1f ms, shade %.1f ms | total %.1f ms\n",
-              median(t.geometry.wall), median(t.raster.wall), median(t.shade.wall), ms);
-  std::printf("sequential P=1 cpu:  geometry %.1f ms, clear+raster %.1f ms, shade %.1f ms | total %.1f ms\n",
-              median(t.geometry.cpu), median(t.raster.cpu), median(t.shade.cpu), cpuMs);
+  std::printf("sequential P=1 wall: geometry %.1f ms, clear %.1f ms, raster %.1f ms, shade %.1f ms | total %.1f ms\n",
+              median(t.geometry.wall), median(t.clear.wall), median(t.raster.wall), median(t.shade.wall), ms);
+  std::printf("sequential P=1 cpu:  geometry %.1f ms, clear %.1f ms, raster %.1f ms, shade %.1f ms | total %.1f ms\n",
+              median(t.geometry.cpu), median(t.clear.cpu), median(t.raster.cpu), median(t.shade.cpu), cpuMs);
   const double covered = double(std::max<size_t>(1, fb.coveredPixels()));
   std::printf("sequential P=1: %.2f Mtriangles/s, %.1f Mpixels/s (per cpu second: %.2f, %.1f), %zu covered pixels, "
               "shade %.1f cpu ns/covered pixel\n",
               triangles / ms / 1e3, pixels / ms / 1e3, triangles / cpuMs / 1e3, pixels / cpuMs / 1e3,
               fb.coveredPixels(), 1e6 * median(t.shade.cpu) / covered);
   std::printf("image hash %016llx\n", static_cast<unsigned long long>(imageHash(fb)));
-  std::printf("parallel sort-first / sort-middle / sort-last: not in this build (raster/sort/ absent)\n");
-
-  if (o.noAnchor) return;
-  if (o.anchor.empty() || !std::filesystem::exists(o.anchor)) {
+  // llvmpipe first, so every row below can print its ratio. LP_NUM_THREADS=0 draws on one
+  // thread; =1 uses two (front end + one tile thread): the counterparts of P=1 and P=2.
+  Anchor anchors[2];
+  if (o.noAnchor) {
+    std::printf("llvmpipe: skipped (--no-anchor)\n");
+  } else if (o.anchor.empty() || !std::filesystem::exists(o.anchor)) {
     std::printf("llvmpipe: anchor program not available (build the llvmpipe_anchor target), no ratios\n");
-    return;
-  }
-  for (int threads : {0, 1}) {
-    const Anchor a = runAnchor(o.anchor, path, o.width, o.height, threads, o.frames);
-    if (!a.ok) {
-      std::printf("llvmpipe LP_NUM_THREADS=%d: %s\n", threads, a.note.c_str());
-      continue;
+  } else {
+    for (int threads : {0, 1}) {
+      anchors[threads] = runAnchor(o.anchor, path, o.width, o.height, threads, o.frames);
+      const Anchor& a = anchors[threads];
+      if (a.ok) std::printf("llvmpipe LP_NUM_THREADS=%d: %.1f ms (cpu %.1f ms)\n", threads, a.ms, a.cpuMs);
+      else std::printf("llvmpipe LP_NUM_THREADS=%d: %s\n", threads, a.note.c_str());
     }
-    std::printf("llvmpipe LP_NUM_THREADS=%d: %.1f ms (cpu %.1f ms) | sequential P=1 / llvmpipe = %.2f (cpu %.2f)\n",
-                threads, a.ms, a.cpuMs, ms / a.ms, cpuMs / a.cpuMs);
+  }
+  auto ratio = [&anchors](int threads, double ourMs, double ourCpuMs) {
+    const Anchor& a = anchors[threads];
+    if (!a.ok) return std::string();
+    char buf[96];
+    std::snprintf(buf, sizeof buf, " | / llvmpipe LP_NUM_THREADS=%d: %.2f (cpu %.2f)", threads, ourMs / a.ms,
+                  ourCpuMs / a.cpuMs);
+    return std::string(buf);
+  };
+  std::printf("sequential P=1: %.1f ms (cpu %.1f ms)%s\n", ms, cpuMs, ratio(0, ms, cpuMs).c_str());
+
+  for (const raster::SortPointInfo& info : raster::sortPoints()) {
+    const SortRow p1 = timeSortPoint(info, 1, scene, view, o.frames, reference);
+    const SortRow p2 = timeSortPoint(info, 2, scene, view, o.frames, reference);
+    std::printf("%s P=1: %.1f ms (cpu %.1f ms), %.2f Mtriangles/s, %.1f Mpixels/s%s\n", std::string(info.name).c_str(),
+                p1.ms, p1.cpuMs, triangles / p1.ms / 1e3, pixels / p1.ms / 1e3, ratio(0, p1.ms, p1.cpuMs).c_str());
+    std::printf("%s P=2: %.1f ms (cpu %.1f ms), %.2f Mtriangles/s, %.1f Mpixels/s, speed-up T1/T2 %.2f, efficiency "
+                "%.2f%s\n",
+                std::string(info.name).c_str(), p2.ms, p2.cpuMs, triangles / p2.ms / 1e3, pixels / p2.ms / 1e3,
+                p1.ms / p2.ms, p1.ms / (2.0 * p2.ms), ratio(1, p2.ms, p2.cpuMs).c_str());
   }
 }
 
