@@ -49,7 +49,7 @@ TEST_CASE("RasterRenderCommand: sort-first with static strips agrees with sort-m
   CHECK(readPixels(dir / "first.exr") == readPixels(dir / "middle.exr"));
 }
 
-TEST_CASE("RasterRenderCommand: an orbit reports migrations; binary-swap needs a power-of-two P") {
+TEST_CASE("RasterRenderCommand: an orbit reports migrations and binary-swap needs a power-of-two P") {
   const auto dir = scratchDir("raster_render_orbit");
   CommandResult r = render("sort-first", "--frames 4 --orbit", dir / "orbit.png");
   CHECK(r.exitStatus == 0);
