@@ -129,6 +129,11 @@ RunSummary summarize(const RunRecord& record) {
   // Efficiency of the whole run over the time spent in stages; the controller's serial code
   // between stages is not PE time.
   summary.total = summarizePes("total", record.schedule, stageWall, peTotals(record));
+  for (const CounterRecord& c : record.counters) {
+    double total = 0.0;
+    for (double v : c.perPe) total += v;
+    summary.counters.push_back({c.name, spreadOf(c.perPe), total});
+  }
   return summary;
 }
 
@@ -170,6 +175,11 @@ std::string formatSummary(const RunSummary& summary) {
     const Spread& s = summary.total.figures[i];
     std::snprintf(line, sizeof line, "  %-24s %14s %14s %14s\n", figures[i].name, number(s.min).c_str(),
                   number(s.mean).c_str(), number(s.max).c_str());
+    out += line;
+  }
+  for (const CounterSummary& c : summary.counters) {
+    std::snprintf(line, sizeof line, "  %-24s %14s %14s %14s  (total %s)\n", c.name.c_str(), number(c.spread.min).c_str(),
+                  number(c.spread.mean).c_str(), number(c.spread.max).c_str(), number(c.total).c_str());
     out += line;
   }
   if (summary.total.computeToComm >= 0.0) {

@@ -42,10 +42,18 @@ struct StageSummary {
   const Spread& figure(const std::string& name) const;
 };
 
+// A named algorithm counter of the run record, over PEs.
+struct CounterSummary {
+  std::string name;
+  Spread spread;
+  double total = 0.0;
+};
+
 struct RunSummary {
   int pes = 1;
   double wallSeconds = 0.0;
   std::vector<StageSummary> stages;
+  std::vector<CounterSummary> counters;
   StageSummary total;  // per-PE figures summed over stages first
 };
 

@@ -60,6 +60,14 @@ struct TaskSpan {
   std::uint64_t bytesSent = 0;
 };
 
+// An algorithm counter or figure reported per PE (geometry bytes held, primitives duplicated,
+// photons stored ...), named "Category/what" (STYLE.md §4). Kept beside the runtime's own
+// figures so reports read every number from the same record.
+struct CounterRecord {
+  std::string name;
+  std::vector<double> perPe;  // one value per PE
+};
+
 struct RunRecord {
   int pes = 1;
   std::string schedule;
@@ -67,6 +75,7 @@ struct RunRecord {
   double wallSeconds = 0.0;  // first stage start to last stage end
   std::vector<StageRecord> stages;
   std::vector<TaskSpan> timeline;
+  std::vector<CounterRecord> counters;  // in the order first recorded
   std::string error;  // the error that ended the run, empty when it completed
 };
 

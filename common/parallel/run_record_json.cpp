@@ -98,6 +98,9 @@ json toJson(const RunRecord& record) {
   for (const TaskSpan& t : record.timeline)
     timeline.push_back({t.pe, t.stage, t.task, t.start, t.end, t.messagesSent, t.bytesSent});
   j["timeline"] = timeline;
+  json counters = json::array();
+  for (const CounterRecord& c : record.counters) counters.push_back({{"name", c.name}, {"perPe", c.perPe}});
+  j["counters"] = counters;
   return j;
 }
 
@@ -208,6 +211,15 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
         span.pe >= record.pes || span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
       throw InputError(origin + ": \"timeline\" span names a PE, stage or task the record does not have");
     record.timeline.push_back(span);
+  }
+  // Optional: records written before counters existed have none.
+  for (const json& jc : j.value("counters", json::array())) {
+    CounterRecord c;
+    c.name = field<std::string>(jc, "name", origin, "counter");
+    c.perPe = field<std::vector<double>>(jc, "perPe", origin, "counter " + c.name);
+    if (static_cast<int>(c.perPe.size()) != record.pes)
+      throw InputError(origin + ": counter \"" + c.name + "\" needs one value per PE (" + std::to_string(record.pes) + ")");
+    record.counters.push_back(std::move(c));
   }
   return record;
 }

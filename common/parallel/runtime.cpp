@@ -50,6 +50,17 @@ void Runtime::recordBroadcast(std::size_t bytesPerPe) {
   pendingBroadcastBytes_ += bytesPerPe;
 }
 
+void Runtime::addCounter(std::string_view name, int pe, double value) {
+  PR_CHECK(pe >= 0 && pe < options_.pes, "counter '" + std::string(name) + "' names PE " + std::to_string(pe));
+  std::lock_guard<std::mutex> lock(counterMutex_);
+  auto it = std::find_if(record_.counters.begin(), record_.counters.end(),
+                         [&](const CounterRecord& c) { return c.name == name; });
+  if (it == record_.counters.end())
+    it = record_.counters.insert(record_.counters.end(),
+                                 CounterRecord{std::string(name), std::vector<double>(options_.pes, 0.0)});
+  it->perPe[pe] += value;
+}
+
 void Runtime::attach(ChannelBase* channel) {
   PR_CHECK(!inStage_, "channels with handlers are created between stages");
   channels_.push_back(channel);

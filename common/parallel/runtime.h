@@ -87,6 +87,10 @@ class Runtime {
   // counted as one broadcast message per receiving PE in the next stage run.
   void recordBroadcast(std::size_t bytesPerPe);
 
+  // Adds value to the named per-PE counter (created at zero for every PE on first use).
+  // Thread-safe: callable from tasks, handlers or the controlling thread.
+  void addCounter(std::string_view name, int pe, double value);
+
   const RunRecord& record() const { return record_; }
   // Seconds since the runtime was created (steady clock).
   double now() const {
@@ -126,6 +130,7 @@ class Runtime {
   bool inStage_ = false;
   std::size_t pendingBroadcastBytes_ = 0, pendingBroadcasts_ = 0;
 
+  std::mutex counterMutex_;
   std::mutex errorMutex_;
   std::exception_ptr error_;
 };

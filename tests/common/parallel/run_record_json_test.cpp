@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/parallel/channel.h"
+#include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
 #include "common/util/error.h"
 
@@ -80,4 +81,33 @@ TEST_CASE("RunRecord: a value of the wrong type deep in the record is an input e
   const std::string text =
       "{\"pes\": 1, \"stages\": [{\"name\": \"s\", \"wallSeconds\": 1, \"tasks\": [[1, \"x\", 0]]}], \"timeline\": []}";
   CHECK_THROWS_AS(runRecordFromJsonText(text, "m.json"), pr::InputError);
+}
+
+TEST_CASE("RunRecord: named per-PE counters add up, survive JSON and appear in the summary") {
+  Runtime rt(3, "demand");
+  rt.runStage("count", TaskSet::grid(6, 1), [&](Pe& pe, TaskId) { rt.addCounter("Test/items", pe.id(), 1.0); });
+  rt.addCounter("Test/bytes_held", 2, 4096.0);
+  const RunRecord& a = rt.record();
+  REQUIRE(a.counters.size() == 2);
+  CHECK(a.counters[0].name == "Test/items");
+  double items = 0.0;
+  for (double v : a.counters[0].perPe) items += v;
+  CHECK(items == 6.0);  // one per task, wherever it ran
+  CHECK(a.counters[1].perPe == std::vector<double>{0.0, 0.0, 4096.0});
+
+  const RunRecord b = runRecordFromJsonText(toJsonText(a), "test");
+  REQUIRE(b.counters.size() == 2);
+  CHECK(b.counters[1].name == "Test/bytes_held");
+  CHECK(b.counters[1].perPe == a.counters[1].perPe);
+
+  const RunSummary s = summarize(b);
+  REQUIRE(s.counters.size() == 2);
+  CHECK(s.counters[1].total == 4096.0);
+  CHECK(s.counters[1].spread.max == 4096.0);
+  CHECK(s.counters[1].spread.min == 0.0);
+  CHECK(formatSummary(s).find("Test/bytes_held") != std::string::npos);
+
+  CHECK_THROWS_AS(runRecordFromJsonText(
+                      R"({"pes": 2, "stages": [], "timeline": [], "counters": [{"name": "x", "perPe": [1]}]})", "test"),
+                  pr::InputError);
 }
