@@ -50,9 +50,10 @@ class ObjectFrame {
 
   TraceResult run(PartitionFigures& figures) {
     const int pes = rt_.pes();
-    rt_.runStage("build", par::TaskSet::uniform(pes), [&](par::Pe&, par::TaskId t) {
-      if (!assignment_.triangles(int(t)).empty())
-        bvhs_[t] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(int(t)), job_.options.bvh);
+    runOnEveryOwner(rt_, "build", [&](par::Pe& pe) {
+      const int p = pe.id();
+      if (!assignment_.triangles(p).empty())
+        bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);
     });
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -88,12 +89,16 @@ class ObjectFrame {
       figures.triangles.push_back(n);
       figures.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
     }
-    for (const PeState& st : state_) {
+    for (int p = 0; p < pes; ++p) {
+      const PeState& st = state_[size_t(p)];
       PR_CHECK(st.live == 0, "object partitioning: a ray still waits for hit replies after the stage");
       result.rays += st.stats;
       figures.rayMessages += st.queriesSent;
       figures.hitMessages += st.repliesSent;
+      rt_.addCounter("Partition/ray_queries_sent", p, double(st.queriesSent));
+      rt_.addCounter("Partition/hit_replies_sent", p, double(st.repliesSent));
     }
+    recordPartitionFigures(figures, rt_);
     return result;
   }
 

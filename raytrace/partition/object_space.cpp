@@ -48,9 +48,9 @@ class ObjectSpaceFrame {
   TraceResult run(PartitionFigures& figures) {
     const int pes = rt_.pes();
     // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
-    rt_.runStage("build", par::TaskSet::uniform(pes), [&](par::Pe&, par::TaskId t) {
+    runOnEveryOwner(rt_, "build", [&](par::Pe& pe) {
       for (int v = 0; v < split_.voxels(); ++v)
-        if (owners_[v] == int(t) && !split_.triangles(v).empty())
+        if (owners_[v] == pe.id() && !split_.triangles(v).empty())
           bvhs_[v] = Bvh(job_.scene.positions, job_.scene.triangles, split_.triangles(v), job_.options.bvh);
     });
 
@@ -82,10 +82,13 @@ class ObjectSpaceFrame {
       figures.geometryBytes[owners_[v]] += bvhs_[v].stats().memoryBytes + split_.triangles(v).size() * kTriangleVertexBytes;
       figures.triangles[owners_[v]] += split_.triangles(v).size();
     }
-    for (const PeState& st : state_) {
+    for (int p = 0; p < pes; ++p) {
+      const PeState& st = state_[size_t(p)];
       result.rays += st.stats;
       figures.rayMessages += st.raysSent;
+      rt_.addCounter("Partition/ray_messages_sent", p, double(st.raysSent));
     }
+    recordPartitionFigures(figures, rt_);
     return result;
   }
 

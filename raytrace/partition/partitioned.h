@@ -6,10 +6,13 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <functional>
 #include <string_view>
 #include <vector>
 
+#include "common/parallel/runtime.h"
 #include "common/parallel/task.h"
+#include "common/util/error.h"
 #include "common/scene/scene.h"
 #include "raytrace/integrators/integrator.h"
 #include "raytrace/partition/partition.h"
@@ -25,6 +28,26 @@ struct PartitionFigures {
   uint64_t hitMessages = 0;              // hit records sent back (object partitioning)
   int partitions = 0;                    // voxels or object pieces
 };
+
+// Runs ownerWork(pe) once on every PE, on that PE itself: owner-local work such as building the
+// BVHs of the PE's own partition, which no other PE may do for it (shared/DESIGN.md rule 1).
+// A balanced data-driven split of P tasks over P PEs hands task p to PE p, whatever --schedule says.
+inline void runOnEveryOwner(par::Runtime& rt, std::string_view stage, const std::function<void(par::Pe&)>& ownerWork) {
+  const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
+  rt.runStage(stage, par::TaskSet::uniform(rt.pes()), *balanced, [&](par::Pe& pe, par::TaskId t) {
+    PR_CHECK(t == pe.id(), "owner-local task " + std::to_string(t) + " ran on PE " + std::to_string(pe.id()));
+    ownerWork(pe);
+  });
+}
+
+// Puts the per-PE figures in the run record as named counters, beside the runtime's own
+// measurements, so `render` summaries and --metrics JSON report them.
+inline void recordPartitionFigures(const PartitionFigures& figures, par::Runtime& rt) {
+  for (int p = 0; p < rt.pes(); ++p) {
+    rt.addCounter("Partition/geometry_bytes", p, double(figures.geometryBytes[size_t(p)]));
+    rt.addCounter("Partition/triangles_held", p, double(figures.triangles[size_t(p)]));
+  }
+}
 
 // Bytes a PE holds per triangle besides its BVH: the index triple and material, and the
 // vertex data shading reads at a hit (position, normal, uv of three vertices).
