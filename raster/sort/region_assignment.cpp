@@ -49,6 +49,15 @@ RegionGrid::RegionGrid(int width, int height, RegionStrategy strategy, int tileS
   }
 }
 
+par::TaskSet RegionGrid::regionTasks() const {
+  par::TaskSet set = par::TaskSet::uniform(regions_.size());
+  for (size_t r = 0; r < regions_.size(); ++r) {
+    set.tasks[r].x = 0.5f * float(regions_[r].x0 + regions_[r].x1);
+    set.tasks[r].y = 0.5f * float(regions_[r].y0 + regions_[r].y1);
+  }
+  return set;
+}
+
 std::vector<int> RegionGrid::regionsOf(int pe) const {
   std::vector<int> mine;
   for (int r = 0; r < regionCount(); ++r)

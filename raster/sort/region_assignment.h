@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/parallel/schedulers/scheduler.h"
+#include "common/parallel/task.h"
 #include "raster/region.h"
 
 namespace pr::raster {
@@ -32,6 +33,8 @@ class RegionGrid {
 
   int regionCount() const { return static_cast<int>(regions_.size()); }
   const Rect& region(int r) const { return regions_[r]; }
+  // One task per region, positioned at its centre (for spiral and preferred-bias orders).
+  par::TaskSet regionTasks() const;
   int owner(int r) const { return owner_[r]; }
   const std::vector<int>& owners() const { return owner_; }
   bool dynamic() const { return dynamic_; }

@@ -203,11 +203,7 @@ class SortFirst : public SortPoint {
     std::vector<RegionFramebuffer> drawn(tiles);
     {
       TilePull<uint32_t> pull(rt, "sort-first tile", bins);
-      par::TaskSet set = par::TaskSet::uniform(tiles);
-      for (int r = 0; r < tiles; ++r) {
-        set.tasks[r].x = 0.5f * float(grid.region(r).x0 + grid.region(r).x1);
-        set.tasks[r].y = 0.5f * float(grid.region(r).y0 + grid.region(r).y1);
-      }
+      const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
         std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
         std::sort(ids.begin(), ids.end());  // arrival order -> id order, for runs of ids

@@ -106,11 +106,7 @@ class SortMiddle : public SortPoint {
     std::vector<RegionFramebuffer> drawn(tiles);
     {
       TilePull<ScreenTriangle> pull(rt, "sort-middle tile", bins);
-      par::TaskSet set = par::TaskSet::uniform(tiles);
-      for (int r = 0; r < tiles; ++r) {
-        set.tasks[r].x = 0.5f * float(grid.region(r).x0 + grid.region(r).x1);
-        set.tasks[r].y = 0.5f * float(grid.region(r).y0 + grid.region(r).y1);
-      }
+      const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-middle rasterize", set, [&](par::Pe& pe, par::TaskId t) {
         const std::vector<ScreenTriangle> tris = pull.gather(pe, static_cast<int>(t));
         RegionFramebuffer fb(grid.region(static_cast<int>(t)));
