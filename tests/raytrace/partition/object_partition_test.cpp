@@ -142,9 +142,14 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
       CHECK(st.traffic[1].messages == 1);
       // The query carries a ray (32 bytes) and its return address; the hit reply also the
       // hit record and the surface interaction, so it is the larger of the two.
-      const auto& query = st.traffic[0].from == st.traffic[1].to ? st.traffic[0] : st.traffic[1];
+      // Which PE originates depends on which PE took the tile, so tell them apart by size.
+      CHECK(st.traffic[0].from == st.traffic[1].to);
+      const bool firstIsQuery = st.traffic[0].bytes < st.traffic[1].bytes;
+      const auto& query = firstIsQuery ? st.traffic[0] : st.traffic[1];
+      const auto& hit = firstIsQuery ? st.traffic[1] : st.traffic[0];
       CHECK(query.bytes >= sizeof(rt::Ray));
       CHECK(query.bytes <= sizeof(rt::Ray) + 8);
+      CHECK(hit.bytes > sizeof(rt::Hit));
     }
   }
 }
