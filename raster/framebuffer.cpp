@@ -17,10 +17,33 @@ RegionFramebuffer::RegionFramebuffer(const Rect& rect) : rect_(rect) {
   colour_.assign(n, glm::vec3(0.0f));
 }
 
-void RegionFramebuffer::clear() {
-  std::fill(key_.begin(), key_.end(), kClearKey);
-  std::fill(triangle_.begin(), triangle_.end(), kNoTriangle);
-  std::fill(colour_.begin(), colour_.end(), glm::vec3(0.0f));
+void RegionFramebuffer::clear() { window().clear(); }
+
+void PixelWindow::clear() const {
+  const size_t w = static_cast<size_t>(rect.width());
+  for (int y = 0; y < rect.height(); ++y) {
+    const size_t row = static_cast<size_t>(y) * stride;
+    std::fill_n(keys + row, w, kClearKey);
+    std::fill_n(triangles + row, w, kNoTriangle);
+    std::fill_n(colours + row, w, glm::vec3(0.0f));
+  }
+}
+
+PixelWindow RegionFramebuffer::window(const Rect& r) {
+  PR_CHECK(r.empty() || intersect(r, rect_) == r, "RegionFramebuffer::window: rectangle outside the buffer");
+  if (r.empty()) return PixelWindow{r, static_cast<size_t>(rect_.width()), nullptr, nullptr, nullptr};
+  const size_t at = index(r.x0, r.y0);
+  return PixelWindow{r, static_cast<size_t>(rect_.width()), key_.data() + at, triangle_.data() + at,
+                     colour_.data() + at};
+}
+
+void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst) {
+  const Rect r = intersect(src.rect(), dst.rect());
+  for (int y = r.y0; y < r.y1; ++y) {
+    std::copy_n(src.keys() + src.index(r.x0, y), r.width(), dst.keys() + dst.index(r.x0, y));
+    std::copy_n(src.colours() + src.index(r.x0, y), r.width(), dst.colours() + dst.index(r.x0, y));
+    std::fill_n(dst.triangles() + dst.index(r.x0, y), r.width(), kNoTriangle);
+  }
 }
 
 size_t RegionFramebuffer::coveredPixels() const {

@@ -1,6 +1,7 @@
 // RegionFramebuffer: colour, depth key (depth + primitive order) and triangle index for one
-// screen rectangle (a tile, a strip, or the whole screen). Region owners rasterize into their
-// own; sort-last PEs hold a full-screen one each; resolveInto() composites them into the image.
+// screen rectangle (a tile, a strip, or the whole screen). The frame is one of these; region
+// owners draw into their regions of it through PixelWindows; sort-last PEs hold a full-screen
+// one each and resolveInto() composites them; copyInto() stores a finished region in the frame.
 #pragma once
 
 #include <cstdint>
@@ -16,6 +17,25 @@ namespace pr::raster {
 
 // Marks a pixel whose triangle index is unknown (empty, or composited from another buffer).
 inline constexpr uint32_t kNoTriangle = 0xffffffffu;
+
+// A rectangle of some framebuffer's pixels, addressed in that framebuffer's rows: what the
+// rasterize and shade stages draw into. A region owner draws straight into its own region of
+// the frame through a window on it (regions are disjoint, so no two PEs write one pixel); a
+// RegionFramebuffer is also a window on all of itself.
+struct PixelWindow {
+  Rect rect;
+  size_t stride = 0;               // pixels per row of the arrays below
+  uint64_t* keys = nullptr;        // each points at pixel (rect.x0, rect.y0)
+  uint32_t* triangles = nullptr;
+  glm::vec3* colours = nullptr;
+
+  // Offset of screen pixel (x, y), inside rect, from the pointers above.
+  size_t index(int x, int y) const {
+    return static_cast<size_t>(y - rect.y0) * stride + static_cast<size_t>(x - rect.x0);
+  }
+  // The cleared state (no fragment, no triangle, colour 0) for every pixel of rect.
+  void clear() const;
+};
 
 class RegionFramebuffer {
  public:
@@ -49,6 +69,10 @@ class RegionFramebuffer {
   uint32_t triangle(int x, int y) const { return triangle_[index(x, y)]; }
   const glm::vec3& colour(int x, int y) const { return colour_[index(x, y)]; }
 
+  // The whole buffer, or the part of it inside r (which must lie inside rect()).
+  PixelWindow window() { return window(rect_); }
+  PixelWindow window(const Rect& r);
+
   // Number of pixels holding a fragment.
   size_t coveredPixels() const;
   size_t memoryBytes() const;
@@ -62,6 +86,10 @@ class RegionFramebuffer {
 
 // True when both cover the same rectangle and hold bit-identical keys and colours.
 bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
+
+// Stores src's pixels in dst where the two overlap: keys and colours copied, triangle indices
+// kNoTriangle. For finished regions that are disjoint and cover the frame between them.
+void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst);
 
 // The part of fb inside rect (intersected with fb's rectangle): keys and colours copied,
 // triangle indices kNoTriangle. What a sort-last PE sends to the owner of a screen region.

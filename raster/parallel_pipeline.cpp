@@ -6,11 +6,18 @@
 
 namespace pr::raster {
 
-RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
-                              const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
-  RegionFramebuffer image(Rect{0, 0, view.width, view.height});
+void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view, const SortOptions& options,
+                 par::Runtime& runtime, RegionFramebuffer& image, SortCounters* counters) {
+  const Rect screen{0, 0, view.width, view.height};
+  if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
   const SortCounters c = sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
   if (counters) *counters += c;
+}
+
+RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
+                              const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
+  RegionFramebuffer image;
+  renderFrame(sortPoint, scene, view, options, runtime, image, counters);
   return image;
 }
 

@@ -22,6 +22,11 @@ RegionFramebuffer renderParallel(const scene::Scene& scene, const FrameView& vie
 RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
                               const SortOptions& options, par::Runtime& runtime, SortCounters* counters = nullptr);
 
+// The same into the caller's image (reallocated only when its size differs from the view's):
+// an animation keeps one image, as a display keeps its frame buffer.
+void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view, const SortOptions& options,
+                 par::Runtime& runtime, RegionFramebuffer& image, SortCounters* counters = nullptr);
+
 // The camera turned by angleRadians about the vertical (+y) axis through centre: frame i of an
 // N-frame orbit uses angle 2 pi i / N.
 scene::Camera orbitCamera(const scene::Camera& camera, glm::vec3 centre, float angleRadians);

@@ -1,23 +1,23 @@
 // The sequential raster pipeline: the shared stages chained on one thread. Geometry runs in
-// batches in primitive order; each region then gets the screen triangles whose bounds overlap
-// it (binning), rasterizes and shades them in its own RegionFramebuffer and is depth-resolved
-// into the full-screen image.
+// batches in primitive order; then the whole screen, or each region in turn with the screen
+// triangles whose bounds overlap it (binning), is drawn: cleared, rasterized, shaded.
 #include "raster/sequential_pipeline.h"
 
 #include <algorithm>
 
 #include "common/util/error.h"
-#include "raster/stages/depth_resolve.h"
+#include "raster/stages/draw_region.h"
 #include "raster/stages/setup.h"
 
 namespace pr::raster {
 
-RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& view,
-                                   const SequentialOptions& options, RasterStats* stats) {
+void renderSequential(const scene::Scene& scene, const FrameView& view, const SequentialOptions& options,
+                      RegionFramebuffer& image, RasterStats* stats) {
   PR_CHECK(options.batchSize > 0, "renderSequential: zero batch size");
   RasterStats local;
   RasterStats& st = stats ? *stats : local;
   const Rect screen{0, 0, view.width, view.height};
+  if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
 
   std::vector<ScreenTriangle> tris;
   tris.reserve(scene.triangles.size());
@@ -28,15 +28,18 @@ RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& v
 
   const ShadingContext ctx = makeShadingContext(scene, view);
   st.usesHeadlight = ctx.usesHeadlight;
-  RegionFramebuffer image(screen);
-  if (options.regions.empty()) {
-    rasterizeTriangles(tris, image, &st.raster);
-    shadeRegion(ctx, tris, image, &st.shade);
+  auto draw = [&](std::span<const ScreenTriangle> list, const PixelWindow& pixels) {
+    drawRegion(ctx, list, pixels, &st.raster, &st.shade);
     st.regionsDrawn += 1;
-    st.trianglesBinned += tris.size();
-    return image;
+    st.trianglesBinned += list.size();
+  };
+  if (options.regions.empty()) {
+    draw(tris, image.window());
+    return;
   }
 
+  // Each region is drawn whole; the pixels no region covers are cleared here.
+  image.clear();
   std::vector<Rect> bounds(tris.size());
   for (size_t i = 0; i < tris.size(); ++i) bounds[i] = pixelBounds(tris[i]);
   std::vector<ScreenTriangle> bin;
@@ -47,13 +50,14 @@ RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& v
     for (size_t i = 0; i < tris.size(); ++i) {
       if (overlaps(bounds[i], r)) bin.push_back(tris[i]);
     }
-    RegionFramebuffer fb(r);
-    rasterizeTriangles(bin, fb, &st.raster);
-    shadeRegion(ctx, bin, fb, &st.shade);
-    resolveInto(fb, image);
-    st.regionsDrawn += 1;
-    st.trianglesBinned += bin.size();
+    draw(bin, image.window(r));
   }
+}
+
+RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& view,
+                                   const SequentialOptions& options, RasterStats* stats) {
+  RegionFramebuffer image;
+  renderSequential(scene, view, options, image, stats);
   return image;
 }
 

@@ -1,5 +1,5 @@
-// The sequential raster pipeline: geometry -> (bin to regions) -> rasterize -> shade -> depth
-// resolve into the image, on the calling thread. It is the reference the parallel sort-first,
+// The sequential raster pipeline: geometry -> (bin to regions) -> rasterize -> shade, into the
+// image, on the calling thread. It is the reference the parallel sort-first,
 // sort-middle and sort-last pipelines must match bit for bit, and it calls exactly the stage
 // functions they call; it has no sort point (nothing is redistributed).
 #pragma once
@@ -37,6 +37,10 @@ struct RasterStats {
 // Renders one frame seen through `view` into a full-screen framebuffer.
 RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& view,
                                    const SequentialOptions& options = {}, RasterStats* stats = nullptr);
+
+// The same into the caller's image (reallocated only when its size differs from the view's).
+void renderSequential(const scene::Scene& scene, const FrameView& view, const SequentialOptions& options,
+                      RegionFramebuffer& image, RasterStats* stats = nullptr);
 
 // Same, with the frame view of a scene camera (throws pr::InputError for a bad image size).
 RegionFramebuffer renderSequential(const scene::Scene& scene, const scene::Camera& camera, int width,

@@ -46,8 +46,8 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   for (int frame = 0; frame < o.frames; ++frame) {
     const float angle = o.orbit ? 6.28318530718f * float(frame) / float(o.frames) : 0.0f;
     const scene::Camera camera = raster::orbitCamera(r.camera, r.scene.bounds.center(), angle);
-    last = raster::renderFrame(*sortPoint, r.scene, raster::makeFrameView(camera, r.width, r.height), options,
-                               r.runtime, &c);
+    raster::renderFrame(*sortPoint, r.scene, raster::makeFrameView(camera, r.width, r.height), options, r.runtime,
+                        last, &c);
     if (r.progress) r.progress(frame + 1, o.frames);
   }
   RenderOutcome out;

@@ -4,7 +4,6 @@
 
 #include <algorithm>
 
-#include "raster/stages/rasterize.h"
 #include "raster/stages/setup.h"
 
 namespace pr::raster {
@@ -22,26 +21,33 @@ void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scr
   std::sort(owners.begin(), owners.end());
 }
 
-std::vector<RegionFramebuffer> drawOwnedRegions(const ShadingContext& ctx, std::span<const ScreenTriangle> tris,
-                                                const RegionGrid& grid, int pe) {
-  const std::vector<int> mine = grid.regionsOf(pe);
-  std::vector<int> slot(grid.regionCount(), -1);
-  for (size_t i = 0; i < mine.size(); ++i) slot[mine[i]] = static_cast<int>(i);
-  // Bin once: each triangle to every owned region its bounds overlap.
-  std::vector<std::vector<ScreenTriangle>> bins(mine.size());
-  for (const ScreenTriangle& t : tris) {
-    grid.forEachOverlapped(pixelBounds(t), [&](int r) {
-      if (slot[r] >= 0) bins[slot[r]].push_back(t);
-    });
+void RegionDrawer::draw(const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists,
+                        const RegionGrid& grid, std::span<const int> regions, RegionFramebuffer& frame) {
+  slot_.assign(grid.regionCount(), -1);
+  for (size_t i = 0; i < regions.size(); ++i) slot_[regions[i]] = static_cast<int>(i);
+  // Count, then place: every triangle once per owned region it overlaps, in list order.
+  start_.assign(regions.size() + 1, 0);
+  for (const std::vector<ScreenTriangle>& list : lists)
+    for (const ScreenTriangle& t : list)
+      grid.forEachOverlapped(pixelBounds(t), [&](int r) {
+        if (slot_[r] >= 0) ++start_[slot_[r] + 1];
+      });
+  for (size_t i = 0; i < regions.size(); ++i) start_[i + 1] += start_[i];
+  binned_ = start_.back();
+  if (binned_ > capacity_) {
+    capacity_ = binned_ + binned_ / 4;
+    storage_ = std::make_unique_for_overwrite<ScreenTriangle[]>(capacity_);
   }
-  std::vector<RegionFramebuffer> out;
-  out.reserve(mine.size());
-  for (size_t i = 0; i < mine.size(); ++i) {
-    out.emplace_back(grid.region(mine[i]));
-    rasterizeTriangles(bins[i], out.back());
-    shadeRegion(ctx, bins[i], out.back());
+  std::vector<size_t> cursor(start_.begin(), start_.end() - 1);
+  for (const std::vector<ScreenTriangle>& list : lists)
+    for (const ScreenTriangle& t : list)
+      grid.forEachOverlapped(pixelBounds(t), [&](int r) {
+        if (slot_[r] >= 0) storage_[cursor[slot_[r]]++] = t;
+      });
+  for (size_t i = 0; i < regions.size(); ++i) {
+    const std::span<const ScreenTriangle> bin(storage_.get() + start_[i], start_[i + 1] - start_[i]);
+    drawRegion(ctx, bin, frame.window(grid.region(regions[i])));
   }
-  return out;
 }
 
 }  // namespace pr::raster

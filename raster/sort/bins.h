@@ -1,14 +1,16 @@
 // Binning, the step on both sides of a sort: a sender groups what it has by the owners of the
 // screen regions it overlaps (one message per owner), and an owner groups what it received by
-// its own regions before rasterizing them. Shared by sort-first and sort-middle.
+// its own regions before drawing them. Shared by sort-first and sort-middle.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
 #include "raster/framebuffer.h"
 #include "raster/sort/region_assignment.h"
+#include "raster/stages/draw_region.h"
 #include "raster/stages/geometry.h"
 #include "raster/stages/shade.h"
 
@@ -18,10 +20,25 @@ namespace pr::raster {
 // is a per-caller mark buffer of size P (all zero on entry and on return).
 void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scratch, std::vector<int>& owners);
 
-// The region framebuffers of PE pe: each of its regions gets the triangles whose pixel bounds
-// overlap it, rasterized and shaded there. Called by the owner on its own triangles only.
-// Returned in the order of grid.regionsOf(pe).
-std::vector<RegionFramebuffer> drawOwnedRegions(const ShadingContext& ctx, std::span<const ScreenTriangle> tris,
-                                                const RegionGrid& grid, int pe);
+// An owner's regions drawn from the screen triangles it holds: each triangle is binned to every
+// one of those regions its pixel bounds overlap (a counting sort into one array, whose storage
+// is kept from frame to frame), then each region is drawn straight into its part of the frame.
+// One per PE; used only by that PE.
+class RegionDrawer {
+ public:
+  // Draws regions (indices into grid) from the triangles of every list in lists.
+  void draw(const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists, const RegionGrid& grid,
+            std::span<const int> regions, RegionFramebuffer& frame);
+
+  // Triangles binned by the last draw (a triangle counts once per region it went to).
+  size_t binned() const { return binned_; }
+
+ private:
+  std::unique_ptr<ScreenTriangle[]> storage_;  // uninitialised beyond what draw() writes
+  size_t capacity_ = 0;
+  size_t binned_ = 0;
+  std::vector<int> slot_;       // grid region -> position in regions, or -1
+  std::vector<size_t> start_;   // per position: first index in storage_, then the fill cursor
+};
 
 }  // namespace pr::raster

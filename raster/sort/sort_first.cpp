@@ -139,7 +139,7 @@ class SortFirst : public SortPoint {
 
     // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
     // it holds, then rasterize and shade.
-    std::vector<std::vector<RegionFramebuffer>> drawn(pes);
+    drawers_.resize(pes);
     auto owned2 = makeOwnerScheduler(self);
     rt.runStage("sort-first render", par::TaskSet::uniform(pes), *owned2, [&](par::Pe& pe, par::TaskId) {
       const int p = pe.id();
@@ -150,11 +150,8 @@ class SortFirst : public SortPoint {
       std::vector<ScreenTriangle> tris;
       transformPrimitives(f.scene, f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
-      drawn[p] = drawOwnedRegions(ctx, tris, grid, p);
+      drawers_[p].draw(ctx, std::span(&tris, 1), grid, grid.regionsOf(p), image);
     });
-
-    for (const auto& regions : drawn)
-      for (const RegionFramebuffer& fb : regions) resolveInto(fb, image);
 
     held_ = std::move(kept);
     previous_.emplace(Previous{f.view, grid});
@@ -200,7 +197,6 @@ class SortFirst : public SortPoint {
       }
     });
 
-    std::vector<RegionFramebuffer> drawn(tiles);
     {
       TilePull<uint32_t> pull(rt, "sort-first tile", bins);
       const par::TaskSet set = grid.regionTasks();
@@ -210,14 +206,10 @@ class SortFirst : public SortPoint {
         std::vector<ScreenTriangle> tris;
         transformPrimitives(f.scene, f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
-        RegionFramebuffer fb(grid.region(static_cast<int>(t)));
-        rasterizeTriangles(tris, fb);
-        shadeRegion(ctx, tris, fb);
-        drawn[t] = std::move(fb);
+        drawRegion(ctx, tris, image.window(grid.region(static_cast<int>(t))));
       });
       for (int p = 0; p < pes; ++p) counters[p].primitivesSent += pull.itemsSent(p);
     }
-    for (const RegionFramebuffer& fb : drawn) resolveInto(fb, image);
     SortCounters sum;
     for (const SortCounters& c : counters) sum += c;
     return sum;
@@ -227,6 +219,7 @@ class SortFirst : public SortPoint {
     FrameView view;
     RegionGrid grid;
   };
+  std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
   // Between frames: the primitives each PE holds, and the view and regions they were sorted by.
   std::vector<std::vector<uint32_t>> held_;
   std::optional<Previous> previous_;

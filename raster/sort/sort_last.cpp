@@ -51,7 +51,7 @@ class SortLast : public SortPoint {
     // Stage 3, the sort: depth compositing by screen region.
     std::vector<CompositeCounters> traffic(pes);
     std::vector<RegionFramebuffer> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
-    for (const RegionFramebuffer& fb : regions) resolveInto(fb, image);
+    for (const RegionFramebuffer& fb : regions) copyInto(fb, image);
 
     SortCounters sum;
     for (const CompositeCounters& c : traffic) {

@@ -1,7 +1,8 @@
 // Sort-middle: the sort sits between geometry and rasterization. PEs transform and light
 // their share of the scene triangles (geometry batches under the runtime's schedule), bin the
 // screen triangles by region owner and send them as messages; each owner then rasterizes and
-// shades its regions. The redistributed PDI is the 80-byte ScreenTriangle.
+// shades its regions, straight into its own regions of the frame. The redistributed PDI is the
+// 80-byte ScreenTriangle.
 #include <algorithm>
 
 #include "common/parallel/channel.h"
@@ -35,15 +36,40 @@ class SortMiddle : public SortPoint {
       const uint32_t first = static_cast<uint32_t>(t) * batch;
       std::vector<ScreenTriangle> tris;
       processTriangles(f.scene, f.view, first, std::min(batch, total - first), tris);
-      std::vector<std::vector<ScreenTriangle>> out(pes);
+      SortCounters& c = counters[pe.id()];
+      // One owner for the whole batch (always so at P = 1): the batch is the message as it is.
+      std::vector<int> owner(tris.size());
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners;
-      SortCounters& c = counters[pe.id()];
-      for (const ScreenTriangle& tri : tris) {
-        ownersOf(grid, pixelBounds(tri), scratch, owners);
-        for (int o : owners) out[o].push_back(tri);
+      bool single = true;
+      for (size_t i = 0; i < tris.size(); ++i) {
+        ownersOf(grid, pixelBounds(tris[i]), scratch, owners);
         c.trianglesRouted += owners.size();
-        if (!owners.empty()) c.trianglesDuplicated += owners.size() - 1;
+        if (owners.empty()) {
+          owner[i] = -1;
+          single = false;
+          continue;
+        }
+        c.trianglesDuplicated += owners.size() - 1;
+        owner[i] = owners.size() == 1 ? owners[0] : pes;  // pes: several owners
+        if (owner[i] != owner[0]) single = false;
+      }
+      if (tris.empty()) return;
+      if (single && owner[0] < pes) {
+        if (owner[0] != pe.id()) c.trianglesSent += tris.size();
+        const size_t bytes = tris.size() * sizeof(ScreenTriangle);
+        triangles.send(pe, owner[0], std::move(tris), bytes);
+        return;
+      }
+      std::vector<std::vector<ScreenTriangle>> out(pes);
+      for (size_t i = 0; i < tris.size(); ++i) {
+        if (owner[i] < 0) continue;
+        if (owner[i] < pes) {
+          out[owner[i]].push_back(tris[i]);
+          continue;
+        }
+        ownersOf(grid, pixelBounds(tris[i]), scratch, owners);
+        for (int o : owners) out[o].push_back(tris[i]);
       }
       for (int o = 0; o < pes; ++o) {
         if (out[o].empty()) continue;
@@ -54,21 +80,20 @@ class SortMiddle : public SortPoint {
     });
 
     // Between stages the controlling thread hands each owner its mailbox.
-    std::vector<std::vector<ScreenTriangle>> inbox(pes);
-    for (int p = 0; p < pes; ++p)
-      for (std::vector<ScreenTriangle>& m : triangles.drain(p)) inbox[p].insert(inbox[p].end(), m.begin(), m.end());
+    std::vector<std::vector<std::vector<ScreenTriangle>>> inbox(pes);
+    for (int p = 0; p < pes; ++p) inbox[p] = triangles.drain(p);
 
-    // Stage 2, rasterize and shade: each owner draws its regions from its own triangles.
-    std::vector<std::vector<RegionFramebuffer>> drawn(pes);
+    // Stage 2, rasterize and shade: each owner draws its regions of the frame from its own
+    // triangles.
+    drawers_.resize(pes);
     std::vector<int> self(pes);
     for (int p = 0; p < pes; ++p) self[p] = p;
     auto owned = makeOwnerScheduler(self);
     rt.runStage("sort-middle rasterize", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
-      drawn[pe.id()] = drawOwnedRegions(ctx, inbox[pe.id()], grid, pe.id());
+      const int p = pe.id();
+      drawers_[p].draw(ctx, inbox[p], grid, grid.regionsOf(p), image);
     });
 
-    for (const auto& regions : drawn)
-      for (const RegionFramebuffer& fb : regions) resolveInto(fb, image);
     SortCounters sum;
     for (const SortCounters& c : counters) sum += c;
     return sum;
@@ -103,24 +128,21 @@ class SortMiddle : public SortPoint {
       }
     });
 
-    std::vector<RegionFramebuffer> drawn(tiles);
     {
       TilePull<ScreenTriangle> pull(rt, "sort-middle tile", bins);
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-middle rasterize", set, [&](par::Pe& pe, par::TaskId t) {
         const std::vector<ScreenTriangle> tris = pull.gather(pe, static_cast<int>(t));
-        RegionFramebuffer fb(grid.region(static_cast<int>(t)));
-        rasterizeTriangles(tris, fb);
-        shadeRegion(ctx, tris, fb);
-        drawn[t] = std::move(fb);
+        drawRegion(ctx, tris, image.window(grid.region(static_cast<int>(t))));
       });
       for (int p = 0; p < pes; ++p) counters[p].trianglesSent += pull.itemsSent(p);
     }
-    for (const RegionFramebuffer& fb : drawn) resolveInto(fb, image);
     SortCounters sum;
     for (const SortCounters& c : counters) sum += c;
     return sum;
   }
+
+  std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
 };
 
 }  // namespace

@@ -61,9 +61,10 @@ class SortPoint {
  public:
   virtual ~SortPoint() = default;
   virtual std::string_view name() const = 0;  // "sort-first" | "sort-middle" | "sort-last"
-  // Renders one frame on the runtime's PEs into image (full screen, cleared by the caller).
+  // Renders one frame on the runtime's PEs into image (full screen), writing every pixel: what
+  // it held before does not matter, so a caller can reuse one image from frame to frame.
   // Called by the controlling thread; runs one or more stages; may keep state between frames
-  // (sort-first's frame coherence).
+  // (sort-first's frame coherence, binning storage).
   virtual SortCounters renderFrame(const FrameInputs& frame, par::Runtime& runtime, RegionFramebuffer& image) = 0;
 };
 

@@ -16,15 +16,15 @@ RasterCounters& RasterCounters::operator+=(const RasterCounters& o) {
   return *this;
 }
 
-void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, RegionFramebuffer& fb,
+void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, const PixelWindow& fb,
                        RasterCounters* counters) {
   TriangleSetup s;
   if (!setupTriangle(tri, s)) return;
   const uint32_t order = primitiveOrder(tri.primitive, tri.sub);
-  uint64_t* keys = fb.keys();
-  uint32_t* triangles = fb.triangles();
-  const Rect rect = fb.rect();
-  const size_t stride = static_cast<size_t>(rect.width());
+  uint64_t* keys = fb.keys;
+  uint32_t* triangles = fb.triangles;
+  const Rect rect = fb.rect;
+  const size_t stride = fb.stride;
   uint64_t fragments = 0, passed = 0;
   forEachCoveredPixel(s, rect, [&](int x, int y, int64_t e1, int64_t e2) {
     float depth = s.depth0 + float(e1) * s.depthE1 + float(e2) * s.depthE2;
@@ -44,7 +44,7 @@ void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, RegionFra
   }
 }
 
-void rasterizeTriangles(std::span<const ScreenTriangle> tris, RegionFramebuffer& fb, RasterCounters* counters) {
+void rasterizeTriangles(std::span<const ScreenTriangle> tris, const PixelWindow& fb, RasterCounters* counters) {
   for (size_t i = 0; i < tris.size(); ++i) rasterizeTriangle(tris[i], static_cast<uint32_t>(i), fb, counters);
 }
 

@@ -8,12 +8,11 @@
 #include <cstdint>
 #include <span>
 
+#include "raster/framebuffer.h"
 #include "raster/region.h"
 #include "raster/stages/setup.h"
 
 namespace pr::raster {
-
-class RegionFramebuffer;
 
 inline constexpr int kBlockSizePx = 8;
 
@@ -95,14 +94,24 @@ void forEachCoveredPixel(const TriangleSetup& s, const Rect& region, Visit&& vis
   }
 }
 
-// Rasterizes one triangle into the owner's framebuffer, clipped to its rectangle, with the
+// Rasterizes one triangle into the owner's pixels, clipped to the window's rectangle, with the
 // depth test of depth_resolve.h; a winning fragment stores its key and localIndex (the
-// triangle's position in the list the shade stage will read). Touches fb only.
-void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, RegionFramebuffer& fb,
+// triangle's position in the list the shade stage will read). Touches the window only.
+void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, const PixelWindow& pixels,
                        RasterCounters* counters = nullptr);
 
 // All triangles of a list, localIndex = position in the list.
-void rasterizeTriangles(std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+void rasterizeTriangles(std::span<const ScreenTriangle> tris, const PixelWindow& pixels,
                         RasterCounters* counters = nullptr);
+
+// The same into a whole framebuffer.
+inline void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, RegionFramebuffer& fb,
+                              RasterCounters* counters = nullptr) {
+  rasterizeTriangle(tri, localIndex, fb.window(), counters);
+}
+inline void rasterizeTriangles(std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+                               RasterCounters* counters = nullptr) {
+  rasterizeTriangles(tris, fb.window(), counters);
+}
 
 }  // namespace pr::raster

@@ -374,13 +374,13 @@ void shadeBatch(const ShadingContext& ctx, const LaneBatch& b, glm::vec3* colour
 
 }  // namespace
 
-void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const PixelWindow& fb,
                  ShadeCounters* counters) {
   const scene::Scene& scene = *ctx.scene;
-  const Rect rect = fb.rect();
-  const uint64_t* keys = fb.keys();
-  const uint32_t* triangles = fb.triangles();
-  glm::vec3* colours = fb.colours();
+  const Rect rect = fb.rect;
+  const uint64_t* keys = fb.keys;
+  const uint32_t* triangles = fb.triangles;
+  glm::vec3* colours = fb.colours;
 
   // Lanes take the headlight path with per-material constants; anything else (punctual lights,
   // textures, vertex colours) is shaded one pixel at a time by shadeSurface.
@@ -430,8 +430,8 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
   int runX = 0, runY = 0;
   int64_t e[3] = {0, 0, 0};
   uint64_t shaded = 0;
-  size_t i = 0;
   for (int y = rect.y0; y < rect.y1; ++y) {
+    size_t i = fb.index(rect.x0, y);
     for (int x = rect.x0; x < rect.x1; ++x, ++i) {
       if (!keyCovered(keys[i]) || triangles[i] == kNoTriangle) continue;
       const ScreenTriangle& tri = tris[triangles[i]];

@@ -13,11 +13,10 @@
 
 #include "common/scene/light.h"
 #include "common/scene/scene.h"
+#include "raster/framebuffer.h"
 #include "raster/stages/geometry.h"
 
 namespace pr::raster {
-
-class RegionFramebuffer;
 
 // Attributes of the scene surface seen through one pixel sample.
 struct SurfacePoint {
@@ -65,9 +64,15 @@ struct ShadeCounters {
   ShadeCounters& operator+=(const ShadeCounters& o) { pixelsShaded += o.pixelsShaded; return *this; }
 };
 
-// Shades every covered pixel of fb from tris[fb.triangle(x, y)] (the list it was rasterized
-// from) and writes its colour. Uncovered pixels keep the background colour 0.
-void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+// Shades every covered pixel of the window from tris[triangle index there] (the list it was
+// rasterized from) and writes its colour. Uncovered pixels keep the background colour 0.
+void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const PixelWindow& pixels,
                  ShadeCounters* counters = nullptr);
+
+// The same over a whole framebuffer.
+inline void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, RegionFramebuffer& fb,
+                        ShadeCounters* counters = nullptr) {
+  shadeRegion(ctx, tris, fb.window(), counters);
+}
 
 }  // namespace pr::raster
