@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cstring>
 
+#include <emmintrin.h>
+
 #include "common/util/error.h"
 
 namespace pr::raster {
@@ -37,13 +39,50 @@ PixelWindow RegionFramebuffer::window(const Rect& r) {
                      colour_.data() + at};
 }
 
+namespace {
+
+// Non-temporal copy of n bytes (the 16-byte-aligned middle of dst; the ends by memcpy).
+void streamCopy(void* dst, const void* src, size_t n) {
+  auto* d = static_cast<char*>(dst);
+  const auto* s = static_cast<const char*>(src);
+  const size_t head = std::min(n, (16 - reinterpret_cast<uintptr_t>(d) % 16) % 16);
+  std::memcpy(d, s, head);
+  size_t i = head;
+  for (; i + 16 <= n; i += 16)
+    _mm_stream_si128(reinterpret_cast<__m128i*>(d + i), _mm_loadu_si128(reinterpret_cast<const __m128i*>(s + i)));
+  std::memcpy(d + i, s + i, n - i);
+}
+
+// Non-temporal fill of n 32-bit words with value.
+void streamFill(uint32_t* dst, size_t n, uint32_t value) {
+  size_t i = 0;
+  for (; i < n && reinterpret_cast<uintptr_t>(dst + i) % 16 != 0; ++i) dst[i] = value;
+  const __m128i v = _mm_set1_epi32(static_cast<int>(value));
+  for (; i + 4 <= n; i += 4) _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i), v);
+  for (; i < n; ++i) dst[i] = value;
+}
+
+}  // namespace
+
+void RegionFramebuffer::reshape(const Rect& rect) {
+  PR_CHECK(rect.x1 >= rect.x0 && rect.y1 >= rect.y0, "RegionFramebuffer: inverted rectangle");
+  rect_ = rect;
+  const size_t n = static_cast<size_t>(rect.area());
+  key_.resize(n);
+  triangle_.resize(n);
+  colour_.resize(n);
+}
+
 void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst) {
   const Rect r = intersect(src.rect(), dst.rect());
+  const size_t w = static_cast<size_t>(r.width());
   for (int y = r.y0; y < r.y1; ++y) {
-    std::copy_n(src.keys() + src.index(r.x0, y), r.width(), dst.keys() + dst.index(r.x0, y));
-    std::copy_n(src.colours() + src.index(r.x0, y), r.width(), dst.colours() + dst.index(r.x0, y));
-    std::fill_n(dst.triangles() + dst.index(r.x0, y), r.width(), kNoTriangle);
+    streamCopy(dst.keys() + dst.index(r.x0, y), src.keys() + src.index(r.x0, y), w * sizeof(uint64_t));
+    streamCopy(dst.colours() + dst.index(r.x0, y), src.colours() + src.index(r.x0, y), w * sizeof(glm::vec3));
+    streamFill(dst.triangles() + dst.index(r.x0, y), w, kNoTriangle);
   }
+  // Streaming stores are weakly ordered: fence them before anyone else may read the frame.
+  _mm_sfence();
 }
 
 size_t RegionFramebuffer::coveredPixels() const {

@@ -69,6 +69,10 @@ class RegionFramebuffer {
   uint32_t triangle(int x, int y) const { return triangle_[index(x, y)]; }
   const glm::vec3& colour(int x, int y) const { return colour_[index(x, y)]; }
 
+  // Makes this buffer cover rect, keeping its storage when it is large enough (a per-PE scratch
+  // tile reused for region after region); the pixels are unspecified until clear().
+  void reshape(const Rect& rect);
+
   // The whole buffer, or the part of it inside r (which must lie inside rect()).
   PixelWindow window() { return window(rect_); }
   PixelWindow window(const Rect& r);
@@ -88,7 +92,9 @@ class RegionFramebuffer {
 bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
 
 // Stores src's pixels in dst where the two overlap: keys and colours copied, triangle indices
-// kNoTriangle. For finished regions that are disjoint and cover the frame between them.
+// kNoTriangle. For finished regions that are disjoint and cover the frame between them. The
+// frame is written once per frame and not read back while drawing, so the stores bypass the
+// cache (no read of the old frame contents); they are complete when copyInto returns.
 void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst);
 
 // The part of fb inside rect (intersected with fb's rectangle): keys and colours copied,

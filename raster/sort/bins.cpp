@@ -46,8 +46,19 @@ void RegionDrawer::draw(const ShadingContext& ctx, std::span<const std::vector<S
       });
   for (size_t i = 0; i < regions.size(); ++i) {
     const std::span<const ScreenTriangle> bin(storage_.get() + start_[i], start_[i + 1] - start_[i]);
-    drawRegion(ctx, bin, frame.window(grid.region(regions[i])));
+    drawOne(ctx, bin, grid.region(regions[i]), frame);
   }
+}
+
+void RegionDrawer::drawOne(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const Rect& rect,
+                           RegionFramebuffer& frame) {
+  if (rect.area() > kScratchTilePixels) {
+    drawRegion(ctx, tris, frame.window(rect));
+    return;
+  }
+  scratch_.reshape(rect);
+  drawRegion(ctx, tris, scratch_.window());
+  copyInto(scratch_, frame);
 }
 
 }  // namespace pr::raster

@@ -22,13 +22,20 @@ void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scr
 
 // An owner's regions drawn from the screen triangles it holds: each triangle is binned to every
 // one of those regions its pixel bounds overlap (a counting sort into one array, whose storage
-// is kept from frame to frame), then each region is drawn straight into its part of the frame.
-// One per PE; used only by that PE.
+// is kept from frame to frame), then each region is drawn (drawOne). One per PE; used only by
+// that PE.
+inline constexpr long long kScratchTilePixels = 128 * 128;
 class RegionDrawer {
  public:
   // Draws regions (indices into grid) from the triangles of every list in lists.
   void draw(const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists, const RegionGrid& grid,
             std::span<const int> regions, RegionFramebuffer& frame);
+
+  // Draws region rect of the frame from tris. A region up to kScratchTilePixels is drawn in
+  // this PE's scratch buffer, where clearing, depth tests and shading stay in cache, and then
+  // stored into the frame once (copyInto); a larger one (a strip) is drawn in place.
+  void drawOne(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const Rect& rect,
+               RegionFramebuffer& frame);
 
   // Triangles binned by the last draw (a triangle counts once per region it went to).
   size_t binned() const { return binned_; }
@@ -38,7 +45,9 @@ class RegionDrawer {
   size_t capacity_ = 0;
   size_t binned_ = 0;
   std::vector<int> slot_;       // grid region -> position in regions, or -1
-  std::vector<size_t> start_;   // per position: first index in storage_, then the fill cursor
+  std::vector<size_t> start_;   // per position: first index in storage_
+  RegionFramebuffer scratch_;
 };
+
 
 }  // namespace pr::raster

@@ -197,6 +197,7 @@ class SortFirst : public SortPoint {
       }
     });
 
+    drawers_.resize(pes);
     {
       TilePull<uint32_t> pull(rt, "sort-first tile", bins);
       const par::TaskSet set = grid.regionTasks();
@@ -206,7 +207,7 @@ class SortFirst : public SortPoint {
         std::vector<ScreenTriangle> tris;
         transformPrimitives(f.scene, f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
-        drawRegion(ctx, tris, image.window(grid.region(static_cast<int>(t))));
+        drawers_[pe.id()].drawOne(ctx, tris, grid.region(static_cast<int>(t)), image);
       });
       for (int p = 0; p < pes; ++p) counters[p].primitivesSent += pull.itemsSent(p);
     }

@@ -128,12 +128,13 @@ class SortMiddle : public SortPoint {
       }
     });
 
+    drawers_.resize(pes);
     {
       TilePull<ScreenTriangle> pull(rt, "sort-middle tile", bins);
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-middle rasterize", set, [&](par::Pe& pe, par::TaskId t) {
         const std::vector<ScreenTriangle> tris = pull.gather(pe, static_cast<int>(t));
-        drawRegion(ctx, tris, image.window(grid.region(static_cast<int>(t))));
+        drawers_[pe.id()].drawOne(ctx, tris, grid.region(static_cast<int>(t)), image);
       });
       for (int p = 0; p < pes; ++p) counters[p].trianglesSent += pull.itemsSent(p);
     }
