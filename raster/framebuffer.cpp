@@ -53,15 +53,6 @@ void streamCopy(void* dst, const void* src, size_t n) {
   std::memcpy(d + i, s + i, n - i);
 }
 
-// Non-temporal fill of n 32-bit words with value.
-void streamFill(uint32_t* dst, size_t n, uint32_t value) {
-  size_t i = 0;
-  for (; i < n && reinterpret_cast<uintptr_t>(dst + i) % 16 != 0; ++i) dst[i] = value;
-  const __m128i v = _mm_set1_epi32(static_cast<int>(value));
-  for (; i + 4 <= n; i += 4) _mm_stream_si128(reinterpret_cast<__m128i*>(dst + i), v);
-  for (; i < n; ++i) dst[i] = value;
-}
-
 }  // namespace
 
 void RegionFramebuffer::reshape(const Rect& rect) {
@@ -79,7 +70,6 @@ void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst) {
   for (int y = r.y0; y < r.y1; ++y) {
     streamCopy(dst.keys() + dst.index(r.x0, y), src.keys() + src.index(r.x0, y), w * sizeof(uint64_t));
     streamCopy(dst.colours() + dst.index(r.x0, y), src.colours() + src.index(r.x0, y), w * sizeof(glm::vec3));
-    streamFill(dst.triangles() + dst.index(r.x0, y), w, kNoTriangle);
   }
   // Streaming stores are weakly ordered: fence them before anyone else may read the frame.
   _mm_sfence();

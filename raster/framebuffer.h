@@ -91,8 +91,9 @@ class RegionFramebuffer {
 // True when both cover the same rectangle and hold bit-identical keys and colours.
 bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
 
-// Stores src's pixels in dst where the two overlap: keys and colours copied, triangle indices
-// kNoTriangle. For finished regions that are disjoint and cover the frame between them. The
+// Stores src's pixels in dst where the two overlap: keys and colours copied; dst's triangle
+// indices are left alone (an index means something only in the buffer that rasterized the
+// pixel). For finished regions that are disjoint and cover the frame between them. The
 // frame is written once per frame and not read back while drawing, so the stores bypass the
 // cache (no read of the old frame contents); they are complete when copyInto returns.
 void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst);
