@@ -64,8 +64,10 @@ void RegionFramebuffer::reshape(const Rect& rect) {
   colour_.resize(n);
 }
 
-void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst) {
-  const Rect r = intersect(src.rect(), dst.rect());
+void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst) { copyInto(src, dst, src.rect()); }
+
+void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst, const Rect& within) {
+  const Rect r = intersect(intersect(src.rect(), dst.rect()), within);
   const size_t w = static_cast<size_t>(r.width());
   for (int y = r.y0; y < r.y1; ++y) {
     streamCopy(dst.keys() + dst.index(r.x0, y), src.keys() + src.index(r.x0, y), w * sizeof(uint64_t));

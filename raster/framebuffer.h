@@ -97,6 +97,8 @@ bool identical(const RegionFramebuffer& a, const RegionFramebuffer& b);
 // frame is written once per frame and not read back while drawing, so the stores bypass the
 // cache (no read of the old frame contents); they are complete when copyInto returns.
 void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst);
+// The same for the pixels inside `within` only.
+void copyInto(const RegionFramebuffer& src, RegionFramebuffer& dst, const Rect& within);
 
 // The part of fb inside rect (intersected with fb's rectangle): keys and colours copied,
 // triangle indices kNoTriangle. What a sort-last PE sends to the owner of a screen region.

@@ -29,8 +29,8 @@ class BinarySwap : public Compositor {
  public:
   std::string_view name() const override { return "binary-swap"; }
 
-  std::vector<RegionFramebuffer> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
-                                           std::vector<CompositeCounters>& counters) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
+                              std::vector<CompositeCounters>& counters) override {
     const int pes = rt.pes();
     if (!std::has_single_bit(static_cast<unsigned>(pes)))
       throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +
@@ -39,9 +39,8 @@ class BinarySwap : public Compositor {
     std::vector<int> self(pes);
     for (int p = 0; p < pes; ++p) self[p] = p;
 
-    // current[p]: PE p's composited rectangle so far (its own data only).
-    std::vector<RegionFramebuffer> current = std::move(buffers);
-    buffers.assign(pes, RegionFramebuffer());
+    // kept[p]: the rectangle PE p still composites; its pixels stay in buffers[p].
+    std::vector<Rect> kept(pes, buffers[0].rect());
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int k = 0; k < rounds; ++k) {
       par::Channel<PixelMessage> pixels(rt, "binary-swap pixels");
@@ -49,13 +48,12 @@ class BinarySwap : public Compositor {
       rt.runStage("binary-swap round " + std::to_string(k), par::TaskSet::uniform(pes), *owned,
                   [&](par::Pe& pe, par::TaskId) {
                     const int p = pe.id();
-                    for (const PixelMessage& m : inbox[p]) mergePixels(m, current[p]);
+                    for (const PixelMessage& m : inbox[p]) mergePixels(m, buffers[p]);
                     inbox[p].clear();
-                    const auto [lower, upper] = halves(current[p].rect());
+                    const auto [lower, upper] = halves(kept[p]);
                     const bool keepLower = ((p >> k) & 1) == 0;
-                    const Rect give = keepLower ? upper : lower;
-                    PixelMessage m = packPixels(current[p], give, sparse);
-                    current[p] = crop(current[p], keepLower ? lower : upper);
+                    PixelMessage m = packPixels(buffers[p], keepLower ? upper : lower, sparse);
+                    kept[p] = keepLower ? lower : upper;
                     if (sparse && m.pixels() == 0) return;  // nothing covered there: no message
                     const size_t bytes = m.bytes(sparse);
                     CompositeCounters& c = counters[p];
@@ -68,9 +66,9 @@ class BinarySwap : public Compositor {
     }
     auto owned = makeOwnerScheduler(self);
     rt.runStage("binary-swap merge", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
-      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, current[pe.id()]);
+      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
-    return current;
+    return kept;
   }
 };
 

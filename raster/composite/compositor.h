@@ -37,7 +37,7 @@ struct PixelMessage {
 
 // The part of fb inside rect, as the sending PE packs it.
 PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool sparse);
-// Depth-composites a received message into dst (the receiver's own buffer).
+// Depth-composites a received message into dst (the receiver's own buffer), where they overlap.
 void mergePixels(const PixelMessage& message, RegionFramebuffer& dst);
 
 // Traffic a compositor caused, per PE (what the Channel counted, by kind).
@@ -49,12 +49,14 @@ class Compositor {
  public:
   virtual ~Compositor() = default;
   virtual std::string_view name() const = 0;  // "direct-send" | "binary-swap"
-  // Called by the controlling thread after every PE has rendered into buffers[pe]; runs its
-  // own stages. Returns the composited screen regions (disjoint, covering the screen) for the
-  // controller to collect; counters[pe] receives PE pe's traffic. Throws pr::InputError when
-  // the method cannot run with this PE count.
-  virtual std::vector<RegionFramebuffer> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers,
-                                                   bool sparse, std::vector<CompositeCounters>& counters) = 0;
+  // Called by the controlling thread after every PE has rendered and shaded into buffers[pe]
+  // (full screen each); runs its own stages, merging received pixels into the receiver's own
+  // buffer. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
+  // (disjoint rectangles that cover the screen; empty for a PE left without one).
+  // counters[pe] receives PE pe's traffic. Throws pr::InputError when the method cannot run
+  // with this PE count.
+  virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers, bool sparse,
+                                      std::vector<CompositeCounters>& counters) = 0;
 };
 
 std::unique_ptr<Compositor> makeDirectSend();

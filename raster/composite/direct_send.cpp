@@ -18,14 +18,22 @@ PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool spar
   m.rect = intersect(fb.rect(), rect);
   const Rect& r = m.rect;
   if (!sparse) {
-    m.keys.reserve(static_cast<size_t>(r.area()));
-    m.colours.reserve(static_cast<size_t>(r.area()));
+    // Full frame: every pixel, row by row.
+    const size_t w = static_cast<size_t>(r.width());
+    m.keys.resize(static_cast<size_t>(r.area()));
+    m.colours.resize(static_cast<size_t>(r.area()));
+    for (int y = r.y0; y < r.y1; ++y) {
+      const size_t row = static_cast<size_t>(y - r.y0) * w;
+      std::copy_n(fb.keys() + fb.index(r.x0, y), w, m.keys.data() + row);
+      std::copy_n(fb.colours() + fb.index(r.x0, y), w, m.colours.data() + row);
+    }
+    return m;
   }
   for (int y = r.y0; y < r.y1; ++y) {
     for (int x = r.x0; x < r.x1; ++x) {
       const size_t i = fb.index(x, y);
-      if (sparse && !keyCovered(fb.keys()[i])) continue;
-      if (sparse) m.index.push_back(static_cast<uint32_t>((y - r.y0) * r.width() + (x - r.x0)));
+      if (!keyCovered(fb.keys()[i])) continue;
+      m.index.push_back(static_cast<uint32_t>((y - r.y0) * r.width() + (x - r.x0)));
       m.keys.push_back(fb.keys()[i]);
       m.colours.push_back(fb.colours()[i]);
     }
@@ -33,19 +41,35 @@ PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool spar
   return m;
 }
 
+namespace {
+
+// Keeps (key, colour) at dst's pixel i when it beats what is there.
+inline void mergePixel(RegionFramebuffer& dst, size_t i, uint64_t key, const glm::vec3& colour) {
+  if (!depthTest(dst.keys()[i], key)) return;
+  dst.keys()[i] = key;
+  dst.colours()[i] = colour;
+  dst.triangles()[i] = kNoTriangle;
+}
+
+}  // namespace
+
 void mergePixels(const PixelMessage& m, RegionFramebuffer& dst) {
   const Rect& r = m.rect;
+  if (m.index.empty() && m.pixels() == static_cast<size_t>(r.area())) {
+    // Full frame: row by row over the part inside dst.
+    const Rect both = intersect(r, dst.rect());
+    for (int y = both.y0; y < both.y1; ++y) {
+      size_t k = static_cast<size_t>(y - r.y0) * static_cast<size_t>(r.width()) + static_cast<size_t>(both.x0 - r.x0);
+      size_t i = dst.index(both.x0, y);
+      for (int x = both.x0; x < both.x1; ++x, ++k, ++i) mergePixel(dst, i, m.keys[k], m.colours[k]);
+    }
+    return;
+  }
   for (size_t k = 0; k < m.pixels(); ++k) {
     const uint32_t local = m.index.empty() ? static_cast<uint32_t>(k) : m.index[k];
     const int x = r.x0 + static_cast<int>(local % static_cast<uint32_t>(r.width()));
     const int y = r.y0 + static_cast<int>(local / static_cast<uint32_t>(r.width()));
-    if (!dst.rect().contains(x, y)) continue;
-    const size_t i = dst.index(x, y);
-    if (depthTest(dst.keys()[i], m.keys[k])) {
-      dst.keys()[i] = m.keys[k];
-      dst.colours()[i] = m.colours[k];
-      dst.triangles()[i] = kNoTriangle;
-    }
+    if (dst.rect().contains(x, y)) mergePixel(dst, dst.index(x, y), m.keys[k], m.colours[k]);
   }
 }
 
@@ -55,12 +79,12 @@ class DirectSend : public Compositor {
  public:
   std::string_view name() const override { return "direct-send"; }
 
-  std::vector<RegionFramebuffer> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
-                                           std::vector<CompositeCounters>& counters) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
+                              std::vector<CompositeCounters>& counters) override {
     const int pes = rt.pes();
     const Rect screen = buffers[0].rect();
     // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
-    const std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
+    std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
     const int owners = static_cast<int>(strips.size());
     std::vector<int> self(pes);
     for (int p = 0; p < pes; ++p) self[p] = p;
@@ -83,15 +107,12 @@ class DirectSend : public Compositor {
 
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
-    std::vector<RegionFramebuffer> result(owners);
     auto merge = makeOwnerScheduler(self);
     rt.runStage("direct-send merge", par::TaskSet::uniform(pes), *merge, [&](par::Pe& pe, par::TaskId) {
-      const int p = pe.id();
-      if (p >= owners) return;
-      result[p] = crop(buffers[p], strips[p]);
-      for (const PixelMessage& m : inbox[p]) mergePixels(m, result[p]);
+      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
-    return result;
+    strips.resize(pes);  // PEs beyond the strips own nothing
+    return strips;
   }
 };
 

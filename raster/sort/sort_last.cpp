@@ -23,11 +23,20 @@ class SortLast : public SortPoint {
     const Rect screen{0, 0, f.view.width, f.view.height};
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
 
+    // Every PE clears its own full-screen buffer (kept from frame to frame).
+    std::vector<int> self(pes);
+    for (int p = 0; p < pes; ++p) self[p] = p;
+    buffers_.resize(pes);
+    auto clearing = makeOwnerScheduler(self);
+    rt.runStage("sort-last clear", par::TaskSet::uniform(pes), *clearing, [&](par::Pe& pe, par::TaskId) {
+      RegionFramebuffer& mine = buffers_[pe.id()];
+      if (mine.rect() == screen) mine.clear();
+      else mine = RegionFramebuffer(screen);
+    });
+    std::vector<RegionFramebuffer>& buffers = buffers_;
+
     // Stage 1, geometry and rasterization of a PE's batches into its own full-screen buffer;
     // the triangle list stays with the PE for deferred shading (triangle index = list position).
-    std::vector<RegionFramebuffer> buffers;
-    buffers.reserve(pes);
-    for (int p = 0; p < pes; ++p) buffers.emplace_back(screen);
     std::vector<std::vector<ScreenTriangle>> tris(pes);
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const uint32_t batch = f.options.batchSize;
@@ -42,16 +51,18 @@ class SortLast : public SortPoint {
     });
 
     // Stage 2, shading of each PE's visible pixels, in its own buffer.
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
     auto owned = makeOwnerScheduler(self);
     rt.runStage("sort-last shade", par::TaskSet::uniform(pes), *owned,
                 [&](par::Pe& pe, par::TaskId) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
 
     // Stage 3, the sort: depth compositing by screen region.
     std::vector<CompositeCounters> traffic(pes);
-    std::vector<RegionFramebuffer> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
-    for (const RegionFramebuffer& fb : regions) copyInto(fb, image);
+    const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
+    // Each PE stores the region it composited into the frame.
+    auto storing = makeOwnerScheduler(self);
+    rt.runStage("sort-last store", par::TaskSet::uniform(pes), *storing, [&](par::Pe& pe, par::TaskId) {
+      copyInto(buffers[pe.id()], image, regions[pe.id()]);
+    });
 
     SortCounters sum;
     for (const CompositeCounters& c : traffic) {
@@ -61,6 +72,9 @@ class SortLast : public SortPoint {
     }
     return sum;
   }
+
+ private:
+  std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
 };
 
 }  // namespace
