@@ -157,9 +157,7 @@ class SortFirst : public SortPoint {
     previous_.emplace(Previous{f.view, grid});
     scene_ = &f.scene;
     triangles_ = total;
-    SortCounters sum;
-    for (const SortCounters& c : counters) sum += c;
-    return sum;
+    return recordSortCounters(name(), counters, rt);
   }
 
  private:
@@ -211,9 +209,7 @@ class SortFirst : public SortPoint {
       });
       for (int p = 0; p < pes; ++p) counters[p].primitivesSent += pull.itemsSent(p);
     }
-    SortCounters sum;
-    for (const SortCounters& c : counters) sum += c;
-    return sum;
+    return recordSortCounters(name(), counters, rt);
   }
 
   struct Previous {

@@ -64,13 +64,13 @@ class SortLast : public SortPoint {
       copyInto(buffers[pe.id()], image, regions[pe.id()]);
     });
 
-    SortCounters sum;
-    for (const CompositeCounters& c : traffic) {
-      sum.pixelsSent += c.pixelsSent;
-      sum.compositeMessages += c.messages;
-      sum.compositeBytes += c.bytes;
+    std::vector<SortCounters> counters(pes);
+    for (int p = 0; p < pes; ++p) {
+      counters[p].pixelsSent = traffic[p].pixelsSent;
+      counters[p].compositeMessages = traffic[p].messages;
+      counters[p].compositeBytes = traffic[p].bytes;
     }
-    return sum;
+    return recordSortCounters(name(), counters, rt);
   }
 
  private:

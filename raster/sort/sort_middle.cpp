@@ -94,9 +94,7 @@ class SortMiddle : public SortPoint {
       drawers_[p].draw(ctx, inbox[p], grid, grid.regionsOf(p), image);
     });
 
-    SortCounters sum;
-    for (const SortCounters& c : counters) sum += c;
-    return sum;
+    return recordSortCounters(name(), counters, rt);
   }
 
  private:
@@ -138,9 +136,7 @@ class SortMiddle : public SortPoint {
       });
       for (int p = 0; p < pes; ++p) counters[p].trianglesSent += pull.itemsSent(p);
     }
-    SortCounters sum;
-    for (const SortCounters& c : counters) sum += c;
-    return sum;
+    return recordSortCounters(name(), counters, rt);
   }
 
   std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)

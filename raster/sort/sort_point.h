@@ -50,6 +50,14 @@ struct SortCounters {
   SortCounters& operator+=(const SortCounters& o);
 };
 
+// Puts each PE's counters of one frame in the run record as named per-PE counters
+// (Sort/triangles_sent, ...; only those that belong to sortPoint, e.g. "sort-middle") and
+// returns their sum over PEs, the frame's SortCounters. Runtime::addCounter adds, so after N
+// frames the record holds the totals the render command prints. Called by each sort point's
+// renderFrame on the controlling thread, after its last stage; perPe has one entry per PE.
+SortCounters recordSortCounters(std::string_view sortPoint, const std::vector<SortCounters>& perPe,
+                                par::Runtime& runtime);
+
 // One frame to render.
 struct FrameInputs {
   const scene::Scene& scene;
