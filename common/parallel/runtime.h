@@ -105,6 +105,10 @@ class Runtime {
   void attach(ChannelBase* channel);
   void detach(ChannelBase* channel);
   bool inStage() const { return inStage_; }
+  // True from the first failure in the current stage until the next stage starts: a task that
+  // waits inside itself for other PEs (a reply, a handshake) must stop waiting, since a failed
+  // PE never answers; what it throws then is dropped, the first error is the one rethrown.
+  bool aborting() const { return abort_.load(std::memory_order_acquire); }
 
  private:
   struct Doorbell;

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <stdexcept>
 #include <string>
 #include <thread>
 #include <utility>
@@ -22,6 +23,7 @@ class TilePull {
   TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins)
       : runtime_(runtime),
         bins_(bins),
+        name_(name),
         sent_(runtime.pes(), 0),
         replies_(runtime, name + " replies"),
         requests_(runtime, name + " requests", [this](par::Pe& pe, Request&& r) {
@@ -33,7 +35,9 @@ class TilePull {
 
   // Inside the task for `tile` on pe: its own bin plus every other PE's, in PE order. While it
   // waits for replies the PE answers the requests sent to it, so PEs waiting on each other
-  // always make progress.
+  // always make progress. When another PE's task fails the runtime aborts the stage and that
+  // PE never replies: gather throws instead of waiting forever (the runtime keeps the first
+  // error, so the original failure is what runStage rethrows).
   std::vector<Item> gather(par::Pe& pe, int tile) {
     const int pes = runtime_.pes();
     std::vector<std::vector<Item>> parts(pes);
@@ -42,6 +46,9 @@ class TilePull {
       if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()}, sizeof(Request));
     std::vector<Item> reply;
     for (int got = 0; got < pes - 1;) {
+      if (runtime_.aborting())
+        throw std::runtime_error("'" + name_ + "': stage aborted while PE " + std::to_string(pe.id()) +
+                                 " waited for the bins of tile " + std::to_string(tile));
       if (replies_.tryReceive(pe, reply)) {
         for (Item& item : reply) parts[pe.id()].push_back(std::move(item));
         ++got;
@@ -66,6 +73,7 @@ class TilePull {
 
   par::Runtime& runtime_;
   std::vector<std::vector<std::vector<Item>>>& bins_;
+  std::string name_;
   std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
   par::Channel<std::vector<Item>> replies_;
   par::Channel<Request> requests_;
