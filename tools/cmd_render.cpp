@@ -94,7 +94,6 @@ void run(RenderArgs& a) {
   const scene::Scene scene = scene::loadGltf(a.scene);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
 
-  a.schedule.params.pes = a.threads;
   par::Runtime runtime(par::RuntimeOptions{a.threads, a.schedule.schedule, a.schedule.params, true});
   ProgressBar bar(!a.quiet && isatty(STDERR_FILENO));
   const RenderRequest request{scene, camera, a.width, a.height, a.settings, runtime,

@@ -44,7 +44,7 @@ class Channel : public ChannelBase {
   // (defaults to sizeof(T); pass the real payload size for variable-length messages).
   void send(Pe& from, int to, T message, std::size_t bytes = sizeof(T)) {
     PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name_ + "': destination PE out of range");
-    const auto t0 = std::chrono::steady_clock::now();
+    const SendReceiveTimer timer(from);
     runtime_.countMessage(from.id(), to, bytes);
     if (handler_) runtime_.outstanding().add();  // before the receiver can see it
     {
@@ -53,7 +53,6 @@ class Channel : public ChannelBase {
       boxes_[to]->size.store(boxes_[to]->queue.size(), std::memory_order_release);
     }
     runtime_.ring(to);
-    from.counters().commSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
   // One copy to every other PE, counted once per receiving PE.
@@ -65,6 +64,7 @@ class Channel : public ChannelBase {
   // Inside a task on PE `me`: takes one waiting message, if any.
   bool tryReceive(Pe& me, T& out) {
     PR_CHECK(!handler_, "Channel '" + name_ + "' has a handler; its messages are delivered to it");
+    const SendReceiveTimer timer(me);
     std::optional<T> message;
     if (!pop(me.id(), message)) return false;
     out = std::move(*message);
@@ -85,7 +85,10 @@ class Channel : public ChannelBase {
 
   bool handleOne(Pe& pe) override {
     std::optional<T> message;
-    if (!pop(pe.id(), message)) return false;
+    {
+      const SendReceiveTimer timer(pe);
+      if (!pop(pe.id(), message)) return false;
+    }
     handler_(pe, std::move(*message));
     return true;
   }

@@ -144,9 +144,10 @@ class DataManager {
 
  private:
   const T& fetch(Pe& pe, int owner, ItemId item) {
-    const auto t0 = std::chrono::steady_clock::now();
-    T value = load_(owner, item);
-    pe.counters().commSeconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    T value = [&] {
+      const SendReceiveTimer timer(pe);
+      return load_(owner, item);
+    }();
     const std::size_t bytes = bytes_ ? bytes_(value) : sizeof(T);
     pe.runtime().countMessage(pe.id(), owner, kItemRequestBytes);
     pe.runtime().countMessage(owner, pe.id(), bytes);

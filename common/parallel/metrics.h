@@ -19,10 +19,12 @@ Spread spreadOf(const std::vector<double>& values);
 // max(busy) / mean(busy) - 1 (shared/DESIGN.md); 0 for no work at all.
 double loadImbalance(const std::vector<double>& busySeconds);
 
-// The per-PE figures, by their JSON/C++ name, in a fixed order.
+// The per-PE figures, by their JSON/C++ name, in a fixed order, each with where it comes from:
+// "measured" (a clock or a counter at the event) or "modelled: ..." (how it is derived).
 struct PeFigure {
   const char* name;
   double (*get)(const PeStageRecord&);
+  const char* provenance;
 };
 const std::vector<PeFigure>& peFigures();
 

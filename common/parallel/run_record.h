@@ -13,14 +13,19 @@
 
 namespace pr::par {
 
-// One PE in one stage. busy = inside tasks and message handlers; idle = stage wall - busy;
-// syncWaitSeconds = the part of idle after the PE's last piece of work until the stage ended
-// (waiting at the end-of-stage synchronisation point).
+// One PE in one stage. busy = inside tasks and message handlers, less the time a task waited
+// for a reply; idle = stage wall - busy; syncWaitSeconds = the part of idle after the PE's last
+// piece of work until the stage ended (waiting at the end-of-stage synchronisation point).
+// Communication time is sendReceiveSeconds (inside Channel calls, part of busy) plus
+// messageWaitSeconds (waiting on an empty mailbox while work was still to come, inside a task
+// or between tasks; part of idle, never of syncWait).
 struct PeStageRecord {
   double busySeconds = 0.0;
   double idleSeconds = 0.0;
   double syncWaitSeconds = 0.0;
-  double commSeconds = 0.0;  // inside Channel send/receive, part of busy
+  double sendReceiveSeconds = 0.0;
+  double messageWaitSeconds = 0.0;
+  double commSeconds() const { return sendReceiveSeconds + messageWaitSeconds; }
   std::uint64_t tasks = 0;
   std::uint64_t messagesHandled = 0;
   std::uint64_t messagesSent = 0, bytesSent = 0;
@@ -47,6 +52,7 @@ struct StageRecord {
   std::vector<PeStageRecord> pes;
   std::vector<Traffic> traffic;
   std::vector<TaskInfo> tasks;  // the stage's TaskSet (cost estimates, positions)
+  std::vector<int> owners;      // owner-pinned stages: the PE of each task; empty otherwise
 };
 
 // One task (or, with task = kMessageSpan, one message handler) on one PE.

@@ -47,7 +47,9 @@ json peJson(const PeStageRecord& r) {
   return {{"busySeconds", r.busySeconds},
           {"idleSeconds", r.idleSeconds},
           {"syncWaitSeconds", r.syncWaitSeconds},
-          {"commSeconds", r.commSeconds},
+          {"sendReceiveSeconds", r.sendReceiveSeconds},
+          {"messageWaitSeconds", r.messageWaitSeconds},
+          {"commSeconds", r.commSeconds()},
           {"tasks", r.tasks},
           {"messagesHandled", r.messagesHandled},
           {"messagesSent", r.messagesSent},
@@ -72,6 +74,10 @@ json toJson(const RunRecord& record) {
   j["error"] = record.error;
   const RunSummary summary = summarize(record);
   j["summary"] = summaryJson(summary.total);
+  json provenance = json::object();
+  for (const PeFigure& f : peFigures()) provenance[f.name] = f.provenance;
+  j["figureProvenance"] = provenance;  // per figure: "measured" or "modelled: how"
+
   json stages = json::array();
   for (std::size_t i = 0; i < record.stages.size(); ++i) {
     const StageRecord& s = record.stages[i];
@@ -91,6 +97,7 @@ json toJson(const RunRecord& record) {
     json tasks = json::array();
     for (const TaskInfo& t : s.tasks) tasks.push_back({t.costEstimate, t.x, t.y});
     js["tasks"] = tasks;  // [costEstimate, x, y]
+    if (!s.owners.empty()) js["owners"] = s.owners;  // owner-pinned stages: the PE of each task
     stages.push_back(js);
   }
   j["stages"] = stages;
@@ -174,7 +181,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       r.busySeconds = jp.value("busySeconds", 0.0);
       r.idleSeconds = jp.value("idleSeconds", 0.0);
       r.syncWaitSeconds = jp.value("syncWaitSeconds", 0.0);
-      r.commSeconds = jp.value("commSeconds", 0.0);
+      r.sendReceiveSeconds = jp.value("sendReceiveSeconds", 0.0);
+      r.messageWaitSeconds = jp.value("messageWaitSeconds", 0.0);
       r.tasks = jp.value("tasks", std::uint64_t{0});
       r.messagesHandled = jp.value("messagesHandled", std::uint64_t{0});
       r.messagesSent = jp.value("messagesSent", std::uint64_t{0});
@@ -199,6 +207,9 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
         throw InputError(origin + ": " + where + " \"tasks\" entries must be [costEstimate, x, y]");
       s.tasks.push_back({jt[0].get<double>(), jt[1].get<float>(), jt[2].get<float>()});
     }
+    s.owners = js.value("owners", std::vector<int>());
+    if (!s.owners.empty() && s.owners.size() != s.tasks.size())
+      throw InputError(origin + ": " + where + " \"owners\" must name one PE per task");
     record.stages.push_back(std::move(s));
   }
   const json timeline = field<json>(j, "timeline", origin, "run record");

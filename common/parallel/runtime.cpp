@@ -1,5 +1,6 @@
-// The thread engine: one std::thread per PE for each stage, a Scheduler shared by all of them,
-// counters per PE, and the end-of-stage bookkeeping that turns counters into a StageRecord.
+// The thread engine: one std::thread per PE for the runtime's life, a Scheduler shared by all of
+// them in each stage, counters per PE, and the end-of-stage bookkeeping that turns counters into
+// a StageRecord.
 // Sits between the renderers' stages and metrics.cpp (seed chapter 3, task management).
 #include "common/parallel/runtime.h"
 
@@ -25,7 +26,6 @@ Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(
     throw InputError("number of PEs must be in [1, 4096], got " + std::to_string(options_.pes));
   if (options_.params.grain < 1)
     throw InputError("grain must be at least 1 task, got " + std::to_string(options_.params.grain));
-  options_.params.pes = options_.pes;
   schedule_ = makeScheduler(options_.schedule);
   const int p = options_.pes;
   counters_ = std::vector<PeCounters>(p);
@@ -38,10 +38,71 @@ Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(
   record_.grain = options_.params.grain;
 }
 
-Runtime::~Runtime() = default;
+Runtime::~Runtime() {
+  {
+    std::lock_guard lock(stageMutex_);
+    shutdown_ = true;
+  }
+  stageStart_.notify_all();
+  for (std::thread& t : workers_) t.join();
+}
+
+void Runtime::startWorkers() {
+  workers_.reserve(options_.pes);
+  for (int p = 0; p < options_.pes; ++p) workers_.emplace_back([this, p] { workerMain(p); });
+}
+
+namespace {
+
+// Polls ready() with yields for a few tens of microseconds before the caller blocks: stages of a
+// raster frame follow each other within microseconds, and a futex wake-up costs more than that.
+template <class Ready>
+void spinBriefly(Ready&& ready) {
+  for (int i = 0; i < 256 && !ready(); ++i) std::this_thread::yield();
+}
+
+}  // namespace
+
+// A PE thread: waits for the next stage, runs its share, reports back; until the runtime ends.
+void Runtime::workerMain(int p) {
+  std::uint64_t seen = 0;
+  for (;;) {
+    StageJob job;
+    spinBriefly([&] { return generation_.load(std::memory_order_acquire) != seen; });
+    {
+      std::unique_lock lock(stageMutex_);
+      stageStart_.wait(lock, [&] { return shutdown_ || generation_ != seen; });
+      if (shutdown_) return;
+      seen = generation_;
+      job = job_;
+    }
+    peLoop(p, *job.scheduler, *job.work, job.stage, *job.name);
+    {
+      std::lock_guard lock(stageMutex_);
+      if (--running_ == 0) stageDone_.notify_one();
+    }
+  }
+}
 
 void Runtime::runStage(std::string_view name, const TaskSet& tasks, const TaskFn& work) {
   runStage(name, tasks, *schedule_, work);
+}
+
+void Runtime::runPinned(std::string_view name, const TaskSet& tasks, std::vector<int> owner, const TaskFn& work) {
+  const std::unique_ptr<Scheduler> pinned = makeOwnerPinnedScheduler(owner);
+  pinnedOwners_ = std::move(owner);
+  runStage(name, tasks, *pinned, work);
+}
+
+void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work) {
+  std::vector<int> owner(static_cast<std::size_t>(options_.pes));
+  for (int p = 0; p < options_.pes; ++p) owner[static_cast<std::size_t>(p)] = p;
+  const TaskSet tasks = TaskSet::uniform(owner.size());
+  runPinned(name, tasks, std::move(owner), [&](Pe& pe, TaskId t) {
+    PR_CHECK(t == pe.id(), "task " + std::to_string(t) + " of each-PE stage '" + pe.stageName() + "' ran on PE " +
+                               std::to_string(pe.id()));
+    work(pe);
+  });
 }
 
 void Runtime::recordBroadcast(std::size_t bytesPerPe) {
@@ -116,11 +177,24 @@ void Runtime::fail(int p, const std::string& stage, TaskId task, std::exception_
   ringAll();
 }
 
+// A PE with no task left blocks here until a message arrives or the stage's work is done. Whether
+// the wait was for a message or at the closing barrier is known only afterwards: the wait is
+// kept pending, booked as message waiting when more work follows (confirmWait), and left as
+// barrier time (syncWaitSeconds) when nothing does.
 void Runtime::waitForWork(int p) {
   Doorbell& bell = *bells_[p];
-  std::unique_lock lock(bell.mutex);
-  bell.cv.wait(lock, [&] { return bell.rung || outstanding_.finished() || abort_.load(std::memory_order_acquire); });
-  bell.rung = false;
+  const double t0 = now();
+  {
+    std::unique_lock lock(bell.mutex);
+    bell.cv.wait(lock, [&] { return bell.rung || outstanding_.finished() || abort_.load(std::memory_order_acquire); });
+    bell.rung = false;
+  }
+  counters_[p].pendingWaitSeconds += now() - t0;
+}
+
+void Runtime::confirmWait(PeCounters& c) {
+  c.messageWaitSeconds += c.pendingWaitSeconds;
+  c.pendingWaitSeconds = 0.0;
 }
 
 // Handles every message waiting for pe in the handled channels; true when it handled any.
@@ -132,9 +206,11 @@ bool Runtime::handleMessages(Pe& pe, std::vector<TaskSpan>& spans) {
       const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
       const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
       const double t0 = now();
+      confirmWait(c);
+      const double w0 = c.inTaskWaitSeconds;
       if (!channel->handleOne(pe)) break;
       const double t1 = now();
-      c.busySeconds += t1 - t0;
+      c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
       c.lastWorkEnd = t1;
       c.messagesHandled.fetch_add(1, std::memory_order_relaxed);
       if (options_.recordTimeline)
@@ -179,9 +255,11 @@ void Runtime::peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage,
           const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
           const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
           const double t0 = now();
+          confirmWait(c);
+          const double w0 = c.inTaskWaitSeconds;
           work(pe, id);
           const double t1 = now();
-          c.busySeconds += t1 - t0;
+          c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
           c.lastWorkEnd = t1;
           c.tasks.fetch_add(1, std::memory_order_relaxed);
           if (options_.recordTimeline)
@@ -215,7 +293,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
                     &c.bytesReceived, &c.schedulingMessages, &c.schedulingBytes, &c.cacheHits, &c.cacheMisses,
                     &c.prefetches})
       a->store(0, std::memory_order_relaxed);
-    c.busySeconds = c.commSeconds = 0.0;
+    c.busySeconds = c.sendReceiveSeconds = c.messageWaitSeconds = c.inTaskWaitSeconds = c.pendingWaitSeconds = 0.0;
   }
   for (auto& a : pairMessages_) a.store(0, std::memory_order_relaxed);
   for (auto& a : pairBytes_) a.store(0, std::memory_order_relaxed);
@@ -224,19 +302,25 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   abort_.store(false);
   error_ = nullptr;
   outstanding_.reset(static_cast<std::int64_t>(tasks.size()));
-  ScheduleParams params = options_.params;
-  params.pes = pes;
-  scheduler.reset(tasks, params);
+  scheduler.reset(tasks, pes, options_.params);
+  std::vector<int> owners = std::move(pinnedOwners_);
+  pinnedOwners_.clear();
 
+  if (workers_.empty()) startWorkers();
   inStage_ = true;
   const double start = now();
   for (PeCounters& c : counters_) c.lastWorkEnd = start;
   {
-    std::vector<std::thread> threads;
-    threads.reserve(pes);
-    for (int p = 0; p < pes; ++p)
-      threads.emplace_back([&, p] { peLoop(p, scheduler, work, stage, name); });
-    for (std::thread& t : threads) t.join();
+    std::unique_lock lock(stageMutex_);
+    job_ = StageJob{&scheduler, &work, stage, &name};
+    running_ = pes;
+    ++generation_;
+  }
+  stageStart_.notify_all();
+  spinBriefly([&] { return running_.load(std::memory_order_acquire) == 0; });
+  {
+    std::unique_lock lock(stageMutex_);
+    stageDone_.wait(lock, [&] { return running_ == 0; });
   }
   const double end = now();
   inStage_ = false;
@@ -246,10 +330,11 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   StageRecord sr;
   sr.name = name;
   sr.schedule = std::string(scheduler.name());
-  sr.grain = params.grain;
+  sr.grain = options_.params.grain;
   sr.startSeconds = start;
   sr.wallSeconds = end - start;
   sr.tasks = tasks.tasks;
+  sr.owners = std::move(owners);
   sr.pes.resize(pes);
   for (int p = 0; p < pes; ++p) {
     const PeCounters& c = counters_[p];
@@ -257,7 +342,8 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.busySeconds = c.busySeconds;
     r.idleSeconds = std::max(0.0, sr.wallSeconds - c.busySeconds);
     r.syncWaitSeconds = std::max(0.0, end - std::max(c.lastWorkEnd, start));
-    r.commSeconds = c.commSeconds;
+    r.sendReceiveSeconds = c.sendReceiveSeconds;
+    r.messageWaitSeconds = c.messageWaitSeconds;
     r.tasks = c.tasks.load();
     r.messagesHandled = c.messagesHandled.load();
     r.messagesSent = c.messagesSent.load();

@@ -26,9 +26,12 @@
 // An exception thrown by a task or handler stops every PE at its next task boundary and is
 // rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
 // P may exceed the core count: idle PEs block on a condition variable, they do not spin.
+// The PE threads live for the runtime's lifetime (started by the first stage): a stage costs a
+// wake-up and a barrier, not P thread creations (bench_runtime section 6).
 #pragma once
 
 #include <chrono>
+#include <condition_variable>
 #include <cstddef>
 #include <exception>
 #include <functional>
@@ -36,6 +39,7 @@
 #include <mutex>
 #include <string>
 #include <string_view>
+#include <thread>
 #include <vector>
 
 #include "common/parallel/pe.h"
@@ -49,7 +53,7 @@ namespace pr::par {
 struct RuntimeOptions {
   int pes = 1;
   std::string schedule = "demand";  // registry name (schedulers/registry.cpp)
-  ScheduleParams params;            // params.pes is set from pes
+  ScheduleParams params;
   bool recordTimeline = true;       // keep one TaskSpan per task and handled message
 };
 
@@ -82,6 +86,13 @@ class Runtime {
   // runtime's schedule (options().schedule).
   void runStage(std::string_view name, const TaskSet& tasks, const TaskFn& work);
   void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work);
+  // Task t runs on PE owner[t] (owner-pinned: a region, voxel or buffer runs where its data is),
+  // whatever the runtime's schedule; the record names the stage's schedule "owner-pinned" and
+  // keeps the owners, so the simulator can say how the method would pin them at another P.
+  void runPinned(std::string_view name, const TaskSet& tasks, std::vector<int> owner, const TaskFn& work);
+  // One task on each PE, task p on PE p: owner-local work (build my BVHs, clear my buffers,
+  // composite my rectangle) that no other PE may do for it (shared/DESIGN.md rule 1).
+  void runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work);
 
   // Replicated read-only data (scene, photon map) of bytesPerPe, sent once to every PE:
   // counted as one broadcast message per receiving PE in the next stage run.
@@ -112,10 +123,19 @@ class Runtime {
 
  private:
   struct Doorbell;
+  struct StageJob {
+    Scheduler* scheduler = nullptr;
+    const TaskFn* work = nullptr;
+    int stage = 0;
+    const std::string* name = nullptr;
+  };
 
+  void startWorkers();
+  void workerMain(int p);
   void peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name);
   bool handleMessages(Pe& pe, std::vector<TaskSpan>& spans);
   void waitForWork(int p);
+  static void confirmWait(PeCounters& c);
   void ringAll();
   void fail(int p, const std::string& stage, TaskId task, std::exception_ptr error);
 
@@ -133,6 +153,18 @@ class Runtime {
   std::atomic<bool> abort_{false};
   bool inStage_ = false;
   std::size_t pendingBroadcastBytes_ = 0, pendingBroadcasts_ = 0;
+
+  // The PE threads and the stage hand-over: the controlling thread publishes job_ and bumps
+  // generation_; each worker runs it once and the last one to finish wakes the controller.
+  std::vector<std::thread> workers_;
+  std::mutex stageMutex_;
+  std::condition_variable stageStart_, stageDone_;
+  // Written under stageMutex_, read without it by the short spin before a blocking wait.
+  std::atomic<std::uint64_t> generation_{0};
+  std::atomic<int> running_{0};
+  bool shutdown_ = false;
+  StageJob job_;
+  std::vector<int> pinnedOwners_;  // owners of the next stage's tasks, when runPinned runs it
 
   std::mutex counterMutex_;
   std::mutex errorMutex_;

@@ -139,8 +139,7 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
   if (options.pes < 1 || options.pes > 65536)
     throw InputError("simulated PEs must be in [1, 65536], got " + std::to_string(options.pes));
   const int pes = options.pes;
-  ScheduleParams params = options.params;
-  params.pes = pes;
+  const ScheduleParams& params = options.params;
   const NetworkModel& net = options.network;
 
   RunRecord record;
@@ -156,7 +155,7 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
     const SimStage& stage = workload.stages[s];
     PR_CHECK(stage.costs.size() == stage.tasks.size(), "SimStage costs and tasks differ in size");
     const bool traffic = !stage.messages.empty();
-    scheduler.reset(stage.tasks, params);
+    scheduler.reset(stage.tasks, pes, params);
     StageRecord sr;
     sr.name = stage.name;
     sr.schedule = record.schedule;
@@ -193,7 +192,7 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
         if (traffic && stage.messages[id] > 0) {
           const double send = net.seconds(stage.messages[id], stage.bytes[id]);
           d += send;
-          r.commSeconds += send;
+          r.sendReceiveSeconds += send;
           r.messagesSent += stage.messages[id];
           r.bytesSent += stage.bytes[id];
         }

@@ -65,7 +65,7 @@ Workload readWorkload(const std::filesystem::path& file);
 
 struct SimOptions {
   int pes = 1;
-  ScheduleParams params;  // params.pes is set from pes
+  ScheduleParams params;
   NetworkModel network;   // zero cost by default
   bool recordTimeline = false;
 };

@@ -36,17 +36,13 @@ class BinarySwap : public Compositor {
       throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +
                        " (use direct-send)");
     const int rounds = std::countr_zero(static_cast<unsigned>(pes));
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
 
     // kept[p]: the rectangle PE p still composites; its pixels stay in buffers[p].
     std::vector<Rect> kept(pes, buffers[0].rect());
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int k = 0; k < rounds; ++k) {
       par::Channel<PixelMessage> pixels(rt, "binary-swap pixels");
-      auto owned = makeOwnerScheduler(self);
-      rt.runStage("binary-swap round " + std::to_string(k), par::TaskSet::uniform(pes), *owned,
-                  [&](par::Pe& pe, par::TaskId) {
+      rt.runOnEachPe("binary-swap round " + std::to_string(k), [&](par::Pe& pe) {
                     const int p = pe.id();
                     for (const PixelMessage& m : inbox[p]) mergePixels(m, buffers[p]);
                     inbox[p].clear();
@@ -64,8 +60,7 @@ class BinarySwap : public Compositor {
                   });
       for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
     }
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("binary-swap merge", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("binary-swap merge", [&](par::Pe& pe) {
       for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
     return kept;

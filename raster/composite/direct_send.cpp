@@ -86,12 +86,9 @@ class DirectSend : public Compositor {
     // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
     std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
     const int owners = static_cast<int>(strips.size());
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
 
     par::Channel<PixelMessage> pixels(rt, "composite pixels");
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("direct-send", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("direct-send", [&](par::Pe& pe) {
       CompositeCounters& c = counters[pe.id()];
       for (int o = 0; o < owners; ++o) {
         if (o == pe.id()) continue;
@@ -107,8 +104,7 @@ class DirectSend : public Compositor {
 
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
-    auto merge = makeOwnerScheduler(self);
-    rt.runStage("direct-send merge", par::TaskSet::uniform(pes), *merge, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("direct-send merge", [&](par::Pe& pe) {
       for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
     strips.resize(pes);  // PEs beyond the strips own nothing

@@ -1,5 +1,5 @@
 // Region assignment for the parallel raster pipelines: the region grid (static strips or
-// round-robin tiles) and the owner-placed schedule that runs each region's task on its owner.
+// round-robin tiles) and its owners.
 #include "raster/sort/region_assignment.h"
 
 #include <algorithm>
@@ -68,45 +68,6 @@ std::vector<int> RegionGrid::regionsOf(int pe) const {
 int RegionGrid::cellOf(const std::vector<int>& edges, int v) {
   // edges is increasing with edges.front() <= v < edges.back(): the cell whose start is <= v.
   return static_cast<int>(std::upper_bound(edges.begin(), edges.end(), v) - edges.begin()) - 1;
-}
-
-namespace {
-
-class OwnerScheduler : public par::Scheduler {
- public:
-  explicit OwnerScheduler(std::vector<int> owner) : owner_(std::move(owner)) {}
-  std::string_view name() const override { return "owner"; }
-
-  void reset(const par::TaskSet& tasks, const par::ScheduleParams& params) override {
-    PR_CHECK(tasks.size() == owner_.size(), "owner schedule: one owner per task");
-    portions_.assign(params.pes, {});
-    for (size_t t = 0; t < owner_.size(); ++t) {
-      PR_CHECK(owner_[t] >= 0 && owner_[t] < params.pes, "owner schedule: owner out of range");
-      portions_[owner_[t]].push_back(static_cast<par::TaskId>(t));
-    }
-    sent_.assign(params.pes, 0);
-  }
-
-  // Each PE touches only its own portion and flag.
-  void next(int pe, double, par::Grab& out) override {
-    out.clear();
-    if (sent_[pe] || portions_[pe].empty()) return;
-    sent_[pe] = 1;
-    out.tasks = portions_[pe];
-    out.packets = 1;
-    out.moved = out.tasks.size();
-  }
-
- private:
-  std::vector<int> owner_;
-  std::vector<std::vector<par::TaskId>> portions_;
-  std::vector<char> sent_;
-};
-
-}  // namespace
-
-std::unique_ptr<par::Scheduler> makeOwnerScheduler(std::vector<int> owner) {
-  return std::make_unique<OwnerScheduler>(std::move(owner));
 }
 
 }  // namespace pr::raster

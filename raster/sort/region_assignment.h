@@ -63,9 +63,4 @@ class RegionGrid {
   std::vector<int> owner_;
 };
 
-// A static schedule that runs task t on PE owner[t]: how the pipelines place a task on the PE
-// that owns its data (a region, a PE's own buffers). Sent as one packet per PE, like the
-// data-driven models.
-std::unique_ptr<par::Scheduler> makeOwnerScheduler(std::vector<int> owner);
-
 }  // namespace pr::raster

@@ -90,14 +90,11 @@ class SortFirst : public SortPoint {
     std::vector<SortCounters> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
     par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives");
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
     // the lowest of its previous owners (its primary); an unseen primitive has one holder.
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("sort-first pre-transform", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       SortCounters& c = counters[p];
       std::vector<std::vector<uint32_t>> out(pes);
@@ -140,8 +137,7 @@ class SortFirst : public SortPoint {
     // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
     // it holds, then rasterize and shade.
     drawers_.resize(pes);
-    auto owned2 = makeOwnerScheduler(self);
-    rt.runStage("sort-first render", par::TaskSet::uniform(pes), *owned2, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-first render", [&](par::Pe& pe) {
       const int p = pe.id();
       std::vector<uint32_t>& mine = kept[p];
       mine.insert(mine.end(), received[p].begin(), received[p].end());
@@ -171,10 +167,7 @@ class SortFirst : public SortPoint {
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     std::vector<SortCounters> counters(pes);
     std::vector<std::vector<std::vector<uint32_t>>> bins(pes, std::vector<std::vector<uint32_t>>(tiles));
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("sort-first pre-transform", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       SortCounters& c = counters[p];
       const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);

@@ -24,11 +24,8 @@ class SortLast : public SortPoint {
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
 
     // Every PE clears its own full-screen buffer (kept from frame to frame).
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
     buffers_.resize(pes);
-    auto clearing = makeOwnerScheduler(self);
-    rt.runStage("sort-last clear", par::TaskSet::uniform(pes), *clearing, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-last clear", [&](par::Pe& pe) {
       RegionFramebuffer& mine = buffers_[pe.id()];
       if (mine.rect() == screen) mine.clear();
       else mine = RegionFramebuffer(screen);
@@ -51,16 +48,13 @@ class SortLast : public SortPoint {
     });
 
     // Stage 2, shading of each PE's visible pixels, in its own buffer.
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("sort-last shade", par::TaskSet::uniform(pes), *owned,
-                [&](par::Pe& pe, par::TaskId) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
+    rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
 
     // Stage 3, the sort: depth compositing by screen region.
     std::vector<CompositeCounters> traffic(pes);
     const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
     // Each PE stores the region it composited into the frame.
-    auto storing = makeOwnerScheduler(self);
-    rt.runStage("sort-last store", par::TaskSet::uniform(pes), *storing, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-last store", [&](par::Pe& pe) {
       copyInto(buffers[pe.id()], image, regions[pe.id()]);
     });
 

@@ -86,10 +86,7 @@ class SortMiddle : public SortPoint {
     // Stage 2, rasterize and shade: each owner draws its regions of the frame from its own
     // triangles.
     drawers_.resize(pes);
-    std::vector<int> self(pes);
-    for (int p = 0; p < pes; ++p) self[p] = p;
-    auto owned = makeOwnerScheduler(self);
-    rt.runStage("sort-middle rasterize", par::TaskSet::uniform(pes), *owned, [&](par::Pe& pe, par::TaskId) {
+    rt.runOnEachPe("sort-middle rasterize", [&](par::Pe& pe) {
       const int p = pe.id();
       drawers_[p].draw(ctx, inbox[p], grid, grid.regionsOf(p), image);
     });

@@ -56,7 +56,10 @@ class TilePull {
         pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
         runtime_.outstanding().done();  // this task is still counted, so never the last unit
       } else {
+        // Waiting for a reply is communication, not work: booked as such, not as busy.
+        const double t0 = runtime_.now();
         std::this_thread::yield();
+        pe.recordWait(runtime_.now() - t0);
       }
     }
     return std::move(parts[pe.id()]);

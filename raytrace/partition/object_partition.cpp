@@ -50,7 +50,7 @@ class ObjectFrame {
 
   TraceResult run(PartitionFigures& figures) {
     const int pes = rt_.pes();
-    runOnEveryOwner(rt_, "build", [&](par::Pe& pe) {
+    rt_.runOnEachPe("build", [&](par::Pe& pe) {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
         bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);

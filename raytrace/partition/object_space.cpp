@@ -48,7 +48,7 @@ class ObjectSpaceFrame {
   TraceResult run(PartitionFigures& figures) {
     const int pes = rt_.pes();
     // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
-    runOnEveryOwner(rt_, "build", [&](par::Pe& pe) {
+    rt_.runOnEachPe("build", [&](par::Pe& pe) {
       for (int v = 0; v < split_.voxels(); ++v)
         if (owners_[v] == pe.id() && !split_.triangles(v).empty())
           bvhs_[v] = Bvh(job_.scene.positions, job_.scene.triangles, split_.triangles(v), job_.options.bvh);

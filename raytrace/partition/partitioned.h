@@ -29,17 +29,6 @@ struct PartitionFigures {
   int partitions = 0;                    // voxels or object pieces
 };
 
-// Runs ownerWork(pe) once on every PE, on that PE itself: owner-local work such as building the
-// BVHs of the PE's own partition, which no other PE may do for it (shared/DESIGN.md rule 1).
-// A balanced data-driven split of P tasks over P PEs hands task p to PE p, whatever --schedule says.
-inline void runOnEveryOwner(par::Runtime& rt, std::string_view stage, const std::function<void(par::Pe&)>& ownerWork) {
-  const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
-  rt.runStage(stage, par::TaskSet::uniform(rt.pes()), *balanced, [&](par::Pe& pe, par::TaskId t) {
-    PR_CHECK(t == pe.id(), "owner-local task " + std::to_string(t) + " ran on PE " + std::to_string(pe.id()));
-    ownerWork(pe);
-  });
-}
-
 // Puts the per-PE figures in the run record as named counters, beside the runtime's own
 // measurements, so `render` summaries and --metrics JSON report them.
 inline void recordPartitionFigures(const PartitionFigures& figures, par::Runtime& rt) {

@@ -6,7 +6,9 @@
 //     and the effect of the grain (task packet size) on efficiency and request traffic;
 //  3. parallel efficiency at P = 2 on an embarrassingly parallel workload (target >= 97%);
 //  4. the simulator's prediction of recorded runs at P = 1 and 2 (target within 10%);
-//  5. simulator speed in simulated tasks per second (target >= 1M).
+//  5. simulator speed in simulated tasks per second (target >= 1M);
+//  6. the fixed cost of one stage (start, barrier, record) at P = 1, 2 and 4, beside the cost
+//     of one empty task, as a raster frame runs two to five stages.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -162,6 +164,35 @@ void simulatorSpeed() {
   }
 }
 
+void stageOverhead() {
+  const int stages = 2000;
+  std::printf("\n6. stage overhead, %d stages of P empty tasks each (per stage, median of 5 rounds)\n", stages);
+  std::printf("%3s %14s %16s\n", "P", "per stage", "per stage / task");
+  for (int pes : {1, 2, 4}) {
+    RuntimeOptions options;
+    options.pes = pes;
+    options.schedule = "balanced";
+    options.recordTimeline = false;
+    Runtime rt(options);
+    const TaskSet tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
+    rt.runStage("warm-up", tasks, [](Pe&, TaskId) {});
+    std::vector<double> rounds;
+    for (int round = 0; round < 5; ++round) {
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int s = 0; s < stages; ++s) rt.runStage("empty", tasks, [](Pe&, TaskId) {});
+      rounds.push_back(secondsSince(t0) / stages);
+    }
+    std::sort(rounds.begin(), rounds.end());
+    // The anchor in the same run: one empty task under the demand pool (section 2's figure).
+    Runtime pool(RuntimeOptions{pes, "demand", ScheduleParams(), false});
+    const TaskSet many = TaskSet::uniform(100000);
+    const auto t1 = std::chrono::steady_clock::now();
+    pool.runStage("empty", many, [](Pe&, TaskId) {});
+    const double perTask = secondsSince(t1) / 100000;
+    std::printf("%3d %11.2f us %16.0f\n", pes, rounds[2] * 1e6, rounds[2] / perTask);
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -173,5 +204,6 @@ int main() {
   efficiency();
   prediction();
   simulatorSpeed();
+  stageOverhead();
   return 0;
 }

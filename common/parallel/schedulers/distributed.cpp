@@ -15,8 +15,8 @@ class DistributedScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "distributed"; }
 
-  void reset(const TaskSet& tasks, const ScheduleParams& params) override {
-    pes_ = params.pes;
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
+    pes_ = pes;
     grain_ = std::max(1, params.grain);
     pools_.clear();
     for (int p = 0; p < pes_; ++p) pools_.push_back(std::make_unique<Pool>());

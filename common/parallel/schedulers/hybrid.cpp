@@ -14,11 +14,11 @@ class HybridScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "hybrid"; }
 
-  void reset(const TaskSet& tasks, const ScheduleParams& params) override {
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
     const double fraction = std::clamp(params.staticFraction, 0.0, 1.0);
     staticCount_ = static_cast<std::size_t>(std::ceil(fraction * tasks.size()));
-    portions_ = balancedSplit(staticCount_, params.pes);
-    sent_.assign(params.pes, 0);
+    portions_ = balancedSplit(staticCount_, pes);
+    sent_.assign(pes, 0);
     total_ = tasks.size();
     grain_ = std::max(1, params.grain);
     cursor_.store(staticCount_, std::memory_order_relaxed);

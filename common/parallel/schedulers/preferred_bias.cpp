@@ -14,12 +14,12 @@ class PreferredBiasScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "preferred-bias"; }
 
-  void reset(const TaskSet& tasks, const ScheduleParams& params) override {
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
     grain_ = std::max(1, params.grain);
     costs_.resize(tasks.size());
     for (std::size_t i = 0; i < tasks.size(); ++i) costs_[i] = tasks.tasks[i].costEstimate;
     regions_.clear();
-    const auto portions = balancedSplit(tasks.size(), params.pes);
+    const auto portions = balancedSplit(tasks.size(), pes);
     for (const auto& portion : portions) {
       Region region;
       region.front = portion.empty() ? 0 : portion.front();

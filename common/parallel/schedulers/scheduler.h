@@ -25,8 +25,8 @@ inline constexpr std::size_t kTaskRequestBytes = 16;
 inline constexpr std::size_t kTaskPacketHeaderBytes = 16;
 inline constexpr std::size_t kTaskEntryBytes = sizeof(TaskId);
 
+// The strategy's parameters; the number of PEs is not one of them (reset() is told it).
 struct ScheduleParams {
-  int pes = 1;
   int grain = 1;               // tasks per task packet (--grain)
   int bufferDepth = 2;         // task-manager local pool, in packets (--buffer-depth)
   double staticFraction = 0.5; // hybrid: share of tasks split statically (--static-fraction)
@@ -61,10 +61,10 @@ class Scheduler {
  public:
   virtual ~Scheduler() = default;
   virtual std::string_view name() const = 0;  // its registry name
-  // Prepares a stage: computes any static assignment. Called once, before any PE asks, from one
-  // thread. Data-driven assignments are a pure function of (tasks, params), so the thread
-  // engine and the simulator produce the same ones.
-  virtual void reset(const TaskSet& tasks, const ScheduleParams& params) = 0;
+  // Prepares a stage on pes PEs: computes any static assignment. Called once, before any PE
+  // asks, from one thread. Data-driven assignments are a pure function of (tasks, pes, params),
+  // so the thread engine and the simulator produce the same ones.
+  virtual void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) = 0;
   // PE pe asks for its next task(s) at time now (seconds; real or virtual). Different PEs call
   // concurrently; implementations synchronise themselves. Each task id is handed out exactly
   // once per reset. An empty answer is final for that PE.
@@ -95,4 +95,9 @@ std::vector<std::vector<TaskId>> balancedSplit(std::size_t n, int pes);
 // PE's list then in image order. Balances to within the largest task of total/P (seed 3.2.1).
 std::vector<std::vector<TaskId>> unbalancedSplit(const TaskSet& tasks, int pes);
 
+// Owner-pinned (schedulers/owner_pinned.cpp): task t runs on PE owner[t], sent as one packet
+// per PE like a data-driven portion. Not a --schedule choice: the stages whose tasks are tied
+// to a PE's data (regions, voxels, per-PE buffers) use it through Runtime::runPinned.
+inline constexpr std::string_view kOwnerPinnedSchedule = "owner-pinned";
+std::unique_ptr<Scheduler> makeOwnerPinnedScheduler(std::vector<int> owner);
 }  // namespace pr::par

@@ -1,8 +1,9 @@
 // StaticPortionScheduler: the data-driven models' common mechanics — every PE's portion is
 // fixed in reset() and sent as one task packet on the PE's first request (seed 3.2.1, 3.4.1).
-// balanced.cpp and unbalanced.cpp differ only in the split they pass in.
+// balanced.cpp, unbalanced.cpp and owner_pinned.cpp differ only in the split they pass in.
 #pragma once
 
+#include <functional>
 #include <string_view>
 #include <vector>
 
@@ -12,13 +13,13 @@ namespace pr::par {
 
 class StaticPortionScheduler : public Scheduler {
  public:
-  using Split = std::vector<std::vector<TaskId>> (*)(const TaskSet&, int pes);
-  StaticPortionScheduler(std::string_view name, Split split) : name_(name), split_(split) {}
+  using Split = std::function<std::vector<std::vector<TaskId>>(const TaskSet&, int pes)>;
+  StaticPortionScheduler(std::string_view name, Split split) : name_(name), split_(std::move(split)) {}
   std::string_view name() const override { return name_; }
 
-  void reset(const TaskSet& tasks, const ScheduleParams& params) override {
-    portions_ = split_(tasks, params.pes);
-    sent_.assign(params.pes, 0);
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
+    portions_ = split_(tasks, pes);
+    sent_.assign(pes, 0);
   }
 
   // Each PE touches only its own portion and flag: no synchronisation needed.

@@ -16,11 +16,11 @@ class TaskManagerScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "task-manager"; }
 
-  void reset(const TaskSet& tasks, const ScheduleParams& params) override {
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
     total_ = tasks.size();
     grain_ = std::max(1, params.grain);
     capacity_ = grain_ * std::max(1, params.bufferDepth);
-    local_.assign(params.pes, {});
+    local_.assign(pes, {});
     cursor_.store(0, std::memory_order_relaxed);
   }
 

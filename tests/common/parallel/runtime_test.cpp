@@ -3,9 +3,13 @@
 #include <doctest/doctest.h>
 
 #include <atomic>
+#include <chrono>
+#include <mutex>
 #include <set>
 #include <stdexcept>
+#include <thread>
 
+#include "common/parallel/channel.h"
 #include "common/parallel/runtime.h"
 #include "common/parallel/spin_work.h"
 #include "common/util/error.h"
@@ -93,4 +97,58 @@ TEST_CASE("Runtime: an empty stage and a broadcast are recorded") {
     CHECK(pe.messagesReceived == 0);
   }
   for (const PeStageRecord& pe : r.stages[1].pes) CHECK(pe.broadcastsReceived == 0);
+}
+
+TEST_CASE("Runtime: PE threads live for the run, the same thread serving a PE in every stage") {
+  Runtime rt(3, "balanced");
+  std::vector<std::vector<std::thread::id>> seen(3);
+  std::mutex mutex;
+  for (int stage = 0; stage < 4; ++stage)
+    rt.runOnEachPe("stage", [&](Pe& pe) {
+      std::lock_guard lock(mutex);
+      seen[pe.id()].push_back(std::this_thread::get_id());
+    });
+  std::set<std::thread::id> distinct;
+  for (const auto& ids : seen) {
+    REQUIRE(ids.size() == 4);
+    for (const std::thread::id& id : ids) CHECK(id == ids.front());
+    distinct.insert(ids.front());
+  }
+  CHECK(distinct.size() == 3);
+  CHECK(distinct.count(std::this_thread::get_id()) == 0);  // not the controlling thread
+}
+
+TEST_CASE("Runtime: runPinned runs task t on PE owner[t] whatever the schedule, and records the owners") {
+  Runtime rt(3, "demand");
+  const std::vector<int> owner = {2, 0, 2, 1, 0};
+  std::vector<std::atomic<int>> ranOn(owner.size());
+  rt.runPinned("pinned", TaskSet::uniform(owner.size()), owner, [&](Pe& pe, TaskId t) { ranOn[t] = pe.id(); });
+  for (std::size_t t = 0; t < owner.size(); ++t) CHECK(ranOn[t] == owner[t]);
+  const StageRecord& s = rt.record().stages[0];
+  CHECK(s.schedule == kOwnerPinnedSchedule);
+  CHECK(s.owners == owner);
+  rt.runStage("free", TaskSet::uniform(2), [](Pe&, TaskId) {});
+  CHECK(rt.record().stages[1].schedule == "demand");
+  CHECK(rt.record().stages[1].owners.empty());
+}
+
+TEST_CASE("Runtime: a PE blocked on an empty mailbox books message waiting, not busy or barrier time") {
+  // PE 0's only task sleeps, then sends PE 1 a message; PE 1 has no task and waits for it.
+  Runtime rt(2, "demand");
+  Channel<int> channel(rt, "late", [](Pe&, int&&) {});
+  rt.runPinned("late message", TaskSet::uniform(1), {0}, [&](Pe& pe, TaskId) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(40));
+    channel.send(pe, 1, 7);
+  });
+  const StageRecord& s = rt.record().stages[0];
+  const PeStageRecord& waiter = s.pes[1];
+  CHECK(waiter.messagesHandled == 1);
+  CHECK(waiter.messageWaitSeconds > 0.0);
+  CHECK(waiter.busySeconds < waiter.messageWaitSeconds);
+  CHECK(waiter.messageWaitSeconds <= s.wallSeconds);
+  CHECK(waiter.syncWaitSeconds + waiter.messageWaitSeconds <= s.wallSeconds + 1e-9);
+  // The sender only sent: its message wait is zero, its send time is inside its busy time.
+  CHECK(s.pes[0].messageWaitSeconds == 0.0);
+  CHECK(s.pes[0].sendReceiveSeconds > 0.0);
+  CHECK(s.pes[0].sendReceiveSeconds < s.pes[0].busySeconds);
 }

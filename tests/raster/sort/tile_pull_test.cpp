@@ -56,10 +56,9 @@ TEST_CASE("TilePull: a task failing on one PE ends the stage with its error, not
           // Task 0 on PE 0 gathers tile 0 and waits for PE 1's reply; task 1 on PE 1 fails
           // without ever answering. A PE answers requests between its tasks or inside gather,
           // so PE 0 sends its request only once PE 1 is inside its task.
-          const std::unique_ptr<par::Scheduler> owners = makeOwnerScheduler({0, 1});
           std::atomic<bool> failingTaskStarted{false}, gathering{false};
           try {
-            rt.runStage("pull", par::TaskSet::uniform(2), *owners, [&](par::Pe& pe, par::TaskId t) {
+            rt.runPinned("pull", par::TaskSet::uniform(2), {0, 1}, [&](par::Pe& pe, par::TaskId t) {
               if (pe.id() == 0) {
                 while (!failingTaskStarted.load()) std::this_thread::yield();
                 gathering.store(true);
@@ -92,6 +91,38 @@ TEST_CASE("TilePull: a task failing on one PE ends the stage with its error, not
         CHECK_FALSE(rt.aborting());
       },
       20.0, "TilePull abort");
+}
+
+TEST_CASE("TilePull: the time a PE waits inside its task for a reply is waiting, not busy") {
+  test::runWithTimeout(
+      [] {
+        // PE 0 gathers tile 0 once PE 1 is inside its own 40 ms task; PE 1 answers only after
+        // it, so PE 0's task lasts about 40 ms, nearly all of it spent waiting for the reply.
+        par::Runtime rt(2, "demand");
+        Bins bins = numberedBins(2, 2);
+        TilePull<int> pull(rt, "test tile", bins);
+        std::atomic<bool> sleeping{false};
+        rt.runPinned("pull", par::TaskSet::uniform(2), {0, 1}, [&](par::Pe& pe, par::TaskId) {
+          if (pe.id() == 0) {
+            while (!sleeping.load()) std::this_thread::yield();
+            CHECK(pull.gather(pe, 0).size() == 2);
+            return;
+          }
+          sleeping.store(true);
+          std::this_thread::sleep_for(std::chrono::milliseconds(40));
+        });
+        const par::StageRecord& s = rt.record().stages[0];
+        const double span0 = [&] {
+          for (const par::TaskSpan& span : rt.record().timeline)
+            if (span.pe == 0 && span.task == 0) return span.end - span.start;
+          return 0.0;
+        }();
+        CHECK(span0 >= 0.03);
+        CHECK(s.pes[0].messageWaitSeconds > 0.5 * span0);
+        CHECK(s.pes[0].busySeconds < 0.5 * span0);
+        CHECK(s.pes[0].busySeconds + s.pes[0].messageWaitSeconds <= s.wallSeconds + 1e-9);
+      },
+      20.0, "TilePull wait");
 }
 
 }  // namespace

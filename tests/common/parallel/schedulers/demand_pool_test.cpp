@@ -44,9 +44,8 @@ TEST_CASE("DemandPool: hot-spots by decreasing estimate, ties in image order; se
 TEST_CASE("DemandPool: packets of grain tasks in pool order until the pool is empty") {
   DemandPoolScheduler pool("hot-spots", hotSpotsOrder);
   ScheduleParams params;
-  params.pes = 2;
   params.grain = 2;
-  pool.reset(TaskSet::fromCosts({1, 5, 2, 5, 3}), params);
+  pool.reset(TaskSet::fromCosts({1, 5, 2, 5, 3}), 2, params);
   Grab grab;
   pool.next(0, 0.0, grab);
   CHECK(grab.tasks == std::vector<TaskId>{1, 3});
