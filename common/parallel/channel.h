@@ -27,25 +27,22 @@ class Channel : public ChannelBase {
 
   // Without a handler, messages wait in the mailboxes until the receiver takes them
   // (tryReceive inside a later task, or drain between stages).
-  Channel(Runtime& runtime, std::string name, Handler handler = {})
-      : runtime_(runtime), name_(std::move(name)), handler_(std::move(handler)) {
+  Channel(Runtime& runtime, std::string name, MessageKind kind, Handler handler = {})
+      : ChannelBase(std::move(name), kind), runtime_(runtime), handler_(std::move(handler)) {
     for (int p = 0; p < runtime_.pes(); ++p) boxes_.push_back(std::make_unique<Mailbox>());
-    if (handler_) runtime_.attach(this);
+    runtime_.attach(this, bool(handler_));
   }
-  ~Channel() override {
-    if (handler_) runtime_.detach(this);
-  }
+  ~Channel() override { runtime_.detach(this); }
   Channel(const Channel&) = delete;
   Channel& operator=(const Channel&) = delete;
-
-  const std::string& name() const { return name_; }
 
   // Called by PE `from` inside a task or handler. bytes is the message's size on a wire
   // (defaults to sizeof(T); pass the real payload size for variable-length messages).
   void send(Pe& from, int to, T message, std::size_t bytes = sizeof(T)) {
-    PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name_ + "': destination PE out of range");
+    PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name() + "': destination PE out of range");
     const SendReceiveTimer timer(from);
     runtime_.countMessage(from.id(), to, bytes);
+    if (from.id() != to) countSent(bytes);
     if (handler_) runtime_.outstanding().add();  // before the receiver can see it
     {
       std::lock_guard lock(boxes_[to]->mutex);
@@ -63,7 +60,7 @@ class Channel : public ChannelBase {
 
   // Inside a task on PE `me`: takes one waiting message, if any.
   bool tryReceive(Pe& me, T& out) {
-    PR_CHECK(!handler_, "Channel '" + name_ + "' has a handler; its messages are delivered to it");
+    PR_CHECK(!handler_, "Channel '" + name() + "' has a handler; its messages are delivered to it");
     const SendReceiveTimer timer(me);
     std::optional<T> message;
     if (!pop(me.id(), message)) return false;
@@ -112,7 +109,6 @@ class Channel : public ChannelBase {
   }
 
   Runtime& runtime_;
-  std::string name_;
   Handler handler_;
   std::vector<std::unique_ptr<Mailbox>> boxes_;
 };

@@ -129,18 +129,52 @@ std::vector<PeStageRecord> peTotals(const RunRecord& record) {
   return totals;
 }
 
+namespace {
+
+void addTraffic(std::vector<KindTraffic>& into, const std::string& kind, std::uint64_t messages, std::uint64_t bytes) {
+  if (messages == 0 && bytes == 0) return;
+  auto it = std::find_if(into.begin(), into.end(), [&](const KindTraffic& k) { return k.kind == kind; });
+  if (it == into.end()) it = into.insert(into.end(), KindTraffic{kind, 0, 0});
+  it->messages += messages;
+  it->bytes += bytes;
+}
+
+}  // namespace
+
+std::vector<KindTraffic> trafficByKind(const StageRecord& stage) {
+  std::vector<KindTraffic> kinds;
+  for (const ChannelTraffic& c : stage.channels) addTraffic(kinds, c.kind, c.messages, c.bytes);
+  std::uint64_t schedulingMessages = 0, schedulingBytes = 0, broadcasts = 0, broadcastBytes = 0;
+  for (const PeStageRecord& r : stage.pes) {
+    schedulingMessages += r.schedulingMessages;
+    schedulingBytes += r.schedulingBytes;
+    broadcasts += r.broadcastsReceived;
+    broadcastBytes += r.broadcastBytesReceived;
+  }
+  addTraffic(kinds, "tasks", schedulingMessages, schedulingBytes);
+  addTraffic(kinds, "broadcasts", broadcasts, broadcastBytes);
+  return kinds;
+}
+
 RunSummary summarize(const RunRecord& record) {
   RunSummary summary;
   summary.pes = record.pes;
   summary.wallSeconds = record.wallSeconds;
   double stageWall = 0.0;
+  std::vector<KindTraffic> byKind;
   for (const StageRecord& stage : record.stages) {
     summary.stages.push_back(summarizePes(stage.name, stage.schedule, stage.wallSeconds, stage.pes));
+    summary.stages.back().byKind = trafficByKind(stage);
+    for (const KindTraffic& k : summary.stages.back().byKind) addTraffic(byKind, k.kind, k.messages, k.bytes);
     stageWall += stage.wallSeconds;
   }
   // Efficiency of the whole run over the time spent in stages; the controller's serial code
   // between stages is not PE time.
   summary.total = summarizePes("total", record.schedule, stageWall, peTotals(record));
+  // Channel kinds first, then the runtime's own kinds, whatever order the stages saw them in.
+  std::stable_partition(byKind.begin(), byKind.end(),
+                        [](const KindTraffic& k) { return k.kind != "tasks" && k.kind != "broadcasts"; });
+  summary.total.byKind = std::move(byKind);
   for (const CounterRecord& c : record.counters) {
     double total = 0.0;
     for (double v : c.perPe) total += v;
@@ -193,6 +227,14 @@ std::string formatSummary(const RunSummary& summary) {
     std::snprintf(line, sizeof line, "  %-24s %14s %14s %14s  (total %s)\n", c.name.c_str(), number(c.spread.min).c_str(),
                   number(c.spread.mean).c_str(), number(c.spread.max).c_str(), number(c.total).c_str());
     out += line;
+  }
+  if (!summary.total.byKind.empty()) {
+    out += "traffic between PEs by kind:\n";
+    for (const KindTraffic& k : summary.total.byKind) {
+      std::snprintf(line, sizeof line, "  %-12s %12llu messages %16llu bytes\n", k.kind.c_str(),
+                    (unsigned long long)k.messages, (unsigned long long)k.bytes);
+      out += line;
+    }
   }
   if (summary.total.computeToComm >= 0.0) {
     std::snprintf(line, sizeof line, "computation-to-communication ratio: %.1f\n", summary.total.computeToComm);

@@ -28,6 +28,14 @@ struct PeFigure {
 };
 const std::vector<PeFigure>& peFigures();
 
+// Messages and bytes between PEs of one kind: a MessageKind of the channels ("primitives",
+// "pixels", "rays", "results", "requests", "data"), "tasks" (scheduling traffic, modelled
+// sizes) or "broadcasts" (replicated data, once per receiving PE).
+struct KindTraffic {
+  std::string kind;
+  std::uint64_t messages = 0, bytes = 0;
+};
+
 struct StageSummary {
   std::string name;      // "total" for the whole run
   std::string schedule;
@@ -40,6 +48,7 @@ struct StageSummary {
   // time was spent communicating (no messages).
   double computeToComm = -1.0;
   std::uint64_t tasks = 0, messages = 0, bytes = 0, schedulingMessages = 0, schedulingBytes = 0;
+  std::vector<KindTraffic> byKind;  // channel kinds in first-seen order, then tasks and broadcasts
 
   const Spread& figure(const std::string& name) const;
 };
@@ -62,6 +71,8 @@ struct RunSummary {
 // Per-PE totals over all stages.
 std::vector<PeStageRecord> peTotals(const RunRecord& record);
 RunSummary summarize(const RunRecord& record);
+// Traffic of one stage by kind (see KindTraffic).
+std::vector<KindTraffic> trafficByKind(const StageRecord& stage);
 // A readable table: one row per stage and a total row; figures as min/mean/max.
 std::string formatSummary(const RunSummary& summary);
 

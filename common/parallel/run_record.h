@@ -43,6 +43,13 @@ struct Traffic {
   std::uint64_t messages = 0, bytes = 0;
 };
 
+// Messages and bytes between PEs through one Channel within a stage, with the channel's kind
+// (primitives, pixels, rays, results, requests, data: MessageKind).
+struct ChannelTraffic {
+  std::string name, kind;
+  std::uint64_t messages = 0, bytes = 0;
+};
+
 struct StageRecord {
   std::string name;
   std::string schedule;
@@ -51,6 +58,7 @@ struct StageRecord {
   double wallSeconds = 0.0;
   std::vector<PeStageRecord> pes;
   std::vector<Traffic> traffic;
+  std::vector<ChannelTraffic> channels;  // the same messages, by channel (only non-zero ones)
   std::vector<TaskInfo> tasks;  // the stage's TaskSet (cost estimates, positions)
   std::vector<int> owners;      // owner-pinned stages: the PE of each task; empty otherwise
 };

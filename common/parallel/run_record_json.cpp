@@ -36,6 +36,9 @@ json summaryJson(const StageSummary& s) {
             {"bytes", s.bytes},                 {"schedulingMessages", s.schedulingMessages},
             {"schedulingBytes", s.schedulingBytes}};
   j["computeToComm"] = s.computeToComm >= 0.0 ? json(s.computeToComm) : json(nullptr);
+  json kinds = json::object();
+  for (const KindTraffic& k : s.byKind) kinds[k.kind] = {{"messages", k.messages}, {"bytes", k.bytes}};
+  j["trafficByKind"] = kinds;
   json perPe = json::object();
   const auto& figures = peFigures();
   for (std::size_t i = 0; i < figures.size(); ++i) perPe[figures[i].name] = spreadJson(s.figures[i]);
@@ -94,6 +97,10 @@ json toJson(const RunRecord& record) {
     for (const Traffic& t : s.traffic)
       traffic.push_back({{"from", t.from}, {"to", t.to}, {"messages", t.messages}, {"bytes", t.bytes}});
     js["traffic"] = traffic;
+    json channels = json::array();
+    for (const ChannelTraffic& c : s.channels)
+      channels.push_back({{"name", c.name}, {"kind", c.kind}, {"messages", c.messages}, {"bytes", c.bytes}});
+    js["channels"] = channels;
     json tasks = json::array();
     for (const TaskInfo& t : s.tasks) tasks.push_back({t.costEstimate, t.x, t.y});
     js["tasks"] = tasks;  // [costEstimate, x, y]
@@ -201,6 +208,9 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     for (const json& jt : js.value("traffic", json::array()))
       s.traffic.push_back({jt.value("from", 0), jt.value("to", 0), jt.value("messages", std::uint64_t{0}),
                            jt.value("bytes", std::uint64_t{0})});
+    for (const json& jc : js.value("channels", json::array()))
+      s.channels.push_back({jc.value("name", std::string()), jc.value("kind", std::string()),
+                            jc.value("messages", std::uint64_t{0}), jc.value("bytes", std::uint64_t{0})});
     const json tasks = field<json>(js, "tasks", origin, where);
     for (const json& jt : tasks) {
       if (!jt.is_array() || jt.size() != 3 || !jt[0].is_number())

@@ -122,14 +122,30 @@ void Runtime::addCounter(std::string_view name, int pe, double value) {
   it->perPe[pe] += value;
 }
 
-void Runtime::attach(ChannelBase* channel) {
-  PR_CHECK(!inStage_, "channels with handlers are created between stages");
-  channels_.push_back(channel);
+std::string_view toString(MessageKind kind) {
+  switch (kind) {
+    case MessageKind::Primitives: return "primitives";
+    case MessageKind::Pixels: return "pixels";
+    case MessageKind::Rays: return "rays";
+    case MessageKind::Results: return "results";
+    case MessageKind::Requests: return "requests";
+    case MessageKind::Data: return "data";
+  }
+  return "?";
+}
+
+void Runtime::attach(ChannelBase* channel, bool handled) {
+  PR_CHECK(!inStage_, "channels are created between stages");
+  std::lock_guard lock(channelMutex_);
+  registered_.push_back(channel);
+  if (handled) channels_.push_back(channel);
 }
 
 void Runtime::detach(ChannelBase* channel) {
-  PR_CHECK(!inStage_, "channels with handlers are destroyed between stages");
+  PR_CHECK(!inStage_, "channels are destroyed between stages");
+  std::lock_guard lock(channelMutex_);
   channels_.erase(std::remove(channels_.begin(), channels_.end(), channel), channels_.end());
+  registered_.erase(std::remove(registered_.begin(), registered_.end(), channel), registered_.end());
 }
 
 void Runtime::countMessage(int from, int to, std::size_t bytes) {
@@ -360,6 +376,13 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     for (int q = 0; q < pes; ++q) {
       const std::size_t pair = static_cast<std::size_t>(p) * pes + q;
       if (pairMessages_[pair].load() > 0) sr.traffic.push_back({p, q, pairMessages_[pair].load(), pairBytes_[pair].load()});
+    }
+  }
+  {
+    std::lock_guard lock(channelMutex_);
+    for (ChannelBase* channel : registered_) {
+      const auto [messages, bytes] = channel->takeCounts();
+      if (messages > 0) sr.channels.push_back({channel->name(), std::string(toString(channel->kind())), messages, bytes});
     }
   }
   pendingBroadcasts_ = pendingBroadcastBytes_ = 0;

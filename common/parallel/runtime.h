@@ -12,7 +12,7 @@
 // handled (termination.h). The runtime, not the algorithm, times tasks and handlers.
 //
 //   par::Runtime rt(8, "spiral", scheduleOptions.params);   // or from --schedule/--grain
-//   par::Channel<RayBatch> rays(rt, "rays", [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
+//   par::Channel<RayBatch> rays(rt, "rays", par::MessageKind::Rays, [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
 //   rt.recordBroadcast(sceneBytes);                         // the scene, replicated on every PE
 //   rt.runStage("trace", par::TaskSet::grid(tilesX, tilesY), [&](par::Pe& pe, par::TaskId t) {
 //     for (RayBatch& b : primaryRays(t)) rays.send(pe, ownerOf(b), std::move(b), b.bytes());
@@ -30,8 +30,10 @@
 // wake-up and a barrier, not P thread creations (bench_runtime section 6).
 #pragma once
 
+#include <atomic>
 #include <chrono>
 #include <condition_variable>
+#include <cstdint>
 #include <cstddef>
 #include <exception>
 #include <functional>
@@ -40,6 +42,7 @@
 #include <string>
 #include <string_view>
 #include <thread>
+#include <utility>
 #include <vector>
 
 #include "common/parallel/pe.h"
@@ -57,13 +60,38 @@ struct RuntimeOptions {
   bool recordTimeline = true;       // keep one TaskSpan per task and handled message
 };
 
-// A mailbox set the runtime polls on behalf of a PE (implemented by Channel<T>).
+// What a message carries, for the traffic-by-kind figures of the run record: primitives
+// (sort-first and sort-middle), pixels (sort-last compositing), rays (rays, ray queries and
+// hit records), results (image assembly: tiles, regions, film blocks), requests (asking
+// another PE for something) and data (data items fetched through a DataManager).
+enum class MessageKind : std::uint8_t { Primitives, Pixels, Rays, Results, Requests, Data };
+std::string_view toString(MessageKind kind);
+
+// A mailbox set the runtime polls on behalf of a PE (implemented by Channel<T>). Every channel
+// counts the messages between different PEs sent through it; the runtime books them per stage.
 class ChannelBase {
  public:
+  ChannelBase(std::string name, MessageKind kind) : name_(std::move(name)), kind_(kind) {}
   virtual ~ChannelBase() = default;
+  const std::string& name() const { return name_; }
+  MessageKind kind() const { return kind_; }
+  // Called by Channel::send for a message between two PEs.
+  void countSent(std::size_t bytes) {
+    messages_.fetch_add(1, std::memory_order_relaxed);
+    bytes_.fetch_add(bytes, std::memory_order_relaxed);
+  }
+  // The counts since the last call (by the runtime, between stages).
+  std::pair<std::uint64_t, std::uint64_t> takeCounts() {
+    return {messages_.exchange(0, std::memory_order_relaxed), bytes_.exchange(0, std::memory_order_relaxed)};
+  }
   virtual bool pending(int pe) const = 0;
   // Pops one message for pe and runs the handler on it; false when there was none.
   virtual bool handleOne(Pe& pe) = 0;
+
+ private:
+  std::string name_;
+  MessageKind kind_;
+  std::atomic<std::uint64_t> messages_{0}, bytes_{0};
 };
 
 class Runtime {
@@ -113,7 +141,8 @@ class Runtime {
   void countMessage(int from, int to, std::size_t bytes);
   OutstandingWork& outstanding() { return outstanding_; }
   void ring(int pe);  // wakes pe if it waits for messages
-  void attach(ChannelBase* channel);
+  // Every channel registers (counting); handled ones are also polled for their messages.
+  void attach(ChannelBase* channel, bool handled);
   void detach(ChannelBase* channel);
   bool inStage() const { return inStage_; }
   // True from the first failure in the current stage until the next stage starts: a task that
@@ -144,7 +173,9 @@ class Runtime {
   std::chrono::steady_clock::time_point epoch_;
   RunRecord record_;
 
-  std::vector<ChannelBase*> channels_;
+  std::vector<ChannelBase*> channels_;    // with a handler: polled by the PE loop
+  std::vector<ChannelBase*> registered_;  // all: their traffic goes in the stage record
+  std::mutex channelMutex_;
   std::vector<PeCounters> counters_;
   std::vector<std::atomic<std::uint64_t>> pairMessages_, pairBytes_;  // P x P, row = sender
   std::vector<std::unique_ptr<Doorbell>> bells_;

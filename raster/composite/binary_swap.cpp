@@ -41,7 +41,7 @@ class BinarySwap : public Compositor {
     std::vector<Rect> kept(pes, buffers[0].rect());
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int k = 0; k < rounds; ++k) {
-      par::Channel<PixelMessage> pixels(rt, "binary-swap pixels");
+      par::Channel<PixelMessage> pixels(rt, "binary-swap pixels", par::MessageKind::Pixels);
       rt.runOnEachPe("binary-swap round " + std::to_string(k), [&](par::Pe& pe) {
                     const int p = pe.id();
                     for (const PixelMessage& m : inbox[p]) mergePixels(m, buffers[p]);

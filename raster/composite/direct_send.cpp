@@ -87,7 +87,7 @@ class DirectSend : public Compositor {
     std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
     const int owners = static_cast<int>(strips.size());
 
-    par::Channel<PixelMessage> pixels(rt, "composite pixels");
+    par::Channel<PixelMessage> pixels(rt, "composite pixels", par::MessageKind::Pixels);
     rt.runOnEachPe("direct-send", [&](par::Pe& pe) {
       CompositeCounters& c = counters[pe.id()];
       for (int o = 0; o < owners; ++o) {

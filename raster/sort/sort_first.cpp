@@ -89,7 +89,7 @@ class SortFirst : public SortPoint {
 
     std::vector<SortCounters> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
-    par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives");
+    par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:

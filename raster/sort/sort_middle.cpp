@@ -26,7 +26,7 @@ class SortMiddle : public SortPoint {
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
     if (grid.dynamic()) return renderDynamic(f, rt, grid, ctx, image);
     std::vector<SortCounters> counters(pes);
-    par::Channel<std::vector<ScreenTriangle>> triangles(rt, "screen triangles");
+    par::Channel<std::vector<ScreenTriangle>> triangles(rt, "screen triangles", par::MessageKind::Primitives);
 
     // Stage 1, geometry and the sort: one task per batch of scene triangles, on any PE.
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());

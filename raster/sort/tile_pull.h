@@ -25,8 +25,8 @@ class TilePull {
         bins_(bins),
         name_(name),
         sent_(runtime.pes(), 0),
-        replies_(runtime, name + " replies"),
-        requests_(runtime, name + " requests", [this](par::Pe& pe, Request&& r) {
+        replies_(runtime, name + " replies", par::MessageKind::Primitives),
+        requests_(runtime, name + " requests", par::MessageKind::Requests, [this](par::Pe& pe, Request&& r) {
           std::vector<Item>& bin = bins_[pe.id()][r.tile];
           const size_t bytes = bin.size() * sizeof(Item);
           sent_[pe.id()] += bin.size();

@@ -59,8 +59,8 @@ class ObjectFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};
-    par::Channel<RayQuery> queries(rt_, "queries", [this](par::Pe& pe, RayQuery&& q) { answerRemote(pe, q); });
-    par::Channel<HitReply> hits(rt_, "hits", [this](par::Pe& pe, HitReply&& r) {
+    par::Channel<RayQuery> queries(rt_, "queries", par::MessageKind::Rays, [this](par::Pe& pe, RayQuery&& q) { answerRemote(pe, q); });
+    par::Channel<HitReply> hits(rt_, "hits", par::MessageKind::Rays, [this](par::Pe& pe, HitReply&& r) {
       merge(pe, r);
       drain(pe);
     });

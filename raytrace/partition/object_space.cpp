@@ -57,7 +57,7 @@ class ObjectSpaceFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};
-    par::Channel<TravellingRay> rays(rt_, "rays", [this](par::Pe& pe, TravellingRay&& r) { trace(pe, r); });
+    par::Channel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, [this](par::Pe& pe, TravellingRay&& r) { trace(pe, r); });
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE; geometry is not.

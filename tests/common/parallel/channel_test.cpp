@@ -15,7 +15,7 @@ using namespace pr::par;
 TEST_CASE("Channel: counts are exact for a synthetic all-to-all exchange") {
   const int pes = 4;
   Runtime rt(pes, "balanced");
-  Channel<int> results(rt, "results");
+  Channel<int> results(rt, "results", MessageKind::Data);
   // One task per PE; PE p sends p + 1 messages of 10 * (q + 1) bytes to every other PE q and
   // one message to itself, which is not a transfer between PEs and is not counted.
   rt.runStage("exchange", TaskSet::uniform(pes), [&](Pe& pe, TaskId) {
@@ -57,7 +57,7 @@ TEST_CASE("Channel: counts are exact for a synthetic all-to-all exchange") {
 
 TEST_CASE("Channel: at P = 1 nothing moves between PEs") {
   Runtime rt(1);
-  Channel<double> ch(rt, "self");
+  Channel<double> ch(rt, "self", MessageKind::Data);
   rt.runStage("s", TaskSet::uniform(5), [&](Pe& pe, TaskId) { ch.send(pe, 0, 1.0); });
   CHECK(rt.record().stages[0].pes[0].bytesSent == 0);
   CHECK(rt.record().stages[0].traffic.empty());
@@ -66,7 +66,7 @@ TEST_CASE("Channel: at P = 1 nothing moves between PEs") {
 
 TEST_CASE("Channel: broadcast is counted once per receiving PE") {
   Runtime rt(5, "balanced");
-  Channel<int> ch(rt, "map");
+  Channel<int> ch(rt, "map", MessageKind::Data);
   rt.runStage("b", TaskSet::uniform(5), [&](Pe& pe, TaskId id) {
     if (id == 2) ch.broadcast(pe, 7, 1000);
   });
@@ -83,7 +83,7 @@ TEST_CASE("Channel: a message-driven phase handles every message a handler creat
     CAPTURE(pes);
     Runtime rt(pes, "demand");
     std::atomic<int> handled{0};
-    Channel<int> hops(rt, "hops", [&](Pe& pe, int&& left) {
+    Channel<int> hops(rt, "hops", MessageKind::Data, [&](Pe& pe, int&& left) {
       handled++;
       if (left > 0) hops.send(pe, (pe.id() + 1) % pe.pes(), left - 1);
     });
@@ -102,7 +102,7 @@ TEST_CASE("Channel: a message-driven phase handles every message a handler creat
 
 TEST_CASE("Channel: tryReceive takes messages left by an earlier stage") {
   Runtime rt(2, "balanced");
-  Channel<int> ch(rt, "mail");
+  Channel<int> ch(rt, "mail", MessageKind::Data);
   rt.runStage("send", TaskSet::uniform(2), [&](Pe& pe, TaskId) { ch.send(pe, 1 - pe.id(), pe.id() + 40); });
   std::vector<int> got(2, -1);
   rt.runStage("receive", TaskSet::uniform(2), [&](Pe& pe, TaskId) {
@@ -110,4 +110,41 @@ TEST_CASE("Channel: tryReceive takes messages left by an earlier stage") {
     if (ch.tryReceive(pe, v)) got[pe.id()] = v;
   });
   CHECK(got == std::vector<int>{41, 40});
+}
+
+TEST_CASE("Channel: the record books each channel's traffic by name and kind, apart from the runtime's own") {
+  Runtime rt(3, "balanced");
+  Channel<int> rays(rt, "rays", MessageKind::Rays);
+  Channel<int> tiles(rt, "tiles", MessageKind::Results);
+  Channel<int> idle(rt, "idle", MessageKind::Pixels);
+  rt.recordBroadcast(1000);
+  // PE p sends 2 rays of 40 bytes to PE (p + 1) mod 3 and one 64-byte tile to PE 0 (PE 0's
+  // own tile is no transfer); nothing goes through "idle".
+  rt.runOnEachPe("send", [&](Pe& pe) {
+    for (int k = 0; k < 2; ++k) rays.send(pe, (pe.id() + 1) % 3, k, 40);
+    tiles.send(pe, 0, pe.id(), 64);
+  });
+  const StageRecord& s = rt.record().stages[0];
+  REQUIRE(s.channels.size() == 2);
+  CHECK(s.channels[0].name == "rays");
+  CHECK(s.channels[0].kind == "rays");
+  CHECK(s.channels[0].messages == 6);
+  CHECK(s.channels[0].bytes == 240);
+  CHECK(s.channels[1].name == "tiles");
+  CHECK(s.channels[1].kind == "results");
+  CHECK(s.channels[1].messages == 2);
+  CHECK(s.channels[1].bytes == 128);
+  const std::vector<KindTraffic> kinds = trafficByKind(s);
+  auto find = [&](const char* kind) {
+    for (const KindTraffic& k : kinds)
+      if (k.kind == kind) return k;
+    return KindTraffic{};
+  };
+  CHECK(find("rays").bytes == 240);
+  CHECK(find("results").messages == 2);
+  CHECK(find("pixels").messages == 0);
+  CHECK(find("broadcasts").messages == 3);  // one copy per receiving PE
+  CHECK(find("broadcasts").bytes == 3000);
+  // The kinds add up to the stage's measured messages (tasks and broadcasts aside).
+  CHECK(find("rays").messages + find("results").messages == summarize(rt.record()).stages[0].messages);
 }

@@ -15,7 +15,7 @@ namespace {
 
 RunRecord sampleRecord() {
   Runtime rt(3, "spiral");
-  Channel<int> ch(rt, "c");
+  Channel<int> ch(rt, "c", MessageKind::Data);
   rt.runStage("tiles", TaskSet::grid(3, 2), [&](Pe& pe, TaskId id) { ch.send(pe, (pe.id() + 1) % 3, int(id), 24); });
   return rt.record();
 }

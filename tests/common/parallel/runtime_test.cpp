@@ -135,7 +135,7 @@ TEST_CASE("Runtime: runPinned runs task t on PE owner[t] whatever the schedule, 
 TEST_CASE("Runtime: a PE blocked on an empty mailbox books message waiting, not busy or barrier time") {
   // PE 0's only task sleeps, then sends PE 1 a message; PE 1 has no task and waits for it.
   Runtime rt(2, "demand");
-  Channel<int> channel(rt, "late", [](Pe&, int&&) {});
+  Channel<int> channel(rt, "late", MessageKind::Data, [](Pe&, int&&) {});
   rt.runPinned("late message", TaskSet::uniform(1), {0}, [&](Pe& pe, TaskId) {
     std::this_thread::sleep_for(std::chrono::milliseconds(40));
     channel.send(pe, 1, 7);

@@ -33,7 +33,7 @@ TEST_CASE("Termination: a binary message tree of unknown size is handled complet
     const int pes = 2 + round % 7;
     Runtime rt(pes, round % 2 ? "distributed" : "demand");
     std::atomic<std::uint64_t> handled{0};
-    Channel<std::uint32_t> tree(rt, "tree", [&](Pe& pe, std::uint32_t&& m) {
+    Channel<std::uint32_t> tree(rt, "tree", MessageKind::Data, [&](Pe& pe, std::uint32_t&& m) {
       handled++;
       const std::uint32_t depth = m & 0xff, salt = m >> 8;
       if (depth == 0) return;
@@ -71,7 +71,7 @@ TEST_CASE("Termination: stress with random durations, exceptions and message sto
 
     Runtime rt(pes, schedule);
     std::atomic<std::uint64_t> handled{0};
-    Channel<int> storm(rt, "storm", [&](Pe&, int&& v) {
+    Channel<int> storm(rt, "storm", MessageKind::Data, [&](Pe&, int&& v) {
       handled++;
       if (mode == 2 && v == failAt * 1000 + 7) throw std::logic_error("handler failed on " + std::to_string(v));
     });
