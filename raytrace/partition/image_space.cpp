@@ -1,12 +1,14 @@
 // Image-space partitioning (seed section 5.1.2): the image is cut into tiles, each tile is a
 // task on par::Runtime, and every scheduling strategy of the runtime decides which PE renders
 // which tile. World model: every PE reads the whole scene and its BVH, counted as one
-// broadcast of the scene's bytes per PE. Cost estimates for the unbalanced and hot-spot
-// strategies come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
+// broadcast of the scene's bytes per PE. Cost estimates, for the strategies that declare they
+// need them in the schedule registry (par::scheduleNeedsCostEstimates: unbalanced, hot-spots),
+// come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
 #include <algorithm>
 #include <memory>
 #include <string>
 
+#include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/partition/partition.h"
 
 namespace pr::rt {
@@ -27,8 +29,6 @@ struct TileTask {
   double cost = 1.0;
 };
 
-bool needsCostEstimates(const std::string& schedule) { return schedule == "unbalanced" || schedule == "hot-spots"; }
-
 class ImageSpacePartition final : public Partition {
  public:
   std::string_view name() const override { return "image-space"; }
@@ -42,7 +42,7 @@ class ImageSpacePartition final : public Partition {
     // World model: the scene is replicated on every PE (DESIGN.md rule 1), counted in the
     // first stage that reads it.
     rt.recordBroadcast(job.scene.memoryBytes());
-    if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles, rt);
+    if (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 
     par::TaskSet set;
