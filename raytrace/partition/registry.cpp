@@ -37,6 +37,7 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
   range("tile size", job.options.tileSizePx, 1, 4096);
   if (job.scene.triangles.empty())
     throw InputError("scene " + job.scene.source.string() + " has no triangles to ray trace");
+  checkBvhLimit("scene " + job.scene.source.string(), job.scene.triangles.size());
   std::unique_ptr<Partition> p = makePartition(partition);
   return p->render(job, rt);
 }
