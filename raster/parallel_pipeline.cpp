@@ -8,6 +8,7 @@ namespace pr::raster {
 
 void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view, const SortOptions& options,
                  par::Runtime& runtime, RegionFramebuffer& image, SortCounters* counters) {
+  checkRasterLimits("scene " + scene.source.string(), scene.triangles.size());
   const Rect screen{0, 0, view.width, view.height};
   if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
   const SortCounters c = sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);

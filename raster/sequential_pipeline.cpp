@@ -14,6 +14,7 @@ namespace pr::raster {
 void renderSequential(const scene::Scene& scene, const FrameView& view, const SequentialOptions& options,
                       RegionFramebuffer& image, RasterStats* stats) {
   PR_CHECK(options.batchSize > 0, "renderSequential: zero batch size");
+  checkRasterLimits("scene " + scene.source.string(), scene.triangles.size());
   RasterStats local;
   RasterStats& st = stats ? *stats : local;
   const Rect screen{0, 0, view.width, view.height};

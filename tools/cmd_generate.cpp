@@ -27,9 +27,10 @@ struct GenerateOptions {
 
 std::string sceneListHelp() {
   std::string text = "Writes a bundled scene as glTF 2.0 (.gltf with the buffer embedded, or .glb).\nScenes:";
-  for (const auto& scene : scenegen::sceneRegistry()) {
-    text += "\n  " + std::string(scene.name) + std::string(scene.name.size() < 16 ? 16 - scene.name.size() : 1, ' ') +
-            std::string(scene.description) + "\n" + std::string(18, ' ') + "--size: " + std::string(scene.sizeMeaning) +
+  for (const scenegen::SceneEntry& entry : scenegen::sceneRegistry()) {
+    const scenegen::SceneProperties& scene = entry.properties;
+    text += "\n  " + entry.name + std::string(entry.name.size() < 16 ? 16 - entry.name.size() : 1, ' ') +
+            entry.description + "\n" + std::string(18, ' ') + "--size: " + std::string(scene.sizeMeaning) +
             " (default " + std::to_string(scene.defaultSize) + ", " + std::to_string(scene.minSize) + " to " +
             std::to_string(scene.maxSize) + ")" + (scene.usesSeed ? "; --seed default " + std::to_string(scene.defaultSeed) : "");
   }
@@ -37,9 +38,10 @@ std::string sceneListHelp() {
 }
 
 void runGenerate(const GenerateOptions& options) {
-  const auto& scene = scenegen::findScene(options.scene);
+  const scenegen::SceneEntry& entry = scenegen::findScene(options.scene);
+  const scenegen::SceneProperties& scene = entry.properties;
   if (options.seedOption->count() > 0 && !scene.usesSeed)
-    throw InputError("--seed has no effect on scene '" + std::string(scene.name) + "' (it has no random content)");
+    throw InputError("--seed has no effect on scene '" + entry.name + "' (it has no random content)");
 
   std::string ext = std::filesystem::path(options.output).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
@@ -50,10 +52,10 @@ void runGenerate(const GenerateOptions& options) {
   scenegen::SceneParams params;
   params.size = options.sizeOption->count() > 0 ? options.size : scene.defaultSize;
   params.seed = options.seedOption->count() > 0 ? options.seed : scene.defaultSeed;
-  const scenegen::GltfBuilder builder = scenegen::generateScene(scene, params);
+  const scenegen::GltfBuilder builder = scenegen::generateScene(entry, params);
   const std::string bytes = builder.serialize(ext == ".glb");
   scenegen::writeFileAtomically(options.output, bytes);
-  std::printf("wrote %s: scene %s, %zu triangles, %zu bytes\n", options.output.c_str(), std::string(scene.name).c_str(),
+  std::printf("wrote %s: scene %s, %zu triangles, %zu bytes\n", options.output.c_str(), entry.name.c_str(),
               builder.triangleCount(), bytes.size());
 }
 

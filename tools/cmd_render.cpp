@@ -98,7 +98,7 @@ void run(RenderArgs& a) {
   ProgressBar bar(!a.quiet && isatty(STDERR_FILENO));
   const RenderRequest request{scene, camera, a.width, a.height, a.settings, runtime,
                               [&bar](int64_t done, int64_t total) { bar.update(done, total); }};
-  RenderOutcome outcome = method.render(method.name, request);
+  RenderOutcome outcome = method.make(method.name, request);
   bar.finish();
 
   image::writeImage(a.output, outcome.image);
@@ -106,7 +106,7 @@ void run(RenderArgs& a) {
 
   const par::RunSummary summary = par::summarize(runtime.record());
   const double wall = summary.wallSeconds;
-  std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.family)).c_str(),
+  std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
               a.threads, a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
   if (!outcome.details.empty()) std::printf("%s\n", outcome.details.c_str());
   std::printf("wall %.3f s", wall);
@@ -123,16 +123,8 @@ void addRenderCommand(CLI::App& app) {
   auto args = std::make_shared<RenderArgs>();
   CLI::App* cmd = app.add_subcommand("render", "render a glTF scene with one method on P PEs; write the image and a summary");
   cmd->add_option("scene", args->scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
-  std::string names;
-  for (const RenderMethod& m : renderMethods()) names += (names.empty() ? "" : ", ") + std::string(m.name);
   cmd->add_option("-m,--method", args->method, "render method (default image-space):\n" + describeRenderMethods())
-      ->check(CLI::Validator(
-          [names](std::string& v) {
-            for (const RenderMethod& m : renderMethods())
-              if (m.name == v) return std::string();
-            return "unknown method '" + v + "' (expected one of: " + names + ")";
-          },
-          "METHOD"));
+      ->check(CLI::Validator([](std::string& v) { return renderMethods().problem(v); }, "METHOD"));
   cmd->add_option("-o,--output", args->output, "output image, .png or .exr (default <scene stem>_<method>.png)");
   cmd->add_option("--width", args->width, "image width in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--height", args->height, "image height in pixels")->check(CLI::Range(1, 16384))->capture_default_str();

@@ -3,9 +3,11 @@
 #include "tools/render_methods.h"
 
 #include "common/util/error.h"
+#include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
 #include "raytrace/integrators/integrator.h"
 #include "raytrace/partition/partition.h"
+#include "tools/integrators.h"
 
 namespace pr::cli {
 
@@ -13,14 +15,16 @@ namespace {
 
 RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   rt::TraceOptions options;
-  options.integrator.kind = rt::integratorKindFromString(r.settings.ray.integrator);
   options.integrator.spp = r.settings.ray.spp;
   options.integrator.maxDepth = r.settings.ray.maxDepth;
   options.integrator.seed = r.settings.ray.seed;
   options.tileSizePx = r.settings.ray.tileSizePx;
   options.adaptive = r.settings.ray.adaptive;
   options.progress = r.progress;
-  rt::TraceResult result = rt::renderRays(r.scene, r.camera, r.width, r.height, options, name, r.runtime);
+  rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
+  job.integrator = integrators().find(r.settings.ray.integrator).make(
+      rt::IntegratorSetup{r.scene, r.camera, r.width, r.height, options.integrator});
+  rt::TraceResult result = rt::renderRays(job, name, r.runtime);
   RenderOutcome out;
   out.image = std::move(result.image);
   out.rays = result.rays.total();
@@ -69,11 +73,11 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   return out;
 }
 
-std::vector<RenderMethod> makeMethods() {
-  std::vector<RenderMethod> methods;
-  for (const rt::PartitionInfo& p : rt::partitions()) methods.push_back({p.name, MethodFamily::Ray, p.description, renderRay});
+RenderMethodRegistry makeMethods() {
+  RenderMethodRegistry methods("method");
+  for (const rt::PartitionInfo& p : rt::partitions()) methods.add({p.name, p.description, renderRay, {MethodFamily::Ray}});
   for (const raster::SortPointInfo& s : raster::sortPoints())
-    methods.push_back({s.name, MethodFamily::Raster, s.description, renderRaster});
+    methods.add({s.name, s.description, renderRaster, {MethodFamily::Raster}});
   return methods;
 }
 
@@ -83,32 +87,24 @@ std::string_view toString(MethodFamily family) {
   return family == MethodFamily::Ray ? "ray-tracing" : "rasterization";
 }
 
-const std::vector<RenderMethod>& renderMethods() {
-  static const std::vector<RenderMethod> kMethods = makeMethods();
+const RenderMethodRegistry& renderMethods() {
+  static const RenderMethodRegistry kMethods = makeMethods();
   return kMethods;
 }
 
-const RenderMethod& findRenderMethod(std::string_view name) {
-  std::string names;
-  for (const RenderMethod& m : renderMethods()) {
-    if (m.name == name) return m;
-    names += (names.empty() ? "" : ", ") + std::string(m.name);
-  }
-  throw InputError("unknown method '" + std::string(name) + "' (expected one of: " + names + ")");
-}
+const RenderMethod& findRenderMethod(std::string_view name) { return renderMethods().find(name); }
 
 std::string describeRenderMethods() {
   std::string out;
   for (const RenderMethod& m : renderMethods())
-    out += std::string(m.name) + " (" + std::string(toString(m.family)) + "): " + std::string(m.description) + "\n";
+    out += m.name + " (" + std::string(toString(m.properties.family)) + "): " + m.description + "\n";
   return out;
 }
 
 void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family) {
   RayOptions& ray = settings.ray;
-  family.emplace_back(command.add_option("--integrator", ray.integrator, "ray tracing: whitted | path")
-                          ->check(CLI::IsMember({"whitted", "path"}))
-                          ->capture_default_str(),
+  family.emplace_back(command.add_option("--integrator", ray.integrator, "ray tracing: the integrator (default " + ray.integrator + "):\n" + integrators().describe())
+                          ->check(CLI::Validator([](std::string& v) { return integrators().problem(v); }, "INTEGRATOR")),
                       MethodFamily::Ray);
   family.emplace_back(command.add_option("--spp", ray.spp, "ray tracing: stratified samples per pixel")
                           ->check(CLI::Range(1, rt::kMaxSpp))
@@ -139,9 +135,8 @@ void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions
                           ->check(CLI::IsMember({"static-strips", "static-tiles", "dynamic"}))
                           ->capture_default_str(),
                       MethodFamily::Raster);
-  family.emplace_back(command.add_option("--compositor", r.compositor, "sort-last: direct-send | binary-swap (P a power of two)")
-                          ->check(CLI::IsMember({"direct-send", "binary-swap"}))
-                          ->capture_default_str(),
+  family.emplace_back(command.add_option("--compositor", r.compositor, "sort-last: the compositor (default " + r.compositor + "):\n" + raster::compositors().describe())
+                          ->check(CLI::Validator([](std::string& v) { return raster::compositors().problem(v); }, "COMPOSITOR")),
                       MethodFamily::Raster);
   family.emplace_back(command.add_flag("--sparse", r.sparse, "sort-last: composite covered pixels only"), MethodFamily::Raster);
   family.emplace_back(command.add_option("--frames", r.frames, "rasterization: frames to render (the last is written)")
@@ -154,9 +149,9 @@ void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions
 
 void checkFamilyOptions(const RenderMethod& method, const FamilyOptions& family) {
   for (const auto& [option, f] : family)
-    if (f != method.family && option->count() > 0)
+    if (f != method.properties.family && option->count() > 0)
       throw InputError("option " + option->get_name() + " applies to " + std::string(toString(f)) + " methods, but '" +
-                       std::string(method.name) + "' is a " + std::string(toString(method.family)) + " method");
+                       method.name + "' is a " + std::string(toString(method.properties.family)) + " method");
 }
 
 }  // namespace pr::cli

@@ -1,7 +1,8 @@
 // The render methods of `parrender render -m NAME`: a registry (name -> family -> description
 // -> function) over both families, the ray tracers (one method per raytrace Partition) and the
 // rasterization pipelines. Family-specific options (ray: --integrator --spp --max-depth --seed
-// --tile-size --adaptive) are registered with their family, so giving one to a method of the
+// --tile-size --adaptive; raster: --tile --regions --compositor ...) are registered with their
+// family, with --integrator and --compositor checked against and described by their registries, so giving one to a method of the
 // other family is an input error naming the option. Used by cmd_render.cpp.
 #pragma once
 
@@ -18,6 +19,7 @@
 #include "common/parallel/runtime.h"
 #include "common/scene/camera.h"
 #include "common/scene/scene.h"
+#include "common/util/registry.h"
 
 namespace pr::cli {
 
@@ -66,15 +68,16 @@ struct RenderOutcome {
   std::string details;   // one extra summary line (family-specific), may be empty
 };
 
-struct RenderMethod {
-  std::string_view name;
-  MethodFamily family;
-  std::string_view description;
-  RenderOutcome (*render)(std::string_view name, const RenderRequest& request);
+// Registry: name -> render function -> description, and the method's family.
+struct MethodProperties {
+  MethodFamily family = MethodFamily::Ray;
 };
+using RenderFunction = RenderOutcome (*)(std::string_view name, const RenderRequest& request);
+using RenderMethod = RegistryEntry<RenderFunction, MethodProperties>;
+using RenderMethodRegistry = Registry<RenderFunction, MethodProperties>;
 
 // Every method, ray tracers first (from the raytrace partition registry).
-const std::vector<RenderMethod>& renderMethods();
+const RenderMethodRegistry& renderMethods();
 // Throws pr::InputError naming the unknown method and listing the valid ones.
 const RenderMethod& findRenderMethod(std::string_view name);
 // "name (family): description" lines for --help.

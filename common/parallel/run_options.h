@@ -23,13 +23,7 @@ struct ScheduleOptions {
 // Adds the scheduling options to a subcommand; an unknown schedule or an out-of-range number
 // is a CLI parse error (exit status 2) that lists the valid values.
 inline void addScheduleOptions(CLI::App& command, ScheduleOptions& options) {
-  std::string names;
-  for (const ScheduleInfo& s : schedules()) names += (names.empty() ? "" : ", ") + std::string(s.name);
-  const CLI::Validator known(
-      [names](std::string& value) {
-        return isSchedule(value) ? std::string() : "unknown schedule '" + value + "' (expected one of: " + names + ")";
-      },
-      "SCHEDULE");
+  const CLI::Validator known([](std::string& value) { return schedules().problem(value); }, "SCHEDULE");
   command.add_option("--schedule", options.schedule, "how PEs get tasks (default " + options.schedule + "):\n" + describeSchedules())
       ->check(known);
   command.add_option("--grain", options.params.grain, "tasks per task packet (task granularity)")

@@ -15,6 +15,7 @@
 #include "common/scene/gltf_accessor.h"
 #include "common/scene/gltf_context.h"
 #include "common/scene/gltf_material.h"
+#include "common/util/limits.h"
 
 namespace pr::scene {
 
@@ -184,6 +185,15 @@ class Flattener {
   // Triangle list of a primitive, as vertex indices local to the primitive (spec 3.7.2.1).
   std::vector<uint32_t> triangleList(const tinygltf::Primitive& prim, size_t vertexCount, const std::string& where) {
     std::vector<uint32_t> seq;
+    // Triangle indices are 32 bits too: checked on the declared count, before reading indices.
+    const uint64_t declared = prim.indices >= 0 && size_t(prim.indices) < ctx_.model.accessors.size()
+                                  ? uint64_t(ctx_.model.accessors[size_t(prim.indices)].count)
+                                  : uint64_t(vertexCount);
+    const uint64_t triangles = prim.mode == TINYGLTF_MODE_TRIANGLES ? declared / 3 : (declared >= 3 ? declared - 2 : 0);
+    const std::string problem = countLimitProblem(where, "triangles in the scene",
+                                                  uint64_t(ctx_.scene.triangles.size()) + triangles, kMaxTriangles,
+                                                  "triangle indices are 32 bits");
+    if (!problem.empty()) ctx_.fail(problem);
     if (prim.indices >= 0) {
       seq = accessors_.indices(prim.indices, where + " indices");
       for (uint32_t i : seq) {
@@ -236,6 +246,14 @@ class Flattener {
     };
     const int posIndex = attribute("POSITION");
     if (posIndex < 0) ctx_.fail(where + ": has no POSITION attribute");
+    // Vertex indices are 32 bits: checked on the declared count, before any data is read.
+    if (size_t(posIndex) < ctx_.model.accessors.size()) {
+      const std::string problem =
+          countLimitProblem(where + " POSITION", "vertices in the scene",
+                            uint64_t(ctx_.scene.positions.size()) + uint64_t(ctx_.model.accessors[size_t(posIndex)].count),
+                            kMaxVertices, "vertex indices are 32 bits");
+      if (!problem.empty()) ctx_.fail(problem);
+    }
     const gltf::FloatAccessor& pos = accessors_.floats(posIndex, where + " POSITION");
     if (pos.components != 3) ctx_.fail(where + " POSITION: accessor " + std::to_string(posIndex) + " must be VEC3");
     const size_t count = pos.count;
@@ -276,7 +294,7 @@ class Flattener {
     const bool mirrored = glm::determinant(glm::dmat3(world)) < 0.0;
     const glm::mat3 normalMatrix(glm::transpose(glm::inverse(glm::dmat3(world))));
     const uint32_t base = uint32_t(s.positions.size());
-    PR_CHECK(s.positions.size() + count < size_t(UINT32_MAX), "scene exceeds 2^32 vertices");
+    PR_CHECK(s.positions.size() + count <= kMaxVertices, "scene exceeds kMaxVertices (checked above)");
     for (size_t i = 0; i < count; ++i) {
       const float* p = pos.element(i);
       s.positions.push_back(glm::vec3(world * glm::dvec4(p[0], p[1], p[2], 1.0)));

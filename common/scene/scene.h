@@ -18,6 +18,11 @@
 
 namespace pr::scene {
 
+// Largest vertex and triangle counts of a scene: indices are uint32_t, and UINT32_MAX stays
+// free. The loader refuses more with an input error naming the count.
+inline constexpr uint64_t kMaxVertices = uint64_t(UINT32_MAX) - 1;
+inline constexpr uint64_t kMaxTriangles = uint64_t(UINT32_MAX) - 1;
+
 struct Bounds {
   glm::vec3 min{std::numeric_limits<float>::infinity()};
   glm::vec3 max{-std::numeric_limits<float>::infinity()};

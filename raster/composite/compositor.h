@@ -2,7 +2,8 @@
 // framebuffer of its own primitives; compositing moves pixels between PEs as counted messages
 // until each screen pixel has met every PE's fragment there and kept the nearest key (depth
 // compositing, depth_resolve.h). direct_send.cpp: each PE sends each region straight to its
-// owner; binary_swap.cpp: log2 P pairwise exchanges of halves (Ma et al. 1994).
+// owner; binary_swap.cpp: log2 P pairwise exchanges of halves (Ma et al. 1994); one line each
+// in registry.cpp.
 #pragma once
 
 #include <cstdint>
@@ -13,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
+#include "common/util/registry.h"
 #include "raster/framebuffer.h"
 
 namespace pr::raster {
@@ -59,9 +61,16 @@ class Compositor {
                                       std::vector<CompositeCounters>& counters) = 0;
 };
 
+// Factories, one per compositor file.
 std::unique_ptr<Compositor> makeDirectSend();
 std::unique_ptr<Compositor> makeBinarySwap();
-// "direct-send" | "binary-swap"; throws pr::InputError naming the valid values.
+
+// Registry: name -> factory -> description (registry.cpp); feeds --compositor, its --help
+// and validation, and the sort-last summary.
+using CompositorInfo = RegistryEntry<std::unique_ptr<Compositor> (*)()>;
+using CompositorRegistry = Registry<std::unique_ptr<Compositor> (*)()>;
+const CompositorRegistry& compositors();
+// Throws pr::InputError naming the unknown compositor and listing the valid ones.
 std::unique_ptr<Compositor> makeCompositor(std::string_view name);
 
 }  // namespace pr::raster

@@ -116,10 +116,4 @@ class DirectSend : public Compositor {
 
 std::unique_ptr<Compositor> makeDirectSend() { return std::make_unique<DirectSend>(); }
 
-std::unique_ptr<Compositor> makeCompositor(std::string_view name) {
-  if (name == "direct-send") return makeDirectSend();
-  if (name == "binary-swap") return makeBinarySwap();
-  throw InputError("unknown compositor '" + std::string(name) + "' (expected direct-send or binary-swap)");
-}
-
 }  // namespace pr::raster

@@ -64,29 +64,20 @@ SortCounters recordSortCounters(std::string_view sortPoint, const std::vector<So
   return sum;
 }
 
-const std::vector<SortPointInfo>& sortPoints() {
-  static const std::vector<SortPointInfo> kSortPoints = {
-      {"sort-first", "primitives pre-transformed and sent to screen-region owners, who run the whole pipeline",
-       &makeSortFirst},
-      {"sort-middle", "screen triangles sent from geometry to the region owners, who rasterize", &makeSortMiddle},
-      {"sort-last", "every PE renders its primitives full screen; pixels depth-composited by region", &makeSortLast},
-  };
+const SortPointRegistry& sortPoints() {
+  static const SortPointRegistry kSortPoints(
+      "raster method",
+      {
+          {"sort-first", "primitives pre-transformed and sent to screen-region owners, who run the whole pipeline",
+           &makeSortFirst},
+          {"sort-middle", "screen triangles sent from geometry to the region owners, who rasterize", &makeSortMiddle},
+          {"sort-last", "every PE renders its primitives full screen; pixels depth-composited by region", &makeSortLast},
+      });
   return kSortPoints;
 }
 
-bool isSortPoint(std::string_view name) {
-  for (const SortPointInfo& s : sortPoints())
-    if (s.name == name) return true;
-  return false;
-}
+bool isSortPoint(std::string_view name) { return sortPoints().contains(name); }
 
-std::unique_ptr<SortPoint> makeSortPoint(std::string_view name) {
-  std::string names;
-  for (const SortPointInfo& s : sortPoints()) {
-    if (s.name == name) return s.make();
-    names += (names.empty() ? "" : ", ") + std::string(s.name);
-  }
-  throw InputError("unknown raster method '" + std::string(name) + "' (expected one of: " + names + ")");
-}
+std::unique_ptr<SortPoint> makeSortPoint(std::string_view name) { return sortPoints().find(name).make(); }
 
 }  // namespace pr::raster

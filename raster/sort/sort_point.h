@@ -14,6 +14,7 @@
 
 #include "common/parallel/runtime.h"
 #include "common/scene/scene.h"
+#include "common/util/registry.h"
 #include "raster/framebuffer.h"
 #include "raster/sort/region_assignment.h"
 #include "raster/stages/geometry.h"
@@ -81,12 +82,9 @@ std::unique_ptr<SortPoint> makeSortMiddle();
 std::unique_ptr<SortPoint> makeSortLast();
 
 // Registry: name -> factory -> description (feeds --help and validation).
-struct SortPointInfo {
-  std::string_view name;
-  std::string_view description;
-  std::unique_ptr<SortPoint> (*make)();
-};
-const std::vector<SortPointInfo>& sortPoints();
+using SortPointInfo = RegistryEntry<std::unique_ptr<SortPoint> (*)()>;
+using SortPointRegistry = Registry<std::unique_ptr<SortPoint> (*)()>;
+const SortPointRegistry& sortPoints();
 // Throws pr::InputError naming the unknown method and listing the valid ones.
 std::unique_ptr<SortPoint> makeSortPoint(std::string_view name);
 bool isSortPoint(std::string_view name);

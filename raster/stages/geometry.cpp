@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/util/error.h"
+#include "common/util/limits.h"
 #include "raster/stages/depth_resolve.h"
 
 namespace pr::raster {
@@ -312,6 +313,11 @@ int processTriangle(const scene::Scene& scene, const FrameView& view, uint32_t i
   const PreparedVertex* pv[3] = {&v[0], &v[1], &v[2]};
   for (int k = 0; k < 3; ++k) prepareVertex(view, scene.positions[scene.triangles[index].v[k]], v[k]);
   return assembleTriangle(scene, view, index, pv, out, counters ? *counters : local);
+}
+
+void checkRasterLimits(std::string_view where, size_t triangles) {
+  checkCountLimit(where, "triangles", triangles, kMaxPrimitives,
+                  "the rasterizers' depth key orders primitives by a 29-bit id");
 }
 
 void processTriangles(const scene::Scene& scene, const FrameView& view, uint32_t first, uint32_t count,

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -83,6 +84,11 @@ struct GeometryCounters {
 // returns how many. Pure function of (scene, view, index): the same on every PE.
 int processTriangle(const scene::Scene& scene, const FrameView& view, uint32_t index,
                     ScreenTriangle* out, GeometryCounters* counters = nullptr);
+
+// Throws pr::InputError "<where>: N triangles exceed the limit of ..." when a scene has more
+// triangles than the depth key can order (kMaxPrimitives, 29-bit primitive ids): called where
+// a raster render starts, with the scene's triangle count.
+void checkRasterLimits(std::string_view where, size_t triangles);
 
 // Geometry for the batch of scene triangles [first, first + count), appended to out in
 // primitive order. Called by the PE that owns the batch; touches only out and counters.

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
@@ -48,6 +49,12 @@ inline uint32_t leafFirst(uint32_t ref) { return ref & (kMaxTriangles - 1); }
 inline uint32_t leafCount(uint32_t ref) { return ((ref >> kCountShift) & 15u) + 1; }
 inline uint32_t leaf(uint32_t first, uint32_t count) { return kLeafBit | ((count - 1) << kCountShift) | first; }
 }  // namespace BvhRef
+
+// Throws pr::InputError "<where>: N triangles exceed the limit of ..." when one BVH would hold
+// more triangles than a leaf reference can address (BvhRef::kMaxTriangles - 1, 27 bits).
+// Called where a ray-traced render starts, on the whole scene (every BVH a partition builds
+// holds a subset of it).
+void checkBvhLimit(std::string_view where, size_t triangles);
 
 // A leaf triangle: its world-space vertices (copied so a leaf is one contiguous read) and its
 // scene triangle index, which hit records report. 40 bytes.

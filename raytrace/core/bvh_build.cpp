@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/util/error.h"
+#include "common/util/limits.h"
 #include "raytrace/core/bvh.h"
 
 namespace pr::rt {
@@ -252,6 +253,11 @@ Bvh::Bvh(const scene::Scene& scene, const BvhBuildOptions& options) {
   std::vector<uint32_t> all(scene.triangles.size());
   for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
   build(scene.positions, scene.triangles, all, options);
+}
+
+void checkBvhLimit(std::string_view where, size_t triangles) {
+  checkCountLimit(where, "triangles", triangles, BvhRef::kMaxTriangles - 1,
+                  "a BVH leaf addresses its triangles with 27 bits");
 }
 
 Bvh::Bvh(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,

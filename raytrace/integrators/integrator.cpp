@@ -12,12 +12,6 @@ namespace pr::rt {
 
 std::string_view toString(IntegratorKind kind) { return kind == IntegratorKind::Whitted ? "whitted" : "path"; }
 
-IntegratorKind integratorKindFromString(std::string_view name) {
-  if (name == "whitted") return IntegratorKind::Whitted;
-  if (name == "path") return IntegratorKind::Path;
-  throw InputError("unknown integrator '" + std::string(name) + "' (expected one of: whitted, path)");
-}
-
 IntegratorContext::IntegratorContext(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
                                      const IntegratorOptions& options)
     : scene_(&scene), camera_(camera), width_(width), height_(height), options_(options), lights_(scene) {
@@ -94,15 +88,11 @@ RayMessage IntegratorContext::continuation(const SurfaceInteraction& si, const R
 
 Integrator::Integrator(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
                        const IntegratorOptions& options)
-    : ctx_(scene, camera, width, height, options),
-      camera_(camera),
-      impl_(options.kind == IntegratorKind::Whitted
-                ? std::variant<WhittedIntegrator, PathIntegrator>(WhittedIntegrator(ctx_))
-                : std::variant<WhittedIntegrator, PathIntegrator>(PathIntegrator(ctx_))) {}
+    : ctx_(scene, camera, width, height, options), camera_(camera) {}
 
-void Integrator::cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const {
+void Integrator::cameraRays(const PixelRect& rect, int spp, std::vector<RayMessage>& out) const {
+  PR_CHECK(spp >= 1 && spp <= kMaxSpp, "spp out of range: " + std::to_string(spp));
   const int w = ctx_.width(), h = ctx_.height();
-  const int spp = ctx_.options().spp;
   const float aspect = float(w) / float(h);
   const glm::mat3 rotation(camera_.cameraToWorld);
   const glm::vec3 eye = camera_.position();

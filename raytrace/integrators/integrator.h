@@ -3,18 +3,20 @@
 // reflection, refraction, path continuation), miss handles a ray that left the scene (a
 // shadow ray's contribution is added iff it is unoccluded). Every tracer — sequential,
 // image-space, object-space, object partitioning — calls these same functions and differs
-// only in where a message is traced (shared/DESIGN.md rule 4). Whitted (whitted.cpp) and the
-// path tracer (path_tracer.cpp) are concrete classes behind one std::variant: no per-ray
-// virtual call.
+// only in where a message is traced (shared/DESIGN.md rule 4). The Integrator interface is
+// here; Whitted (whitted.h) and the path tracer (path_tracer.h) implement it through
+// IntegratorBase (trace_loop.h), and an IntegratorRegistry lists them (registry.cpp).
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <string_view>
-#include <variant>
 #include <vector>
 
 #include "common/scene/camera.h"
 #include "common/scene/scene.h"
+#include "common/util/registry.h"
 #include "raytrace/core/interaction.h"
 #include "raytrace/integrators/bsdf.h"
 #include "raytrace/integrators/film.h"
@@ -24,16 +26,16 @@
 
 namespace pr::rt {
 
+// The built-in integrators, for library callers and tests that pick one without a registry
+// (TraceOptions::integrator.kind); programs choose by name from an IntegratorRegistry.
 enum class IntegratorKind : uint8_t { Whitted, Path };
-std::string_view toString(IntegratorKind kind);
-// "whitted" | "path"; throws pr::InputError naming the value otherwise.
-IntegratorKind integratorKindFromString(std::string_view name);
+std::string_view toString(IntegratorKind kind);  // its registry name: "whitted" | "path"
 
 inline constexpr int kMaxDepthLimit = 255;  // RayMessage::depth is 8 bits
 inline constexpr int kMaxSpp = 65535;       // RayMessage::sample is 16 bits
 
 struct IntegratorOptions {
-  IntegratorKind kind = IntegratorKind::Path;
+  IntegratorKind kind = IntegratorKind::Path;  // used only where no Integrator object is given
   int spp = 1;        // samples per pixel, stratified (--spp)
   int maxDepth = 8;   // surface interactions a path may shade (--max-depth); >= 1
   uint64_t seed = 1;  // --seed
@@ -99,55 +101,74 @@ struct ShadingFrame {
   explicit ShadingFrame(const SurfaceInteraction& si);
 };
 
-// Whitted-style ray tracing (Whitted 1980): emission, direct light with shadow rays from every
-// light, ideal mirror reflection, Fresnel-weighted reflection and refraction through dielectrics.
-class WhittedIntegrator {
- public:
-  explicit WhittedIntegrator(const IntegratorContext& ctx) : ctx_(&ctx) {}
-  void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const;
+struct TraceStats;  // trace_stats.h
+class Bvh;          // raytrace/core/bvh.h
 
- private:
-  const IntegratorContext* ctx_;
-};
-
-// Brute-force unidirectional path tracing (Kajiya 1986) with next-event estimation, multiple
-// importance sampling of emitters (power heuristic, Veach 1997) and Russian roulette.
-class PathIntegrator {
- public:
-  explicit PathIntegrator(const IntegratorContext& ctx) : ctx_(&ctx) {}
-  void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const;
-
- private:
-  const IntegratorContext* ctx_;
-};
-
+// An integrator: how a hit becomes radiance and new rays. The interface every tracer drives;
+// concrete integrators derive from IntegratorBase<Self> (trace_loop.h) and are listed in an
+// IntegratorRegistry. Built once per render for its scene, camera and image size, then shared
+// read-only by every PE.
+//
+// Dispatch: the world-model tracers (sequential, image-space) make one virtual call per task,
+// traceToCompletion, whose message loop IntegratorBase instantiates for the concrete class, so
+// shade is a direct call inside it. The message-passing tracers (object-space, object) call
+// shade once per hit message they handle, at the granularity of the message itself.
 class Integrator {
  public:
   Integrator(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
              const IntegratorOptions& options);
+  virtual ~Integrator() = default;
   Integrator(const Integrator&) = delete;
   Integrator& operator=(const Integrator&) = delete;
 
+  virtual std::string_view name() const = 0;  // its registry name, e.g. "path"
   const IntegratorOptions& options() const { return ctx_.options(); }
   const IntegratorContext& context() const { return ctx_; }
 
   // Primary rays of every pixel of `rect`, options().spp stratified samples each, appended to
   // out in pixel order then sample order.
-  void cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const;
+  void cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const { cameraRays(rect, options().spp, out); }
+  // The same with spp samples per pixel (image-space's one-sample cost pre-pass): sample s of
+  // a pixel is the same ray whatever spp, for s < spp, only when spp matches the render's.
+  void cameraRays(const PixelRect& rect, int spp, std::vector<RayMessage>& out) const;
   // A camera or continuation ray hit si (made by makeInteraction from msg.ray's closest hit).
-  void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
-    std::visit([&](const auto& integrator) { integrator.shade(si, msg, out); }, impl_);
-  }
+  virtual void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const = 0;
   // A ray found nothing: a shadow ray adds its contribution (unoccluded); any other ray sees
   // the black background.
   void miss(const RayMessage& msg, Emit& out) const {
     if (msg.kind == RayKind::Shadow) out.addRadiance(msg.pixel, msg.throughput);
   }
+  // The message loop of a PE that holds the whole world: traces every message in queue and
+  // every message shading spawns until none is left, against bvh (over context().scene()).
+  // One call per task; implemented by IntegratorBase (trace_loop.h).
+  virtual void traceToCompletion(const Bvh& bvh, std::vector<RayMessage>& queue, Film& film,
+                                 TraceStats& stats) const = 0;
 
  private:
   IntegratorContext ctx_;
   scene::Camera camera_;
-  std::variant<WhittedIntegrator, PathIntegrator> impl_;
 };
+
+// What an integrator is built for: one render's scene, camera, image size and options.
+struct IntegratorSetup {
+  const scene::Scene& scene;
+  const scene::Camera& camera;
+  int width = 0, height = 0;
+  IntegratorOptions options;
+};
+
+// Registry of integrators: name -> factory -> description; feeds --integrator, its --help,
+// validation and the render summary. A std::function factory, so an entry added by a library
+// further down the link order can capture its own settings (photon counts, ...).
+using IntegratorFactory = std::function<std::shared_ptr<const Integrator>(const IntegratorSetup&)>;
+using IntegratorInfo = RegistryEntry<IntegratorFactory>;
+using IntegratorRegistry = Registry<IntegratorFactory>;
+// The integrators of this library (registry.cpp): whitted, path. photonmap links raytrace,
+// never the reverse, so a program assembles its registry explicitly: a copy of this one plus
+// add() of the photon-map entries (tools/integrators.cpp); see common/util/registry.h for
+// why not static self-registration.
+const IntegratorRegistry& builtinIntegrators();
+// The built-in integrator `kind` names (the default of a TraceJob that carries none).
+std::shared_ptr<const Integrator> makeBuiltinIntegrator(IntegratorKind kind, const IntegratorSetup& setup);
 
 }  // namespace pr::rt

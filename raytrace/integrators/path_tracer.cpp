@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "raytrace/integrators/integrator.h"
+#include "raytrace/integrators/path_tracer.h"
 
 namespace pr::rt {
 
@@ -17,7 +17,7 @@ constexpr float kMaxSurvival = 0.95f;
 }  // namespace
 
 void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
-  const IntegratorContext& ctx = *ctx_;
+  const IntegratorContext& ctx = context();
   const ShadingMaterial m = evalMaterial(ctx.scene(), si);
 
   // Emission: full weight for camera rays and after delta events; otherwise MIS against the

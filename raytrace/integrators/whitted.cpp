@@ -4,7 +4,7 @@
 // glossy surfaces get direct light only. Runs on the PE holding the message.
 #include <cmath>
 
-#include "raytrace/integrators/integrator.h"
+#include "raytrace/integrators/whitted.h"
 
 namespace pr::rt {
 
@@ -14,7 +14,7 @@ constexpr float kMinThroughput = 1.0f / 4096.0f;
 }  // namespace
 
 void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
-  const IntegratorContext& ctx = *ctx_;
+  const IntegratorContext& ctx = context();
   const ShadingMaterial m = evalMaterial(ctx.scene(), si);
   // Every ray of a Whitted tracer reaches an emitter only through camera, mirror or
   // refraction paths, which light sampling never covers, so emission counts fully.

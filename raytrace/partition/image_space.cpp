@@ -1,12 +1,14 @@
 // Image-space partitioning (seed section 5.1.2): the image is cut into tiles, each tile is a
 // task on par::Runtime, and every scheduling strategy of the runtime decides which PE renders
 // which tile. World model: every PE reads the whole scene and its BVH, counted as one
-// broadcast of the scene's bytes per PE. Cost estimates for the unbalanced and hot-spot
-// strategies come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
+// broadcast of the scene's bytes per PE. Cost estimates, for the strategies that declare they
+// need them in the schedule registry (par::scheduleNeedsCostEstimates: unbalanced, hot-spots),
+// come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
 #include <algorithm>
 #include <memory>
 #include <string>
 
+#include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/partition/partition.h"
 
 namespace pr::rt {
@@ -27,8 +29,6 @@ struct TileTask {
   double cost = 1.0;
 };
 
-bool needsCostEstimates(const std::string& schedule) { return schedule == "unbalanced" || schedule == "hot-spots"; }
-
 class ImageSpacePartition final : public Partition {
  public:
   std::string_view name() const override { return "image-space"; }
@@ -37,19 +37,20 @@ class ImageSpacePartition final : public Partition {
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
-    const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
+    const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
+    const Integrator& integrator = *shared;
     std::vector<TileTask> tiles = makeTiles(job);
     // World model: the scene is replicated on every PE (DESIGN.md rule 1), counted in the
     // first stage that reads it.
     rt.recordBroadcast(job.scene.memoryBytes());
-    if (needsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, bvh, tiles, rt);
+    if (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, integrator, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 
     par::TaskSet set;
     set.tasks.reserve(tiles.size());
     for (const TileTask& t : tiles) set.tasks.push_back({t.cost, t.x, t.y});
 
-    Film film(job.width, job.height, job.options.integrator.spp);
+    Film film(job.width, job.height, integrator.options().spp);
     TraceCounters counters;
     std::atomic<int64_t> done{0};
     const int64_t total = int64_t(tiles.size());
@@ -57,7 +58,7 @@ class ImageSpacePartition final : public Partition {
       TraceStats stats;
       std::vector<RayMessage> queue;
       integrator.cameraRays(tiles[size_t(id)].rect, queue);
-      traceToCompletion(job.scene, bvh, integrator, queue, film, stats);
+      integrator.traceToCompletion(bvh, queue, film, stats);
       counters.add(stats);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job.options.progress) job.options.progress(n, total);
@@ -81,10 +82,9 @@ class ImageSpacePartition final : public Partition {
   // Low-resolution pre-pass, its own stage ("cost pre-pass", one task per tile, balanced split)
   // so its time is measured with the render: rays traced per sampled pixel, scaled to the
   // tile's pixel count. Each task writes only its tile's estimate; the scratch film is thrown away.
-  static void estimateCosts(const TraceJob& job, const Bvh& bvh, std::vector<TileTask>& tiles, par::Runtime& rt) {
-    IntegratorOptions pre = job.options.integrator;
-    pre.spp = 1;
-    const Integrator integrator(job.scene, job.camera, job.width, job.height, pre);
+  // The render's integrator makes the rays, one sample per pixel (sample 0, as in a 1-spp render).
+  static void estimateCosts(const TraceJob& job, const Integrator& integrator, const Bvh& bvh,
+                            std::vector<TileTask>& tiles, par::Runtime& rt) {
     Film scratch(job.width, job.height, 1);
     const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
     rt.runStage("cost pre-pass", par::TaskSet::uniform(tiles.size()), *balanced, [&](par::Pe&, par::TaskId id) {
@@ -94,8 +94,8 @@ class ImageSpacePartition final : public Partition {
       int64_t sampled = 0;
       for (int y = t.rect.y0; y < t.rect.y1; y += kPrePassStride)
         for (int x = t.rect.x0; x < t.rect.x1; x += kPrePassStride) {
-          integrator.cameraRays(PixelRect{x, y, x + 1, y + 1}, queue);
-          traceToCompletion(job.scene, bvh, integrator, queue, scratch, stats);
+          integrator.cameraRays(PixelRect{x, y, x + 1, y + 1}, 1, queue);
+          integrator.traceToCompletion(bvh, queue, scratch, stats);
           ++sampled;
         }
       t.cost = sampled > 0 ? double(stats.total()) * double(t.rect.pixels()) / double(sampled) : 1.0;

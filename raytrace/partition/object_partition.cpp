@@ -9,6 +9,7 @@
 #include "raytrace/partition/object_partition.h"
 
 #include <atomic>
+#include <memory>
 #include <vector>
 
 #include "common/parallel/channel.h"
@@ -43,8 +44,8 @@ class ObjectFrame {
       : job_(job),
         rt_(rt),
         assignment_(job.scene, {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position())}),
-        integrator_(job.scene, job.camera, job.width, job.height, job.options.integrator),
-        film_(job.width, job.height, job.options.integrator.spp),
+        integrator_(jobIntegrator(job)),
+        film_(job.width, job.height, integrator_->options().spp),
         bvhs_(rt.pes()),
         state_(rt.pes()) {}
 
@@ -72,7 +73,7 @@ class ObjectFrame {
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
-      integrator_.cameraRays(tiles[size_t(id)], st.start);
+      integrator_->cameraRays(tiles[size_t(id)], st.start);
       st.stats.cameraRays += st.start.size() - before;
       drain(pe);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -134,7 +135,7 @@ class ObjectFrame {
     assignment_.ownersAlong(m.ray, st.owners);
     if (st.owners.empty()) {
       Emit emit(film_, st.spawned);
-      integrator_.miss(m, emit);  // reaches no object: nothing to ask
+      integrator_->miss(m, emit);  // reaches no object: nothing to ask
       return;
     }
     uint32_t slot;
@@ -196,14 +197,14 @@ class ObjectFrame {
     --st.live;
     Emit emit(film_, st.spawned);
     if (done.message.kind == RayKind::Shadow) {
-      if (!done.best.found) integrator_.miss(done.message, emit);
+      if (!done.best.found) integrator_->miss(done.message, emit);
       return;
     }
     if (!done.best.found) {
-      integrator_.miss(done.message, emit);
+      integrator_->miss(done.message, emit);
       return;
     }
-    integrator_.shade(done.best.si, done.message, emit);
+    integrator_->shade(done.best.si, done.message, emit);
     for (const RayMessage& s : st.spawned) {
       ++(s.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
       st.start.push_back(s);
@@ -214,7 +215,7 @@ class ObjectFrame {
   const TraceJob& job_;
   par::Runtime& rt_;
   ObjectAssignment assignment_;
-  Integrator integrator_;
+  std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   Film film_;
   std::vector<Bvh> bvhs_;
   std::vector<PeState> state_;

@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,8 @@ class ObjectSpaceFrame {
         rt_(rt),
         split_(job.scene, {voxelsPerPe * rt.pes(), partitionMargin(job.scene, job.camera.position())}),
         owners_(assignVoxelOwners(split_, rt.pes())),
-        integrator_(job.scene, job.camera, job.width, job.height, job.options.integrator),
-        film_(job.width, job.height, job.options.integrator.spp),
+        integrator_(jobIntegrator(job)),
+        film_(job.width, job.height, integrator_->options().spp),
         bvhs_(split_.voxels()),
         state_(rt.pes()) {}
 
@@ -65,7 +66,7 @@ class ObjectSpaceFrame {
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
-      integrator_.cameraRays(tiles[size_t(id)], camera);
+      integrator_->cameraRays(tiles[size_t(id)], camera);
       st.stats.cameraRays += camera.size();
       for (const RayMessage& m : camera) trace(pe, TravellingRay{m, 0});
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -142,7 +143,7 @@ class ObjectSpaceFrame {
       clipped.tMax = std::min(m.ray.tMax, st.spans[k].tExit);
       Hit hit;
       if (!bvh.intersect(clipped, hit)) continue;
-      integrator_.shade(makeInteraction(job_.scene, m.ray, hit), m, emit);
+      integrator_->shade(makeInteraction(job_.scene, m.ray, hit), m, emit);
       for (const RayMessage& r : st.spawned) {
         ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
         st.work.push_back(TravellingRay{r, 0});
@@ -150,14 +151,14 @@ class ObjectSpaceFrame {
       st.spawned.clear();
       return;
     }
-    integrator_.miss(m, emit);  // left the scene (a shadow ray: unoccluded)
+    integrator_->miss(m, emit);  // left the scene (a shadow ray: unoccluded)
   }
 
   const TraceJob& job_;
   par::Runtime& rt_;
   VoxelSplit split_;
   std::vector<int> owners_;
-  Integrator integrator_;
+  std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   Film film_;
   std::vector<Bvh> bvhs_;
   std::vector<PeState> state_;

@@ -17,9 +17,11 @@
 #include "common/parallel/runtime.h"
 #include "common/scene/camera.h"
 #include "common/scene/scene.h"
+#include "common/util/registry.h"
 #include "raytrace/core/bvh.h"
 #include "raytrace/integrators/film.h"
 #include "raytrace/integrators/integrator.h"
+#include "raytrace/integrators/trace_stats.h"
 
 namespace pr::rt {
 
@@ -35,20 +37,6 @@ struct TraceOptions {
   // single-task tracer may report finer units, e.g. rows): must be thread-safe and cheap.
   // Empty = no progress reports.
   std::function<void(int64_t, int64_t)> progress;
-};
-
-// Rays traced, by kind, summed over PEs (algorithm counters: "Rays/camera", ...).
-struct TraceStats {
-  uint64_t cameraRays = 0;
-  uint64_t continuationRays = 0;
-  uint64_t shadowRays = 0;
-  uint64_t total() const { return cameraRays + continuationRays + shadowRays; }
-  TraceStats& operator+=(const TraceStats& o) {
-    cameraRays += o.cameraRays;
-    continuationRays += o.continuationRays;
-    shadowRays += o.shadowRays;
-    return *this;
-  }
 };
 
 // Per-PE counters merged after the run (atomics: a PE adds its task's counts once per task).
@@ -68,13 +56,22 @@ struct TraceResult {
   size_t tasks = 0;  // tasks of the trace stage
 };
 
-// One render: the scene, its camera, the image size and the options.
+// One render: the scene, its camera, the image size, the options and the integrator.
 struct TraceJob {
   const scene::Scene& scene;
   const scene::Camera& camera;
   int width = 0, height = 0;
   TraceOptions options;
+  // Ready built by the caller for this scene, camera and size, e.g. from the program's
+  // integrator registry (tools/integrators.h); its options() (spp, depth, seed) are the
+  // render's, options.integrator is then unused. nullptr: the built-in integrator that
+  // options.integrator.kind names, built by the partition.
+  std::shared_ptr<const Integrator> integrator = nullptr;
 };
+
+// The integrator a partition renders job with: job.integrator, or the built-in default.
+// Called once per render on the controlling thread.
+std::shared_ptr<const Integrator> jobIntegrator(const TraceJob& job);
 
 class Partition {
  public:
@@ -85,27 +82,19 @@ class Partition {
   virtual TraceResult render(const TraceJob& job, par::Runtime& rt) = 0;
 };
 
-// Registry: name -> description -> factory (registry.cpp); feeds --help, validation, reports.
-struct PartitionInfo {
-  std::string_view name;
-  std::string_view description;
-  std::unique_ptr<Partition> (*make)();
-};
-const std::vector<PartitionInfo>& partitions();
+// Registry: name -> factory -> description (registry.cpp); feeds --help, validation, reports.
+using PartitionInfo = RegistryEntry<std::unique_ptr<Partition> (*)()>;
+using PartitionRegistry = Registry<std::unique_ptr<Partition> (*)()>;
+const PartitionRegistry& partitions();
 bool isPartition(std::string_view name);
 // Throws pr::InputError naming the unknown partition and listing the valid ones.
 std::unique_ptr<Partition> makePartition(std::string_view name);
 
 // Validates the job (size, options) and runs the named partition.
+TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt);
+// The same for a job with the built-in integrator options.integrator.kind names.
 TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
                        const TraceOptions& options, std::string_view partition, par::Runtime& rt);
-
-// The message loop of a PE that holds the whole world (sequential, image-space): traces every
-// message in `queue` and every message shading spawns until none is left, against the full
-// BVH. Adds rays traced by kind to `stats`. The queue is used as a stack (depth first), which
-// bounds its length; order does not change the image (fixed-point film).
-void traceToCompletion(const scene::Scene& scene, const Bvh& bvh, const Integrator& integrator,
-                       std::vector<RayMessage>& queue, Film& film, TraceStats& stats);
 
 // Factories, one per partition file.
 std::unique_ptr<Partition> makeSequentialPartition();

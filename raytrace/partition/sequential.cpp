@@ -1,31 +1,23 @@
 // The sequential tracer: one PE, one message queue, the BVH over the whole scene — the
-// reference every parallel partition must reproduce bit for bit, and the place where the
-// shared message loop (traceToCompletion) lives. Runs as a single task on the runtime so its
-// time is measured like any other method's.
+// reference every parallel partition must reproduce bit for bit — and jobIntegrator, which
+// every partition gets its integrator from. Runs as a single task on the runtime so its time
+// is measured like any other method's.
 #include <memory>
 
+#include "common/util/error.h"
 #include "raytrace/partition/partition.h"
 
 namespace pr::rt {
 
-void traceToCompletion(const scene::Scene& scene, const Bvh& bvh, const Integrator& integrator,
-                       std::vector<RayMessage>& queue, Film& film, TraceStats& stats) {
-  Emit emit(film, queue);
-  while (!queue.empty()) {
-    const RayMessage msg = queue.back();
-    queue.pop_back();
-    if (msg.kind == RayKind::Shadow) {
-      ++stats.shadowRays;
-      if (!bvh.occluded(msg.ray)) integrator.miss(msg, emit);
-      continue;
-    }
-    ++(msg.kind == RayKind::Camera ? stats.cameraRays : stats.continuationRays);
-    Hit hit;
-    if (bvh.intersect(msg.ray, hit))
-      integrator.shade(makeInteraction(scene, msg.ray, hit), msg, emit);
-    else
-      integrator.miss(msg, emit);
+std::shared_ptr<const Integrator> jobIntegrator(const TraceJob& job) {
+  if (job.integrator) {
+    const IntegratorContext& ctx = job.integrator->context();
+    PR_CHECK(&ctx.scene() == &job.scene && ctx.width() == job.width && ctx.height() == job.height,
+             "the job's integrator was built for another scene or image size");
+    return job.integrator;
   }
+  return makeBuiltinIntegrator(job.options.integrator.kind,
+                               IntegratorSetup{job.scene, job.camera, job.width, job.height, job.options.integrator});
 }
 
 namespace {
@@ -38,8 +30,9 @@ class SequentialPartition final : public Partition {
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
-    const Integrator integrator(job.scene, job.camera, job.width, job.height, job.options.integrator);
-    Film film(job.width, job.height, job.options.integrator.spp);
+    const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
+    const Integrator& integrator = *shared;
+    Film film(job.width, job.height, integrator.options().spp);
     TraceCounters counters;
     rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
       TraceStats stats;
@@ -48,7 +41,7 @@ class SequentialPartition final : public Partition {
       // single task reports its progress in rows.
       for (int y = 0; y < job.height; ++y) {
         integrator.cameraRays(PixelRect{0, y, job.width, y + 1}, queue);
-        traceToCompletion(job.scene, bvh, integrator, queue, film, stats);
+        integrator.traceToCompletion(bvh, queue, film, stats);
         if (job.options.progress) job.options.progress(y + 1, job.height);
       }
       counters.add(stats);

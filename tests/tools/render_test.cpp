@@ -7,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include "common/image/image_io.h"
+#include "raster/composite/compositor.h"
+#include "raytrace/integrators/integrator.h"
 #include "test_support.h"
 
 using pr::test::runParrender;
@@ -74,3 +76,23 @@ RENDER_BAD_INPUT("an unknown schedule", join({"render ", cornell(), " --schedule
 RENDER_BAD_INPUT("a zero width", join({"render ", cornell(), " --width 0", out}), "--width")
 RENDER_BAD_INPUT("an unknown camera", join({"render ", cornell(), " --camera 7", out}), "7")
 RENDER_BAD_INPUT("an unsupported output extension", join({"render ", cornell(), " -o \"", (dir / "x.jpg").string(), "\""}), ".jpg")
+
+TEST_CASE("Render: --help lists every integrator and compositor of their registries") {
+  const auto r = runParrender("render --help");
+  INFO(r.output);
+  CHECK(r.exitStatus == 0);
+  for (const pr::rt::IntegratorInfo& i : pr::rt::builtinIntegrators()) {
+    CHECK(r.output.find(i.name) != std::string::npos);
+    CHECK(r.output.find(i.description) != std::string::npos);
+  }
+  for (const pr::raster::CompositorInfo& c : pr::raster::compositors()) {
+    CHECK(r.output.find(c.name) != std::string::npos);
+    CHECK(r.output.find(c.description) != std::string::npos);
+  }
+}
+
+RENDER_BAD_INPUT("an unknown integrator, listing the registry's", join({"render ", cornell(), " --integrator foo", out}),
+                 "unknown integrator 'foo' (expected one of: whitted, path)")
+RENDER_BAD_INPUT("an unknown compositor, listing the registry's",
+                 join({"render ", cornell(), " -m sort-last --compositor foo", out}),
+                 "unknown compositor 'foo' (expected one of: direct-send, binary-swap)")

@@ -8,26 +8,29 @@
 #include <string_view>
 #include <vector>
 
+#include "common/util/registry.h"
 #include "tools/scenegen/gltf_builder.h"
 
 namespace pr::scenegen {
 
 struct SceneParams {
-  int size = 0;       // meaning per scene: SceneEntry::sizeMeaning
-  uint64_t seed = 0;  // used only where SceneEntry::usesSeed
+  int size = 0;       // meaning per scene: SceneProperties::sizeMeaning
+  uint64_t seed = 0;  // used only where SceneProperties::usesSeed
 };
 
-struct SceneEntry {
-  std::string_view name;
-  std::string_view description;  // one line for --help
+// What a scene declares beside its name and description.
+struct SceneProperties {
   std::string_view sizeMeaning;  // what --size sets
   int defaultSize = 0, minSize = 0, maxSize = 0;
   bool usesSeed = false;
   uint64_t defaultSeed = 0;
-  void (*build)(GltfBuilder& builder, const SceneParams& params) = nullptr;
 };
+// The factory writes the scene into the builder.
+using SceneBuild = void (*)(GltfBuilder& builder, const SceneParams& params);
+using SceneEntry = RegistryEntry<SceneBuild, SceneProperties>;
+using SceneRegistry = Registry<SceneBuild, SceneProperties>;
 
-const std::vector<SceneEntry>& sceneRegistry();
+const SceneRegistry& sceneRegistry();
 
 // The entry called `name`; pr::InputError listing the known names otherwise.
 const SceneEntry& findScene(std::string_view name);

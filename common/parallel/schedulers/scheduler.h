@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/parallel/task.h"
+#include "common/util/registry.h"
 
 namespace pr::par {
 
@@ -75,17 +76,23 @@ class Scheduler {
   }
 };
 
-// Registry: name -> factory -> one-line description; feeds --help, validation and reports.
-struct ScheduleInfo {
-  std::string_view name;
-  std::string_view description;
-  std::unique_ptr<Scheduler> (*make)();
+// Registry: name -> factory -> one-line description, and what the strategy declares about
+// itself; feeds --help, validation and reports (common/util/registry.h).
+struct ScheduleProperties {
+  // The strategy orders or splits tasks by Task::cost, so the caller should estimate costs
+  // (a pre-pass or a profile) before the stage; with uniform costs it degenerates.
+  bool needsCostEstimates = false;
 };
-const std::vector<ScheduleInfo>& schedules();
+using ScheduleInfo = RegistryEntry<std::unique_ptr<Scheduler> (*)(), ScheduleProperties>;
+using ScheduleRegistry = Registry<std::unique_ptr<Scheduler> (*)(), ScheduleProperties>;
+const ScheduleRegistry& schedules();
 // Throws pr::InputError naming the unknown schedule and listing the valid ones.
 std::unique_ptr<Scheduler> makeScheduler(std::string_view name);
 bool isSchedule(std::string_view name);
-// "name: description" lines, for --help.
+// Whether the named strategy declares that it needs cost estimates; throws pr::InputError
+// for an unknown name.
+bool scheduleNeedsCostEstimates(std::string_view name);
+// "name  description" lines, for --help.
 std::string describeSchedules();
 
 // Static splits shared by several strategies (balanced.cpp, unbalanced.cpp; tests check them).

@@ -219,6 +219,23 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
     bad.push_back({"accessor past its bufferView", w.write(dir, "accessor_range.gltf"), "bufferView 0 has 36"});
   }
   {
+    // Legal glTF, but past 32-bit vertex indices: refused on the declared count, before the
+    // (absent) data is read.
+    GltfWriter w = oneTriangle();
+    w.doc["accessors"][0]["count"] = 4294967295ull;
+    bad.push_back({"more vertices than 32-bit indices", w.write(dir, "vertex_limit.gltf"),
+                   "4294967295 vertices in the scene exceed the limit of 4294967294"});
+  }
+  {
+    GltfWriter w;
+    int pos = w.addFloats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
+    int idx = w.addIndices({0, 1, 2});
+    w.doc["accessors"][size_t(idx)]["count"] = 3ull * 4294967296ull;
+    w.setRoots({w.addNode({{"mesh", w.addMesh({{"POSITION", pos}}, idx)}})});
+    bad.push_back({"more triangles than 32-bit indices", w.write(dir, "triangle_limit.gltf"),
+                   "4294967296 triangles in the scene exceed the limit of 4294967294"});
+  }
+  {
     GltfWriter w;
     int pos = w.addFloats({0, 0, 0, 1, 0, 0, 0, 1, 0}, "VEC3");
     int idx = w.addIndices({0, 1, 5});

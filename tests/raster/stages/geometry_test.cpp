@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <string>
 #include <vector>
 
 #include "common/util/error.h"
@@ -320,3 +321,19 @@ TEST_CASE("Geometry: an image size outside the limits is an input error") {
 
 }  // namespace
 }  // namespace pr::raster
+
+TEST_CASE("Geometry: the rasterizers order at most 2^29 triangles, an input error beyond") {
+  // Fake counts: nothing of the size is allocated.
+  auto messageOf = [](size_t n) {
+    try {
+      pr::raster::checkRasterLimits("scene big.gltf", n);
+    } catch (const pr::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(pr::raster::kMaxPrimitives == (1u << 29));
+  const std::string message = messageOf((size_t(1) << 29) + 1);
+  CHECK(message.find("536870913 triangles exceed the limit of 536870912") != std::string::npos);
+  CHECK(messageOf(size_t(1) << 29).empty());
+}

@@ -5,8 +5,10 @@
 
 #include <functional>
 #include <numeric>
+#include <string>
 #include <vector>
 
+#include "common/util/error.h"
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/geometry_builders.h"
 
@@ -164,4 +166,19 @@ TEST_CASE("BvhBuild: denormal spacing and huge coordinates build a valid tree") 
   const Bvh bvh(scene);
   const auto seen = checkStructure(bvh, scene.triangles.size(), BvhBuildOptions{}.maxLeafSize);
   for (int count : seen) CHECK(count == 1);
+}
+
+TEST_CASE("BvhBuild: one BVH holds at most 2^27 - 1 triangles, an input error beyond") {
+  // Fake counts: nothing of the size is allocated.
+  auto messageOf = [](size_t n) {
+    try {
+      pr::rt::checkBvhLimit("scene big.gltf", n);
+    } catch (const pr::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(messageOf(size_t(1) << 27) ==
+        "scene big.gltf: 134217728 triangles exceed the limit of 134217727 (a BVH leaf addresses its triangles with 27 bits)");
+  CHECK(messageOf((size_t(1) << 27) - 1).empty());
 }

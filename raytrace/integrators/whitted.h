@@ -1,0 +1,17 @@
+// Whitted-style ray tracing (Whitted 1980): emission, direct light with shadow rays from every
+// light, ideal mirror reflection, Fresnel-weighted reflection and refraction through
+// dielectrics. Registered as "whitted" (registry.cpp); shading in whitted.cpp.
+#pragma once
+
+#include "raytrace/integrators/trace_loop.h"
+
+namespace pr::rt {
+
+class WhittedIntegrator final : public IntegratorBase<WhittedIntegrator> {
+ public:
+  using IntegratorBase::IntegratorBase;
+  std::string_view name() const override { return "whitted"; }
+  void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
+};
+
+}  // namespace pr::rt

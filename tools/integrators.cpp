@@ -1,0 +1,21 @@
+// Assembles the program's integrator registry (see integrators.h). Explicit assembly rather
+// than static self-registration: photonmap is a static library, and an object file of it that
+// nothing references would be dropped by the linker with its registration.
+#include "tools/integrators.h"
+
+namespace pr::cli {
+
+namespace {
+rt::IntegratorRegistry assemble() {
+  rt::IntegratorRegistry registry = rt::builtinIntegrators();
+  // Integrators of photonmap are added here, e.g. registry.add(pm::photonMapIntegrator()).
+  return registry;
+}
+}  // namespace
+
+const rt::IntegratorRegistry& integrators() {
+  static const rt::IntegratorRegistry kIntegrators = assemble();
+  return kIntegrators;
+}
+
+}  // namespace pr::cli
