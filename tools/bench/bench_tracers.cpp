@@ -137,7 +137,7 @@ int main(int argc, char** argv) {
     const scene::Camera cam = scene::selectCamera(s, "", float(width) / float(height));
     const rt::Bvh bvh(s);
     rt::TraceOptions opt;
-    opt.integrator.kind = rt::integratorKindFromString(integrator);
+    opt.integrator.kind = integrator == "whitted" ? rt::IntegratorKind::Whitted : rt::IntegratorKind::Path;
     opt.integrator.spp = spp;
     const double t1 = imageSpaceSeconds(s, cam, bvh, width, height, 1, repeats, opt);
     const double t2 = imageSpaceSeconds(s, cam, bvh, width, height, 2, repeats, opt);
