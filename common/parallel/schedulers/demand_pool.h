@@ -34,7 +34,7 @@ class DemandPoolScheduler : public Scheduler {
   DemandPoolScheduler(std::string_view name, PoolOrder order) : name_(name), order_(order) {}
   std::string_view name() const override { return name_; }
 
-  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
+  void reset(const TaskSet& tasks, int /*pes: one pool for all*/, const ScheduleParams& params) override {
     pool_ = order_(tasks, params);
     grain_ = static_cast<std::size_t>(std::max(1, params.grain));
     cursor_.store(0, std::memory_order_relaxed);
