@@ -54,11 +54,6 @@ class Emit {
   std::vector<RayMessage>* rays_;
 };
 
-// A rectangle of pixels [x0, x1) x [y0, y1): one image-space tile, or the whole image.
-struct PixelRect {
-  int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
-  int64_t pixels() const { return int64_t(x1 - x0) * int64_t(y1 - y0); }
-};
 
 // What both integrators read: the scene, camera, image size, options and light sampler.
 class IntegratorContext {

@@ -27,6 +27,13 @@ class LightSampler {
   explicit LightSampler(const scene::Scene& scene);
 
   bool hasAreaLights() const { return !cdf_.empty(); }
+  // The emissive triangles sampled as area lights (scene triangle indices).
+  const std::vector<uint32_t>& emitters() const { return triangles_; }
+  // Bytes of the sampler's own tables (pick distribution, per-triangle light index).
+  size_t tableBytes() const {
+    return cdf_.size() * sizeof(float) + probability_.size() * sizeof(float) + triangles_.size() * sizeof(uint32_t) +
+           lightOf_.size() * sizeof(uint32_t);
+  }
 
   // A punctual light's contribution at si; false when it cannot reach si (outside its range
   // or spot cone, or si sits on the light).

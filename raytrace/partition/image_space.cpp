@@ -1,7 +1,7 @@
 // Image-space partitioning (seed section 5.1.2): the image is cut into tiles, each tile is a
 // task on par::Runtime, and every scheduling strategy of the runtime decides which PE renders
 // which tile. World model: every PE reads the whole scene and its BVH, counted as one
-// broadcast of the scene's bytes per PE. Cost estimates, for the strategies that declare they
+// broadcast of the scene's and the BVH's bytes per PE; finished tiles travel to the assembler. Cost estimates, for the strategies that declare they
 // need them in the schedule registry (par::scheduleNeedsCostEstimates: unbalanced, hot-spots),
 // come from a cheap low-resolution pre-pass; --adaptive splits expensive tiles.
 #include <algorithm>
@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/parallel/schedulers/scheduler.h"
+#include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/partition.h"
 
 namespace pr::rt {
@@ -34,15 +35,20 @@ class ImageSpacePartition final : public Partition {
   std::string_view name() const override { return "image-space"; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
+    // The world BVH is built once, on the assembler's PE in a stage of its own (so its time is
+    // in the record like the partitioned tracers' builds), and replicated: the scene and the
+    // BVH are one broadcast per PE (world model, DESIGN.md rule 1). A BVH handed in by the
+    // caller (TraceOptions::worldBvh) is not rebuilt: its build is then outside the record.
     std::unique_ptr<Bvh> built;
-    if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+    if (!job.options.worldBvh)
+      rt.runPinned("build", par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+        built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+      });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
     std::vector<TileTask> tiles = makeTiles(job);
-    // World model: the scene is replicated on every PE (DESIGN.md rule 1), counted in the
-    // first stage that reads it.
-    rt.recordBroadcast(job.scene.memoryBytes());
+    rt.recordBroadcast(job.scene.memoryBytes() + bvh.stats().memoryBytes);
     if (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, integrator, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 
@@ -50,15 +56,20 @@ class ImageSpacePartition final : public Partition {
     set.tasks.reserve(tiles.size());
     for (const TileTask& t : tiles) set.tasks.push_back({t.cost, t.x, t.y});
 
+    // Each tile is rendered into its own film and sent, finished, to the assembler.
     Film film(job.width, job.height, integrator.options().spp);
+    FilmAssembly assembly(rt, film);
     TraceCounters counters;
     std::atomic<int64_t> done{0};
     const int64_t total = int64_t(tiles.size());
-    rt.runStage("trace", set, [&](par::Pe&, par::TaskId id) {
+    rt.runStage("trace", set, [&](par::Pe& pe, par::TaskId id) {
+      const PixelRect& rect = tiles[size_t(id)].rect;
+      Film tile(rect, job.width, job.height, integrator.options().spp);
       TraceStats stats;
       std::vector<RayMessage> queue;
-      integrator.cameraRays(tiles[size_t(id)].rect, queue);
-      integrator.traceToCompletion(bvh, queue, film, stats);
+      integrator.cameraRays(rect, queue);
+      integrator.traceToCompletion(bvh, queue, tile, stats);
+      assembly.deliver(pe, tile, rect, false);
       counters.add(stats);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job.options.progress) job.options.progress(n, total);

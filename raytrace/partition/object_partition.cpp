@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "common/parallel/channel.h"
+#include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/object_assignment.h"
 #include "raytrace/partition/partition_margin.h"
 
@@ -45,7 +46,7 @@ class ObjectFrame {
         rt_(rt),
         assignment_(job.scene, {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position())}),
         integrator_(jobIntegrator(job)),
-        film_(job.width, job.height, integrator_->options().spp),
+        films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
         state_(rt.pes()) {}
 
@@ -68,8 +69,8 @@ class ObjectFrame {
     queries_ = &queries;
     hits_ = &hits;
     // Materials, textures, lights and the directory of piece bounds and owners are replicated
-    // on every PE; geometry is not.
-    rt_.recordBroadcast(shadingDataBytes(job_.scene) + assignment_.directoryBytes());
+    // on every PE, and so are the emitters (area-light sampling); other geometry is not.
+    recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), assignment_.directoryBytes());
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
@@ -82,7 +83,15 @@ class ObjectFrame {
     queries_ = nullptr;
     hits_ = nullptr;
 
-    TraceResult result{film_.toImage(), {}, tiles.size()};
+    // Each PE's film contributions travel to the assembler, whose film is the image.
+    {
+      std::vector<Film*> films;
+      for (const std::unique_ptr<Film>& f : films_) films.push_back(f.get());
+      FilmAssembly assembly(rt_, *films_[kAssemblerPe]);
+      assembly.deliverFilms(rt_, films, tiles);
+    }
+
+    TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
     figures = PartitionFigures{};
     figures.partitions = int(assignment_.pieces().size());
     for (int p = 0; p < pes; ++p) {
@@ -134,7 +143,7 @@ class ObjectFrame {
   void launch(par::Pe& pe, PeState& st, const RayMessage& m) {
     assignment_.ownersAlong(m.ray, st.owners);
     if (st.owners.empty()) {
-      Emit emit(film_, st.spawned);
+      Emit emit(*films_[size_t(pe.id())], st.spawned);
       integrator_->miss(m, emit);  // reaches no object: nothing to ask
       return;
     }
@@ -195,7 +204,7 @@ class ObjectFrame {
     const Pending done = p;
     st.freeSlots.push_back(r.slot);
     --st.live;
-    Emit emit(film_, st.spawned);
+    Emit emit(*films_[size_t(pe.id())], st.spawned);
     if (done.message.kind == RayKind::Shadow) {
       if (!done.best.found) integrator_->miss(done.message, emit);
       return;
@@ -216,7 +225,7 @@ class ObjectFrame {
   par::Runtime& rt_;
   ObjectAssignment assignment_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
-  Film film_;
+  std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
   std::vector<PeState> state_;
   par::Channel<RayQuery>* queries_ = nullptr;

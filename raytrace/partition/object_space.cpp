@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/parallel/channel.h"
+#include "raytrace/partition/film_assembly.h"
 #include "common/util/error.h"
 #include "raytrace/partition/partition_margin.h"
 #include "raytrace/partition/voxel_split.h"
@@ -42,7 +43,7 @@ class ObjectSpaceFrame {
         split_(job.scene, {voxelsPerPe * rt.pes(), partitionMargin(job.scene, job.camera.position())}),
         owners_(assignVoxelOwners(split_, rt.pes())),
         integrator_(jobIntegrator(job)),
-        film_(job.width, job.height, integrator_->options().spp),
+        films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(split_.voxels()),
         state_(rt.pes()) {}
 
@@ -61,8 +62,8 @@ class ObjectSpaceFrame {
     par::Channel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, [this](par::Pe& pe, TravellingRay&& r) { trace(pe, r); });
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
-    // every PE; geometry is not.
-    rt_.recordBroadcast(shadingDataBytes(job_.scene) + split_.treeBytes() + owners_.size() * sizeof(int));
+    // every PE, and so are the emitters (area-light sampling); other geometry is not.
+    recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
     rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
@@ -74,7 +75,15 @@ class ObjectSpaceFrame {
     });
     rays_ = nullptr;
 
-    TraceResult result{film_.toImage(), {}, tiles.size()};
+    // Each PE's film contributions travel to the assembler, whose film is the image.
+    {
+      std::vector<Film*> films;
+      for (const std::unique_ptr<Film>& f : films_) films.push_back(f.get());
+      FilmAssembly assembly(rt_, *films_[kAssemblerPe]);
+      assembly.deliverFilms(rt_, films, tiles);
+    }
+
+    TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
     figures = PartitionFigures{};
     figures.partitions = split_.voxels();
     figures.geometryBytes.assign(pes, 0);
@@ -122,7 +131,7 @@ class ObjectSpaceFrame {
       st.spans.push_back(s);
       return true;
     });
-    Emit emit(film_, st.spawned);
+    Emit emit(*films_[size_t(pe.id())], st.spawned);
     for (size_t k = item.span; k < st.spans.size(); ++k) {
       const uint32_t v = st.spans[k].voxel;
       if (split_.triangles(v).empty()) continue;  // nothing to hit: no owner needs the ray
@@ -159,7 +168,7 @@ class ObjectSpaceFrame {
   VoxelSplit split_;
   std::vector<int> owners_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
-  Film film_;
+  std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
   std::vector<PeState> state_;
   par::Channel<TravellingRay>* rays_ = nullptr;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <functional>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -53,6 +54,23 @@ inline uint64_t shadingDataBytes(const scene::Scene& s) {
   return all > geometry ? all - geometry : 0;
 }
 
+// The emitters, replicated on every PE: area-light sampling on whichever PE shades reads the
+// emissive triangles' vertices and the sampler's tables, so a partitioned tracer sends every
+// PE a copy of them, counted in its broadcast (and reported as Partition/emitter_bytes).
+inline uint64_t emitterBytes(const LightSampler& lights) {
+  return lights.emitters().size() * kTriangleVertexBytes + lights.tableBytes();
+}
+
+// Counts what every PE of a partitioned tracer holds a copy of as one broadcast per PE: the
+// shading data, the emitters and the routing directory (directoryBytes: kd tree and voxel
+// owners, or piece bounds and owners). Called between stages, before the trace stage.
+inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const LightSampler& lights,
+                                 uint64_t directoryBytes) {
+  const uint64_t emitters = emitterBytes(lights);
+  for (int p = 0; p < rt.pes(); ++p) rt.addCounter("Partition/emitter_bytes", p, double(emitters));
+  rt.recordBroadcast(shadingDataBytes(s) + emitters + directoryBytes);
+}
+
 // Image tiles of tileSizePx, row-major: the camera-ray tasks of the partitioned tracers.
 inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx) {
   std::vector<PixelRect> tiles;
@@ -60,6 +78,14 @@ inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx)
     for (int x = 0; x < width; x += tileSizePx)
       tiles.push_back({x, y, std::min(width, x + tileSizePx), std::min(height, y + tileSizePx)});
   return tiles;
+}
+
+// One film per PE: shading adds to the film of the PE that shades (no shared writes); the
+// films go to the assembler at the end (film_assembly.h).
+inline std::vector<std::unique_ptr<Film>> makeFilms(const TraceJob& job, int pes, int spp) {
+  std::vector<std::unique_ptr<Film>> films;
+  for (int p = 0; p < pes; ++p) films.push_back(std::make_unique<Film>(job.width, job.height, spp));
+  return films;
 }
 
 inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx) {
