@@ -173,7 +173,9 @@ void addSimulateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "simulate",
       "predict makespan, speed-up, efficiency, imbalance and traffic at other P and networks, from a run record "
-      "(--metrics JSON) or a cost table (one task cost in seconds per line, optionally 'cost x y')");
+      "(--metrics JSON) or a cost table (one task cost in seconds per line, optionally 'cost x y'). Each stage of a "
+      "record is replayed with the strategy it ran with; --schedule replaces the run's own schedule only, and "
+      "owner-pinned stages are scaled by the rules printed per stage");
   cmd->add_option("input", args->input, "run record JSON or cost table")->required()->check(CLI::ExistingFile);
   cmd->add_option("--pes", args->pes, "PE counts to simulate, e.g. 1,2,4,...,1024 (P in [1, 1024])")
       ->capture_default_str();

@@ -4,6 +4,7 @@
 
 #include <cstdio>
 #include <numeric>
+#include <utility>
 
 #include "common/parallel/schedulers/scheduler.h"
 #include "common/util/error.h"
@@ -70,7 +71,9 @@ std::string seconds(double s) {
 
 }  // namespace
 
-StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
+namespace {
+
+StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
   StageReplay r;
   r.stage = stage;
   r.handlers = handlersAt(stage.handlers, recordedPes, pes);
@@ -142,6 +145,24 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
   r.note = "owners follow a data distribution the record does not describe (neither one task per PE nor "
            "round-robin): not predicted at P = " +
            std::to_string(pes);
+  return r;
+}
+
+}  // namespace
+
+StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
+  StageReplay r = planRule(stage, recordedPes, pes, schedule);
+  if (pes != 1 || recordedPes <= 1) return r;  // a cost table (0) says what its tasks send
+  // On one PE every message would be to itself, which is no transfer (Runtime::countMessage):
+  // the work stays, the data traffic goes.
+  std::uint64_t dropped = 0;
+  for (std::uint32_t& m : r.stage.messages) dropped += std::exchange(m, 0u);
+  for (std::uint64_t& b : r.stage.bytes) b = 0;
+  for (HandlerLoad& h : r.handlers) {
+    dropped += std::exchange(h.messagesSent, 0u);
+    h.bytesSent = 0;
+  }
+  if (dropped > 0) r.note += "; its " + std::to_string(dropped) + " data messages are to itself on one PE, not charged";
   return r;
 }
 

@@ -23,8 +23,10 @@
 // Message handlers: at the recorded P each PE keeps its recorded handler work; at another P'
 // the stage's total (seconds, messages handled, messages and bytes sent) is divided evenly over
 // the P' PEs, i.e. the messages go to owners that hold equal shares of the data. Data messages
-// (sent by tasks or handlers) are the recorded ones: a P = 1 record has none, so it predicts no
-// data traffic at P' > 1.
+// (sent by tasks or handlers) are the recorded ones, except at P' = 1, where every message
+// would go to the PE itself and none is charged. A P = 1 record has none, so it predicts no
+// data traffic at P' > 1; a record at P predicts its own message count at every P' > 1,
+// although a partitioned method's count grows with P (more owners, more boundaries crossed).
 #pragma once
 
 #include <string>

@@ -138,3 +138,27 @@ TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split
   }
   CHECK(planReplay(SimStage{}, 2, 3, "demand").handlers.size() == 3);  // none recorded: zero on every PE
 }
+
+TEST_CASE("StageReplay: on one PE no data message is charged; the work stays") {
+  SimStage s;
+  s.name = "trace";
+  s.tasks = TaskSet::uniform(2);
+  s.costs = {1.0, 1.0};
+  s.messages = {2, 0};
+  s.bytes = {800, 0};
+  s.schedule = "demand";
+  s.handlers = {{0.5, 3, 4, 400}, {0.5, 3, 0, 0}};
+  const StageReplay one = planReplay(s, 2, 1, "");
+  CHECK(one.stage.messages == std::vector<std::uint32_t>{0, 0});
+  CHECK(one.stage.bytes == std::vector<std::uint64_t>{0, 0});
+  REQUIRE(one.handlers.size() == 1);
+  CHECK(one.handlers[0].seconds == doctest::Approx(1.0));
+  CHECK(one.handlers[0].messagesSent == 0);
+  CHECK(one.note.find("its 6 data messages are to itself on one PE, not charged") != std::string::npos);
+  SimOptions options = at(1);
+  options.network = NetworkModel{"t", 1.0, 0.0, ""};  // 1 s per message: any charged message shows
+  const RunRecord r = simulate(recordedWorkload({s}, 2), "", options);
+  CHECK(r.stages[0].pes[0].messagesSent == 0);
+  CHECK(r.wallSeconds == doctest::Approx(2 * 2.0 + 3.0));  // 2 tasks, each a request and a packet of 1 s; 3 s of work
+  CHECK(planReplay(s, 2, 3, "").stage.messages == std::vector<std::uint32_t>{2, 0});  // kept at P > 1
+}
