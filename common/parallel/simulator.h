@@ -3,6 +3,9 @@
 // model (latency per message + bytes / bandwidth). It answers "what would this scene do on 30
 // machines, or 300?" from a laptop. The same Scheduler objects as the thread engine make the
 // decisions; the result is a RunRecord, so metrics.cpp derives every figure the same way.
+// A recorded stage is replayed with the strategy it ran with, owner-pinned stages by the
+// scaling rules of stage_replay.h; message handlers, broadcasts and the controlling thread's
+// time between stages are charged too (predict() below says how).
 #pragma once
 
 #include <cstdint>
