@@ -3,6 +3,7 @@
 // (common/parallel/simulator.h). Prints one row per P: makespan, speed-up, efficiency,
 // imbalance, communication volume, Karp-Flatt serial fraction; then the P beyond which adding
 // PEs stops helping.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -72,38 +73,54 @@ struct SimulateArgs {
   bool scheduleGiven = false;
 };
 
+// Seconds from a stage's start until the last PE has its copy of the stage's broadcast data,
+// summed over the stages of a predicted run (NetworkModel::broadcastArrival).
+double broadcastSeconds(const par::RunRecord& predicted, const par::NetworkModel& network) {
+  double total = 0.0;
+  for (const par::StageRecord& s : predicted.stages) {
+    const par::PeStageRecord& last = s.pes.back();
+    total += network.broadcastArrival(predicted.pes - 1, last.broadcastsReceived, last.broadcastBytesReceived);
+  }
+  return total;
+}
+
 void runSimulate(const SimulateArgs& args) {
   const par::NetworkModel& network = par::networkByName(args.network);
   const std::vector<int> pesList = parsePesList(args.pes);
   const par::Workload workload = par::readWorkload(args.input);
+  const bool fromRecord = workload.recordedPes > 0;
 
-  // The recorded run's schedule and grain unless the command line names others.
-  std::string schedule = args.schedule.schedule;
+  // The stages that ran under the run's schedule keep it (and the recorded grain) unless the
+  // command line names another; a cost table uses the command line's.
+  const std::string schedule = args.scheduleGiven || !fromRecord ? args.schedule.schedule : "";
   par::ScheduleParams params = args.schedule.params;
-  if (!args.scheduleGiven && !workload.schedule.empty() && par::isSchedule(workload.schedule)) {
-    schedule = workload.schedule;
-    params.grain = workload.grain;
-  }
+  if (!args.scheduleGiven && fromRecord) params.grain = workload.grain;
   std::size_t tasks = 0;
-  double work = 0.0;
+  double work = 0.0, handlerWork = 0.0, gaps = 0.0;
   for (const par::SimStage& s : workload.stages) {
     tasks += s.costs.size();
     for (double c : s.costs) work += c;
+    for (const par::HandlerLoad& h : s.handlers) handlerWork += h.seconds;
+    gaps += s.gapBeforeSeconds;
   }
-  if (workload.recordedPes > 0)
+  if (fromRecord)
     std::printf("recorded run: P = %d, schedule %s, wall %.6f s; %zu stages, %zu tasks, %.6f s of task work\n",
                 workload.recordedPes, workload.schedule.c_str(), workload.recordedWallSeconds, workload.stages.size(),
                 tasks, work);
   else
     std::printf("cost table: %zu tasks, %.6f s of task work\n", tasks, work);
-  if (workload.unmodelledSeconds > 0.0)
-    std::printf("note: %.6f s of message-handler time in the record is not replayed by the simulator\n",
-                workload.unmodelledSeconds);
-  std::printf("schedule %s, grain %d; network %s (%s)\n\n", schedule.c_str(), params.grain,
-              std::string(network.name).c_str(), std::string(network.description).c_str());
+  if (handlerWork > 0.0)
+    std::printf("message handlers: %.6f s of recorded handler work, charged on the PEs alongside the tasks\n",
+                handlerWork);
+  if (gaps > 0.0) std::printf("controlling thread between stages: %.6f s, replayed serially\n", gaps);
+  std::printf("schedule %s, grain %d; network %s (%s)\n",
+              schedule.empty() ? ("as recorded per stage (run: " + workload.schedule + ")").c_str() : schedule.c_str(),
+              params.grain, std::string(network.name).c_str(), std::string(network.description).c_str());
 
   std::vector<par::ScalingPoint> points;
   std::vector<par::RunSummary> summaries;
+  std::vector<double> broadcasts;
+  std::vector<std::pair<std::string, std::vector<int>>> notes;  // stage notes, and the P they hold for
   std::vector<int> all = pesList;
   if (std::find(all.begin(), all.end(), 1) == all.end()) all.insert(all.begin(), 1);  // T1 for speed-up
   std::sort(all.begin(), all.end());
@@ -113,25 +130,38 @@ void runSimulate(const SimulateArgs& args) {
     options.pes = p;
     options.params = params;
     options.network = network;
-    const par::RunRecord predicted = par::simulate(workload, schedule, options);
-    points.push_back({p, predicted.wallSeconds});
-    summaries.push_back(par::summarize(predicted));
+    const par::Prediction predicted = par::predict(workload, schedule, options);
+    points.push_back({p, predicted.record.wallSeconds});
+    summaries.push_back(par::summarize(predicted.record));
+    broadcasts.push_back(broadcastSeconds(predicted.record, network));
+    const std::string text = par::formatStageNotes(predicted.stages);
+    auto it = std::find_if(notes.begin(), notes.end(), [&](const auto& n) { return n.first == text; });
+    if (it == notes.end()) it = notes.insert(notes.end(), {text, {}});
+    it->second.push_back(p);
   }
+  for (const auto& [text, ps] : notes) {
+    std::string list;
+    for (int p : ps) list += (list.empty() ? "" : ",") + std::to_string(p);
+    std::printf("\nstages at P = %s:\n%s", list.c_str(), text.c_str());
+  }
+  std::printf("\n");
   const par::ScalingTable table = par::scalingTable(points);
-  std::printf("%6s %14s %10s %8s %10s %11s %12s %14s\n", "P", "makespan s", "speed-up", "effic.", "imbalance",
-              "Karp-Flatt", "messages", "bytes");
+  std::printf("%6s %14s %10s %8s %10s %11s %12s %14s %12s\n", "P", "makespan s", "speed-up", "effic.", "imbalance",
+              "Karp-Flatt", "messages", "bytes", "broadcast s");
   for (std::size_t i = 0; i < all.size(); ++i) {
     if (std::find(pesList.begin(), pesList.end(), all[i]) == pesList.end()) continue;
     const par::ScalingRow& row = table.rows[i];
     const par::StageSummary& total = summaries[i].total;
     char kf[32] = "-";
     if (!std::isnan(row.karpFlatt)) std::snprintf(kf, sizeof kf, "%.4f", row.karpFlatt);
-    std::printf("%6d %14.6f %10.3f %8.4f %10.4f %11s %12llu %14llu\n", row.pes, row.seconds, row.speedup,
+    std::printf("%6d %14.6f %10.3f %8.4f %10.4f %11s %12llu %14llu %12.6f\n", row.pes, row.seconds, row.speedup,
                 row.efficiency, total.imbalance, kf,
                 (unsigned long long)(total.messages + total.schedulingMessages),
-                (unsigned long long)(total.bytes + total.schedulingBytes));
+                (unsigned long long)(total.bytes + total.schedulingBytes), broadcasts[i]);
   }
-  std::printf("\nbest P: %d (makespan %.6f s); adding PEs beyond P = %d gains less than %.0f%%\n", table.bestPes,
+  std::printf("\nbroadcast s: until the last PE has its copy of the replicated data (the controller sends the P "
+              "copies one after another)\n");
+  std::printf("best P: %d (makespan %.6f s); adding PEs beyond P = %d gains less than %.0f%%\n", table.bestPes,
               points[std::find(all.begin(), all.end(), table.bestPes) - all.begin()].seconds, table.saturationPes,
               par::kSaturationTolerance * 100.0);
 }
@@ -143,7 +173,9 @@ void addSimulateCommand(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "simulate",
       "predict makespan, speed-up, efficiency, imbalance and traffic at other P and networks, from a run record "
-      "(--metrics JSON) or a cost table (one task cost in seconds per line, optionally 'cost x y')");
+      "(--metrics JSON) or a cost table (one task cost in seconds per line, optionally 'cost x y'). Each stage of a "
+      "record is replayed with the strategy it ran with; --schedule replaces the run's own schedule only, and "
+      "owner-pinned stages are scaled by the rules printed per stage");
   cmd->add_option("input", args->input, "run record JSON or cost table")->required()->check(CLI::ExistingFile);
   cmd->add_option("--pes", args->pes, "PE counts to simulate, e.g. 1,2,4,...,1024 (P in [1, 1024])")
       ->capture_default_str();

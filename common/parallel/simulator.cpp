@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <fstream>
+#include <memory>
 #include <queue>
 #include <sstream>
 
+#include "common/parallel/stage_replay.h"
 #include "common/util/error.h"
 
 namespace pr::par {
@@ -53,6 +55,17 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     SimStage stage;
     stage.name = sr.name;
     stage.tasks.tasks = sr.tasks;
+    stage.schedule = sr.schedule;
+    stage.runtimeSchedule = sr.schedule == record.schedule;
+    stage.owners = sr.owners;
+    for (const PeStageRecord& pe : sr.pes) {
+      stage.broadcasts = std::max(stage.broadcasts, pe.broadcastsReceived);
+      stage.broadcastBytes = std::max(stage.broadcastBytes, pe.broadcastBytesReceived);
+    }
+    if (s > 0) {
+      const StageRecord& previous = record.stages[s - 1];
+      stage.gapBeforeSeconds = std::max(0.0, sr.startSeconds - (previous.startSeconds + previous.wallSeconds));
+    }
     const std::size_t n = sr.tasks.size();
     stage.costs.assign(n, 0.0);
     stage.messages.assign(n, 0);
@@ -62,9 +75,19 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     for (const TaskSpan& span : record.timeline) {
       if (span.stage != static_cast<int>(s)) continue;
       if (span.task == kMessageSpan) {
-        w.unmodelledSeconds += span.end - span.start;
+        if (span.pe < 0 || span.pe >= record.pes)
+          throw InputError(origin + ": stage '" + sr.name + "' has a message span on PE " + std::to_string(span.pe));
+        if (stage.handlers.empty()) stage.handlers.resize(static_cast<std::size_t>(record.pes));
+        HandlerLoad& h = stage.handlers[static_cast<std::size_t>(span.pe)];
+        h.seconds += span.end - span.start;
+        h.handled += 1;
+        h.messagesSent += span.messagesSent;
+        h.bytesSent += span.bytesSent;
         continue;
       }
+      if (span.task < 0 || static_cast<std::size_t>(span.task) >= n)
+        throw InputError(origin + ": stage '" + sr.name + "' has a span for task " + std::to_string(span.task) +
+                         " of " + std::to_string(n));
       stage.costs[span.task] += span.end - span.start;
       stage.messages[span.task] += span.messagesSent;
       stage.bytes[span.task] += span.bytesSent;
@@ -130,49 +153,122 @@ Workload readWorkload(const std::filesystem::path& file) {
   return workloadFromCostTable(s, origin);
 }
 
-RunRecord simulate(const Workload& workload, std::string_view schedule, const SimOptions& options) {
-  auto scheduler = makeScheduler(schedule);
-  return simulate(workload, *scheduler, options);
+std::string formatStageNotes(const std::vector<StageNote>& notes) {
+  std::string text;
+  for (const StageNote& n : notes) {
+    text += "  " + n.stage + ": " + n.rule;
+    if (!n.schedule.empty()) text += " (" + n.schedule + ")";
+    text += ": " + n.note + "\n";
+  }
+  return text;
 }
 
-RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options) {
+namespace {
+
+// The event loop over all stages. runtimeScheduler, when given, replaces the strategy of the
+// stages that ran under the run's own schedule.
+//
+// The message-handler model. A stage's handler work (recorded per PE, or split evenly at
+// another P, stage_replay.h) plus the cost of the data messages the handlers sent is charged
+// on its PE alongside the tasks: the messages are made by the tasks, so when a PE asks for its
+// next task it first handles the share of its handler work that the tasks handed out so far
+// (whoever runs them) have generated, task work handed out / total task work; after its last
+// task it handles the rest. It assumes messages arrive in step with task work and never wait
+// on one another. It is wrong (optimistic) when handler work arrives late — chains of messages
+// that outlast the tasks, a ray bouncing between owners after the last tile is done — and when
+// one owner's messages depend on another's replies: the real stage then ends later.
+Prediction predictWith(const Workload& workload, std::string_view schedule, Scheduler* runtimeScheduler,
+                       const SimOptions& options) {
   if (options.pes < 1 || options.pes > 65536)
     throw InputError("simulated PEs must be in [1, 65536], got " + std::to_string(options.pes));
   const int pes = options.pes;
   const ScheduleParams& params = options.params;
   const NetworkModel& net = options.network;
 
-  RunRecord record;
+  Prediction prediction;
+  RunRecord& record = prediction.record;
   record.pes = pes;
-  record.schedule = std::string(scheduler.name());
+  record.schedule = !schedule.empty() ? std::string(schedule) : workload.schedule;
   record.grain = params.grain;
-  double stageStart = 0.0;
+  double clock = 0.0;  // end of the previous stage
   Grab grab;
   // (virtual time, PE): the PE that is free earliest asks first; ties go to the lower PE id.
   using Event = std::pair<double, int>;
 
-  for (std::size_t s = 0; s < workload.stages.size(); ++s) {
-    const SimStage& stage = workload.stages[s];
-    PR_CHECK(stage.costs.size() == stage.tasks.size(), "SimStage costs and tasks differ in size");
+  for (const SimStage& recorded : workload.stages) {
+    PR_CHECK(recorded.costs.size() == recorded.tasks.size(), "SimStage costs and tasks differ in size");
+    const StageReplay plan = planReplay(recorded, workload.recordedPes, pes, schedule);
+    prediction.stages.push_back({recorded.name, std::string(replayRuleName(plan.rule)), plan.schedule, plan.note,
+                                 plan.rule == ReplayRule::Excluded});
+    // The controlling thread's work between stages is serial: it takes as long at every P.
+    clock += recorded.gapBeforeSeconds;
+    if (plan.rule == ReplayRule::Excluded) continue;
+    const SimStage& stage = plan.stage;
+    std::unique_ptr<Scheduler> own;
+    Scheduler* scheduler = runtimeScheduler;
+    if (!(plan.rule == ReplayRule::Scheduled && plan.runtimeSchedule && runtimeScheduler)) {
+      own = plan.rule == ReplayRule::Scheduled ? makeScheduler(plan.schedule) : makeOwnerPinnedScheduler(stage.owners);
+      scheduler = own.get();
+    }
     const bool traffic = !stage.messages.empty();
-    scheduler.reset(stage.tasks, pes, params);
+    const int stageIndex = static_cast<int>(record.stages.size());
+    const double stageStart = clock;
+    scheduler->reset(stage.tasks, pes, params);
     StageRecord sr;
     sr.name = stage.name;
-    sr.schedule = record.schedule;
+    sr.schedule = plan.schedule;
     sr.grain = params.grain;
     sr.startSeconds = stageStart;
     sr.tasks = stage.tasks.tasks;
+    sr.owners = plan.rule == ReplayRule::Scheduled ? std::vector<int>{} : stage.owners;
     sr.pes.resize(pes);
-    std::vector<double> lastEnd(pes, stageStart);
 
+    // Handler work per PE (its own seconds plus its sends), and how much of it is done.
+    double totalWork = 0.0, handedWork = 0.0;
+    for (double c : stage.costs) totalWork += c;
+    std::vector<double> handlerSeconds(pes, 0.0), handlerDone(pes, 0.0);
+    for (int p = 0; p < pes; ++p) {
+      const HandlerLoad& h = plan.handlers[p];
+      const double send = net.seconds(h.messagesSent, h.bytesSent);
+      handlerSeconds[p] = h.seconds + send;
+      PeStageRecord& r = sr.pes[p];
+      r.messagesHandled = h.handled;
+      r.messagesSent += h.messagesSent;
+      r.bytesSent += h.bytesSent;
+      r.sendReceiveSeconds += send;
+    }
+    auto handle = [&](int p, double& t, double upTo) {
+      const double due = upTo - handlerDone[p];
+      if (due <= 0.0) return;
+      if (options.recordTimeline) record.timeline.push_back({p, stageIndex, kMessageSpan, t, t + due, 0u, 0u});
+      handlerDone[p] = upTo;
+      sr.pes[p].busySeconds += due;
+      t += due;
+    };
+
+    // Each PE starts when its copy of the stage's broadcast data has arrived.
+    std::vector<double> lastEnd(pes, stageStart);
     std::vector<Event> initial(pes);
-    for (int p = 0; p < pes; ++p) initial[p] = {stageStart, p};
+    for (int p = 0; p < pes; ++p) {
+      const double arrival = net.broadcastArrival(p, stage.broadcasts, stage.broadcastBytes);
+      PeStageRecord& r = sr.pes[p];
+      r.broadcastsReceived = stage.broadcasts;
+      r.broadcastBytesReceived = stage.broadcastBytes;
+      r.messageWaitSeconds += arrival;
+      lastEnd[p] = stageStart + arrival;
+      initial[p] = {stageStart + arrival, p};
+    }
     std::priority_queue<Event, std::vector<Event>, std::greater<Event>> ready(std::greater<Event>(), std::move(initial));
     while (!ready.empty()) {
       auto [t, p] = ready.top();
       ready.pop();
-      scheduler.next(p, t, grab);
-      if (grab.tasks.empty()) continue;  // this PE is done with the stage
+      handle(p, t, handlerSeconds[p] * (totalWork > 0.0 ? handedWork / totalWork : 1.0));
+      scheduler->next(p, t, grab);
+      if (grab.tasks.empty()) {  // this PE is done with the stage's tasks: the rest of its messages
+        handle(p, t, handlerSeconds[p]);
+        lastEnd[p] = std::max(lastEnd[p], t);
+        continue;
+      }
       PeStageRecord& r = sr.pes[p];
       const std::uint64_t messages = grab.requests + grab.packets;
       if (grab.from != p && messages > 0) {
@@ -187,6 +283,7 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
           t += net.seconds((grab.requests > 0 ? 1 : 0) + 1, first);
         }
       }
+      for (TaskId id : grab.tasks) handedWork += stage.costs[id];
       for (TaskId id : grab.tasks) {
         double d = stage.costs[id];
         if (traffic && stage.messages[id] > 0) {
@@ -197,27 +294,45 @@ RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOpti
           r.bytesSent += stage.bytes[id];
         }
         if (options.recordTimeline)
-          record.timeline.push_back({p, static_cast<int>(s), id, t, t + d,
-                                     traffic ? stage.messages[id] : 0u, traffic ? stage.bytes[id] : 0u});
+          record.timeline.push_back({p, stageIndex, id, t, t + d, traffic ? stage.messages[id] : 0u,
+                                     traffic ? stage.bytes[id] : 0u});
         t += d;
         r.busySeconds += d;
         r.tasks += 1;
-        scheduler.finished(p, id, d);
+        scheduler->finished(p, id, d);
       }
       lastEnd[p] = t;
       ready.push({t, p});
     }
-    const double end = *std::max_element(lastEnd.begin(), lastEnd.end());
+    const double end = std::max(stageStart, *std::max_element(lastEnd.begin(), lastEnd.end()));
     sr.wallSeconds = end - stageStart;
     for (int p = 0; p < pes; ++p) {
       sr.pes[p].idleSeconds = std::max(0.0, sr.wallSeconds - sr.pes[p].busySeconds);
       sr.pes[p].syncWaitSeconds = end - lastEnd[p];
     }
     record.stages.push_back(std::move(sr));
-    stageStart = end;
+    clock = end;
   }
-  record.wallSeconds = stageStart;
-  return record;
+  record.wallSeconds = clock;
+  return prediction;
+}
+
+}  // namespace
+
+Prediction predict(const Workload& workload, std::string_view schedule, const SimOptions& options) {
+  return predictWith(workload, schedule, nullptr, options);
+}
+
+RunRecord simulate(const Workload& workload, std::string_view schedule, const SimOptions& options) {
+  return predict(workload, schedule, options).record;
+}
+
+Prediction predict(const Workload& workload, Scheduler& scheduler, const SimOptions& options) {
+  return predictWith(workload, scheduler.name(), &scheduler, options);
+}
+
+RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options) {
+  return predict(workload, scheduler, options).record;
 }
 
 }  // namespace pr::par

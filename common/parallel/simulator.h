@@ -3,6 +3,9 @@
 // model (latency per message + bytes / bandwidth). It answers "what would this scene do on 30
 // machines, or 300?" from a laptop. The same Scheduler objects as the thread engine make the
 // decisions; the result is a RunRecord, so metrics.cpp derives every figure the same way.
+// A recorded stage is replayed with the strategy it ran with, owner-pinned stages by the
+// scaling rules of stage_replay.h; message handlers, broadcasts and the controlling thread's
+// time between stages are charged too (predict() below says how).
 #pragma once
 
 #include <cstdint>
@@ -26,6 +29,17 @@ struct NetworkModel {
   double seconds(std::uint64_t messages, std::uint64_t bytes) const {
     return messages * latencySeconds + (bytesPerSecond > 0.0 ? bytes / bytesPerSecond : 0.0);
   }
+  // Replicated data (the scene, a photon map: `messages` messages of `bytes` in all per PE)
+  // reaches PE pe this long after the stage could start: the controller sends the P copies one
+  // after another, PE 0's first, each paying latency + bytes/bandwidth. One sender on a shared
+  // medium is the seed's setting (PVM over one Ethernet segment, where a tree would not help:
+  // the segment carries one copy at a time); on a switched network a binomial tree would take
+  // ceil(log2 P) steps instead of P, so there this is an upper bound. Task packets are not held
+  // up by the copies (the scheduler is taken to have a link of its own), and a stage lasts until
+  // every PE has its copy, work or not: the data is replicated on all of them.
+  double broadcastArrival(int pe, std::uint64_t messages, std::uint64_t bytes) const {
+    return messages == 0 && bytes == 0 ? 0.0 : (pe + 1) * seconds(messages, bytes);
+  }
 };
 // Presets: zero, shared-memory, 10gbe, 1gbe, 100mbit (a 1990s workstation farm).
 const std::vector<NetworkModel>& networks();
@@ -33,15 +47,34 @@ const std::vector<NetworkModel>& networks();
 const NetworkModel& networkByName(std::string_view name);
 std::string describeNetworks();
 
+// Message handlers of one PE in one stage, as recorded (the spans with task == kMessageSpan):
+// their summed seconds, the messages they handled, and the data messages they sent.
+struct HandlerLoad {
+  double seconds = 0.0;
+  std::uint64_t handled = 0;
+  std::uint64_t messagesSent = 0, bytesSent = 0;
+};
+
 // One stage's work. tasks is what the scheduler sees (estimates, positions); costs are the
 // seconds each task really takes; messages/bytes the data messages each task sends (empty:
-// none). A sender pays latency + bytes/bandwidth for its messages inside the task.
+// none). A sender pays latency + bytes/bandwidth for its messages inside the task. The fields
+// after them come from a run record and are empty or zero for a cost table; stage_replay.h
+// says how each is replayed at another P.
 struct SimStage {
   std::string name;
   TaskSet tasks;
   std::vector<double> costs;
   std::vector<std::uint32_t> messages;
   std::vector<std::uint64_t> bytes;
+  std::string schedule;         // the strategy the stage ran with; empty: the one simulate() is given
+  bool runtimeSchedule = true;  // it ran under the run's own schedule, which --schedule replaces
+  std::vector<int> owners;      // owner-pinned stages: the PE of each task in the recorded run
+  std::vector<HandlerLoad> handlers;  // one per recorded PE; empty: no message handled
+  // Replicated read-only data each PE received before the stage (messages and bytes per PE).
+  std::uint64_t broadcasts = 0, broadcastBytes = 0;
+  // The controlling thread's time between the previous stage's end (or the first stage's
+  // start) and this stage's start: collating results, building the next stage's inputs.
+  double gapBeforeSeconds = 0.0;
 };
 struct Workload {
   std::vector<SimStage> stages;
@@ -49,9 +82,6 @@ struct Workload {
   int grain = 1;
   int recordedPes = 0;   // 0 for a cost table
   double recordedWallSeconds = 0.0;
-  // Time the record spent in message handlers: message-driven phases are not replayed (their
-  // dependencies are not in the record), so this much busy time is outside the prediction.
-  double unmodelledSeconds = 0.0;
 };
 
 // Each task's cost is its measured span; estimates and positions are the recorded TaskSet's.
@@ -70,11 +100,38 @@ struct SimOptions {
   bool recordTimeline = false;
 };
 
-// Runs every stage of the workload under `schedule` in virtual time. PEs ask for work in order
-// of virtual time, ties by lower PE id; a PE waiting for a task packet is idle for the request
-// and packet latencies plus the packet's bytes over the bandwidth (refills ahead of need are
-// counted as traffic but not waited for). wallSeconds of the result is the makespan.
-RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options);
+// How each recorded stage was replayed (stage_replay.h): the rule, the strategy, and the
+// rule's assumption or the reason the stage was left out of the prediction.
+struct StageNote {
+  std::string stage;
+  std::string rule;      // replayRuleName()
+  std::string schedule;  // the strategy the replay ran; empty for an excluded stage
+  std::string note;
+  bool excluded = false;
+};
+struct Prediction {
+  RunRecord record;  // excluded stages are not in it
+  std::vector<StageNote> stages;  // every stage of the workload, in order
+};
+// "stage: rule (schedule): note" lines, for parrender simulate.
+std::string formatStageNotes(const std::vector<StageNote>& notes);
+
+// Runs every stage of the workload in virtual time at options.pes PEs. `schedule` is the
+// strategy for the stages that ran under the run's own schedule (all stages of a cost table);
+// empty: each stage's recorded one. Stages that ran with another strategy keep theirs, and
+// owner-pinned stages follow the rules of stage_replay.h. Within a stage: PEs ask for work in
+// order of virtual time, ties by lower PE id; a PE starts only when its copy of the stage's
+// broadcast data has arrived (NetworkModel::broadcastArrival); a PE waiting for a task packet
+// is idle for the request and packet latencies plus the packet's bytes over the bandwidth
+// (refills ahead of need are counted as traffic but not waited for); data messages sent by a
+// task or handler are charged to the sender; message-handler work is charged alongside the
+// tasks (see simulate() in simulator.cpp). Between stages the controlling thread's recorded
+// time is replayed serially. wallSeconds of the result is the makespan.
+// Throws pr::InputError when a stage has no schedule (a cost table and an empty `schedule`).
+Prediction predict(const Workload& workload, std::string_view schedule, const SimOptions& options);
 RunRecord simulate(const Workload& workload, std::string_view schedule, const SimOptions& options);
+// The same with a scheduler object for the stages under the run's own schedule.
+Prediction predict(const Workload& workload, Scheduler& scheduler, const SimOptions& options);
+RunRecord simulate(const Workload& workload, Scheduler& scheduler, const SimOptions& options);
 
 }  // namespace pr::par

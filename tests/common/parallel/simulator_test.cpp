@@ -2,6 +2,7 @@
 // `parrender simulate` command (table on success, exit status 2 on bad input).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <fstream>
 
 #include "common/parallel/metrics.h"
@@ -73,6 +74,100 @@ TEST_CASE("Simulator: data messages a task sent are charged to the sender") {
   CHECK(r.stages[0].pes[0].bytesSent == 1000);
 }
 
+namespace {
+
+// A hand-made record of P = 2 under "balanced": one stage, tasks 0 and 1 of 1 s on PEs 0 and 1,
+// and PE 0 handling one message for 2 s, its handler sending one 1000-byte message on.
+RunRecord handlerRecord() {
+  RunRecord r;
+  r.pes = 2;
+  r.schedule = "balanced";
+  StageRecord s;
+  s.name = "trace";
+  s.schedule = "balanced";
+  s.tasks = TaskSet::uniform(2).tasks;
+  s.pes.resize(2);
+  s.wallSeconds = 3.0;
+  r.stages.push_back(s);
+  r.timeline = {{0, 0, 0, 0.0, 1.0}, {1, 0, 1, 0.0, 1.0}, {0, 0, kMessageSpan, 1.0, 3.0, 1, 1000}};
+  r.wallSeconds = 3.0;
+  return r;
+}
+
+}  // namespace
+
+TEST_CASE("Simulator: message-handler time is charged on its PE with its sends") {
+  const Workload w = workloadFromRecord(handlerRecord(), "hand-made");
+  REQUIRE(w.stages[0].handlers.size() == 2);
+  CHECK(w.stages[0].handlers[0].seconds == doctest::Approx(2.0));
+  CHECK(w.stages[0].handlers[0].handled == 1);
+  CHECK(w.stages[0].handlers[0].bytesSent == 1000);
+  CHECK(w.stages[0].handlers[1].seconds == 0.0);
+  SimOptions options;
+  options.pes = 2;
+  options.network = NetworkModel{"t", 0.25, 1000.0, ""};
+  options.recordTimeline = true;
+  const RunRecord r = simulate(w, "", options);
+  // Each PE waits for its static packet (0.25 s + 24 bytes / 1000 B/s), runs its 1 s task; then
+  // PE 0 handles its message (2 s) and pays for the one it sends (0.25 s + 1000 / 1000 s).
+  const double packet = 0.25 + 24.0 / 1000.0;
+  CHECK(r.wallSeconds == doctest::Approx(packet + 1.0 + 2.0 + 1.25));
+  CHECK(r.stages[0].pes[0].busySeconds == doctest::Approx(1.0 + 2.0 + 1.25));
+  CHECK(r.stages[0].pes[0].messagesHandled == 1);
+  CHECK(r.stages[0].pes[0].messagesSent == 1);
+  CHECK(r.stages[0].pes[0].bytesSent == 1000);
+  CHECK(r.stages[0].pes[1].busySeconds == doctest::Approx(1.0));
+  CHECK(std::count_if(r.timeline.begin(), r.timeline.end(), [](const TaskSpan& t) { return t.task == kMessageSpan; }) ==
+        1);
+  // At P = 4 the 2 s of handler work and its one message are split over the four owners; the
+  // handler busy time summed over PEs is still 2 s plus the send (latency once, 1000 bytes).
+  options.pes = 4;
+  const RunRecord four = simulate(w, "", options);
+  double handlerBusy = 0.0;
+  for (int p = 0; p < 4; ++p) handlerBusy += four.stages[0].pes[p].busySeconds - (p < 2 ? 1.0 : 0.0);
+  CHECK(handlerBusy == doctest::Approx(2.0 + 0.25 + 1.0));
+}
+
+TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arrived") {
+  // 1 MB of scene to each of 4 PEs at 1 ms + 1e6 / 12.5e6 s = 81 ms per copy, sent one after
+  // another: PE p has it at (p + 1) x 81 ms. PE 3 then waits for its task packet
+  // (1 ms + 24 bytes / 12.5 MB/s) and runs its 1 s task.
+  pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
+  w.stages[0].broadcasts = 1;
+  w.stages[0].broadcastBytes = 1000000;
+  SimOptions options;
+  options.pes = 4;
+  options.network = networkByName("100mbit");
+  const RunRecord r = simulate(w, "balanced", options);
+  const double copy = 1e-3 + 1e6 / 12.5e6;
+  CHECK(r.wallSeconds == doctest::Approx(4 * copy + 1e-3 + 24.0 / 12.5e6 + 1.0));
+  CHECK(r.stages[0].pes[3].messageWaitSeconds == doctest::Approx(4 * copy));
+  CHECK(r.stages[0].pes[0].messageWaitSeconds == doctest::Approx(copy));
+  CHECK(r.stages[0].pes[2].broadcastBytesReceived == 1000000);
+  CHECK(options.network.broadcastArrival(1023, 1, 1000000) == doctest::Approx(1024 * copy));
+  options.network = networkByName("zero");
+  CHECK(simulate(w, "balanced", options).wallSeconds == doctest::Approx(1.0));
+}
+
+TEST_CASE("Simulator: broadcasts and the time between stages come from the run record") {
+  Runtime rt(2, "demand");
+  rt.recordBroadcast(5000);
+  rt.runStage("first", TaskSet::uniform(2), [](Pe&, TaskId) { spinFor(1e-4); });
+  spinFor(2e-3);  // the controlling thread's work between the stages
+  rt.runStage("second", TaskSet::uniform(2), [](Pe&, TaskId) { spinFor(1e-4); });
+  const Workload w = workloadFromRecord(rt.record(), "test");
+  CHECK(w.stages[0].broadcasts == 1);
+  CHECK(w.stages[0].broadcastBytes == 5000);
+  CHECK(w.stages[1].broadcasts == 0);
+  CHECK(w.stages[0].gapBeforeSeconds == 0.0);
+  CHECK(w.stages[1].gapBeforeSeconds >= 2e-3);
+  CHECK(w.stages[1].gapBeforeSeconds < 1.0);  // generous: a loaded machine may stall the thread
+  SimOptions options;
+  options.pes = 8;
+  const RunRecord r = simulate(w, "", options);  // zero network: the gap is all that is left
+  CHECK(r.stages[1].startSeconds == doctest::Approx(r.stages[0].wallSeconds + w.stages[1].gapBeforeSeconds));
+}
+
 TEST_CASE("Simulator: cost tables name the line of a bad entry") {
   const Workload w = workloadFromCostTable("# costs\n0.5\n1.5 2 3\n\n2,4,5\n", "t.txt");
   REQUIRE(w.stages[0].costs == std::vector<double>{0.5, 1.5, 2.0});
@@ -104,6 +199,10 @@ TEST_CASE("Simulator: parrender simulate prints a table from a run record and a 
   CHECK(result.output.find("recorded run: P = 2, schedule demand") != std::string::npos);
   CHECK(result.output.find("\n    64 ") != std::string::npos);
   CHECK(result.output.find("best P:") != std::string::npos);
+  CHECK(result.output.find("schedule as recorded per stage (run: demand)") != std::string::npos);
+  CHECK(result.output.find("stages at P = 1,2,4,8,16,32,64:\n  spin: scheduled (demand): under the run's schedule") !=
+        std::string::npos);
+  CHECK(result.output.find("broadcast s") != std::string::npos);
 
   std::ofstream(dir / "costs.txt") << "1\n1\n3\n4\n4\n3\n3\n2\n1\n2\n2\n2\n2\n2\n1\n1\n1\n1\n1\n1\n1\n1\n1\n1\n";
   result = pr::test::runParrender("simulate " + (dir / "costs.txt").string() + " --pes 3 --network zero --schedule balanced");

@@ -1,0 +1,169 @@
+// The replay rules of stage_replay.h: for each recorded stage, the strategy, tasks, owners and
+// handler work the simulator runs at P'. Pure functions of the recorded stage and P'.
+#include "common/parallel/stage_replay.h"
+
+#include <cstdio>
+#include <numeric>
+#include <utility>
+
+#include "common/parallel/schedulers/scheduler.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+
+std::string_view replayRuleName(ReplayRule rule) {
+  switch (rule) {
+    case ReplayRule::Scheduled: return "scheduled";
+    case ReplayRule::AsRecorded: return "as recorded";
+    case ReplayRule::EachPe: return "each PE";
+    case ReplayRule::RoundRobin: return "round-robin";
+    case ReplayRule::OnePe: return "one PE";
+    case ReplayRule::Excluded: return "excluded";
+  }
+  return "?";
+}
+
+namespace {
+
+// n split into `parts` shares as even as whole numbers allow, the first n mod parts one more.
+std::uint64_t evenShare(std::uint64_t n, int parts, int i) {
+  return n / parts + (static_cast<std::uint64_t>(i) < n % parts ? 1 : 0);
+}
+
+// The recorded handler work at P': per PE as recorded at the recorded P, else the total split
+// evenly over the P' PEs.
+std::vector<HandlerLoad> handlersAt(const std::vector<HandlerLoad>& recorded, int recordedPes, int pes) {
+  std::vector<HandlerLoad> out(static_cast<std::size_t>(pes));
+  if (recorded.empty()) return out;
+  if (static_cast<int>(recorded.size()) == pes && recordedPes == pes) return recorded;
+  HandlerLoad total;
+  for (const HandlerLoad& h : recorded) {
+    total.seconds += h.seconds;
+    total.handled += h.handled;
+    total.messagesSent += h.messagesSent;
+    total.bytesSent += h.bytesSent;
+  }
+  for (int p = 0; p < pes; ++p)
+    out[p] = {total.seconds / pes, evenShare(total.handled, pes, p), evenShare(total.messagesSent, pes, p),
+              evenShare(total.bytesSent, pes, p)};
+  return out;
+}
+
+bool isEachPe(const std::vector<int>& owners, int recordedPes) {
+  if (static_cast<int>(owners.size()) != recordedPes) return false;
+  for (std::size_t t = 0; t < owners.size(); ++t)
+    if (owners[t] != static_cast<int>(t)) return false;
+  return true;
+}
+
+bool isRoundRobin(const std::vector<int>& owners, int recordedPes) {
+  if (static_cast<int>(owners.size()) <= recordedPes) return false;
+  for (std::size_t t = 0; t < owners.size(); ++t)
+    if (owners[t] != static_cast<int>(t % recordedPes)) return false;
+  return true;
+}
+
+std::string seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g s", s);
+  return text;
+}
+
+}  // namespace
+
+namespace {
+
+StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
+  StageReplay r;
+  r.stage = stage;
+  r.handlers = handlersAt(stage.handlers, recordedPes, pes);
+  const bool pinned = stage.schedule == kOwnerPinnedSchedule;
+  if (!pinned) {
+    r.rule = ReplayRule::Scheduled;
+    r.runtimeSchedule = stage.runtimeSchedule || stage.schedule.empty();
+    r.schedule = r.runtimeSchedule && !schedule.empty() ? std::string(schedule) : stage.schedule;
+    if (r.schedule.empty()) throw InputError("stage '" + stage.name + "' has no schedule: name one with --schedule");
+    r.note = r.runtimeSchedule ? (stage.schedule.empty() || r.schedule == stage.schedule
+                                      ? "under the run's schedule"
+                                      : "under --schedule " + r.schedule + " (recorded: " + stage.schedule + ")")
+                               : "under its own recorded schedule";
+    r.stage.owners.clear();
+    return r;
+  }
+
+  r.schedule = std::string(kOwnerPinnedSchedule);
+  const std::vector<int>& owners = stage.owners;
+  const std::size_t n = stage.costs.size();
+  if (owners.size() != n) {
+    r.rule = ReplayRule::Excluded;
+    r.schedule.clear();
+    r.note = "owner-pinned, but the record holds no owners for its tasks";
+    return r;
+  }
+  if (pes == recordedPes) {
+    r.rule = ReplayRule::AsRecorded;
+    r.note = "owners as recorded";
+    return r;
+  }
+  if (isEachPe(owners, recordedPes)) {
+    // P' tasks of total/P' each: the method's split of its data at P' is assumed even.
+    r.rule = ReplayRule::EachPe;
+    const double total = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0);
+    std::uint64_t messages = 0, bytes = 0;
+    for (std::size_t t = 0; t < stage.messages.size(); ++t) messages += stage.messages[t];
+    for (std::size_t t = 0; t < stage.bytes.size(); ++t) bytes += stage.bytes[t];
+    r.stage.tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
+    r.stage.costs.assign(static_cast<std::size_t>(pes), total / pes);
+    r.stage.messages.assign(static_cast<std::size_t>(pes), 0);
+    r.stage.bytes.assign(static_cast<std::size_t>(pes), 0);
+    r.stage.owners.resize(static_cast<std::size_t>(pes));
+    for (int p = 0; p < pes; ++p) {
+      r.stage.owners[p] = p;
+      r.stage.messages[p] = static_cast<std::uint32_t>(evenShare(messages, pes, p));
+      r.stage.bytes[p] = evenShare(bytes, pes, p);
+    }
+    r.note = "one task per PE: " + seconds(total) + " of work split evenly over " + std::to_string(pes) +
+             " owners (assumes the data divides evenly)";
+    return r;
+  }
+  if (isRoundRobin(owners, recordedPes)) {
+    r.rule = ReplayRule::RoundRobin;
+    for (std::size_t t = 0; t < n; ++t) r.stage.owners[t] = static_cast<int>(t % pes);
+    r.note = std::to_string(n) + " tasks re-dealt round-robin over " + std::to_string(pes) +
+             " owners (assumes the regions do not depend on P" +
+             (recordedPes == 1 ? "; a P = 1 record cannot tell round-robin from another split)" : ")");
+    return r;
+  }
+  if (pes == 1) {
+    r.rule = ReplayRule::OnePe;
+    r.stage.owners.assign(n, 0);
+    r.note = "every task on the one PE";
+    return r;
+  }
+  r.rule = ReplayRule::Excluded;
+  r.schedule.clear();
+  r.note = "owners follow a data distribution the record does not describe (neither one task per PE nor "
+           "round-robin): not predicted at P = " +
+           std::to_string(pes);
+  return r;
+}
+
+}  // namespace
+
+StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
+  StageReplay r = planRule(stage, recordedPes, pes, schedule);
+  if (pes != 1 || recordedPes <= 1) return r;  // a cost table (0) says what its tasks send
+  // On one PE every message would be to itself, which is no transfer (Runtime::countMessage):
+  // the work stays, the data traffic goes.
+  std::uint64_t dropped = 0;
+  for (std::uint32_t& m : r.stage.messages) dropped += std::exchange(m, 0u);
+  for (std::uint64_t& b : r.stage.bytes) b = 0;
+  for (HandlerLoad& h : r.handlers) {
+    dropped += std::exchange(h.messagesSent, 0u);
+    h.bytesSent = 0;
+  }
+  if (dropped > 0) r.note += "; its " + std::to_string(dropped) + " data messages are to itself on one PE, not charged";
+  return r;
+}
+
+}  // namespace pr::par

@@ -1,0 +1,58 @@
+// StageReplay: how the simulator (simulator.cpp) replays one recorded stage at P' PEs — which
+// strategy hands out its tasks, which tasks there are and on which PE they are pinned, and how
+// much message-handler work each PE does — or why it cannot say, so the stage is left out of
+// the prediction. The rules for owner-pinned stages (Runtime::runPinned, runOnEachPe) say how
+// the method would split its data at P', from what the record holds:
+//
+//   as recorded   P' = the recorded P: the recorded owners and task costs.
+//   each PE       owners 0..P-1, one task per PE (build my BVHs, clear my buffers, composite my
+//                 rectangle): P' tasks of total/P' each. Assumes the work divides evenly over
+//                 owners, as the cost-balanced voxel and object splits and the strip regions
+//                 intend; wrong for per-PE work that does not shrink with P (a full-frame
+//                 buffer on every PE) and for rounds whose count depends on P (binary swap).
+//   round-robin   owners[t] = t mod P with more tasks than PEs (screen regions dealt out):
+//                 re-dealt t mod P'. Assumes the set of regions does not depend on P.
+//   one PE        P' = 1: every task on the one PE (a single owner holds all the data).
+//   excluded      any other owner list follows a data distribution the record does not
+//                 describe (e.g. voxels assigned by cost): no prediction at P' for that stage.
+//
+// Stages with a strategy are replayed with it: the --schedule given to simulate for stages that
+// ran under the run's own schedule, the recorded one for stages with a fixed strategy (the
+// image-space cost pre-pass is always "balanced").
+//
+// Message handlers: at the recorded P each PE keeps its recorded handler work; at another P'
+// the stage's total (seconds, messages handled, messages and bytes sent) is divided evenly over
+// the P' PEs, i.e. the messages go to owners that hold equal shares of the data. Data messages
+// (sent by tasks or handlers) are the recorded ones, except at P' = 1, where every message
+// would go to the PE itself and none is charged. A P = 1 record has none, so it predicts no
+// data traffic at P' > 1; a record at P predicts its own message count at every P' > 1,
+// although a partitioned method's count grows with P (more owners, more boundaries crossed).
+#pragma once
+
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "common/parallel/simulator.h"
+
+namespace pr::par {
+
+enum class ReplayRule { Scheduled, AsRecorded, EachPe, RoundRobin, OnePe, Excluded };
+// "scheduled", "as recorded", "each PE", "round-robin", "one PE", "excluded".
+std::string_view replayRuleName(ReplayRule rule);
+
+struct StageReplay {
+  ReplayRule rule = ReplayRule::Scheduled;
+  std::string schedule;  // registry name, kOwnerPinnedSchedule, or empty when excluded
+  bool runtimeSchedule = false;  // Scheduled under the run's own schedule (or the --schedule one)
+  std::string note;      // the rule's assumption, or why the stage is excluded
+  SimStage stage;        // the stage at P': tasks, costs, messages; owners for pinned rules
+  std::vector<HandlerLoad> handlers;  // P' entries, zero when the stage handled no messages
+};
+
+// Called by simulate() for each stage. recordedPes = 0 for a cost table. schedule: the strategy
+// for stages that ran under the run's own schedule, empty = as recorded.
+// Throws pr::InputError when the stage ends up with no strategy at all.
+StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::string_view schedule);
+
+}  // namespace pr::par

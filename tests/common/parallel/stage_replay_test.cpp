@@ -1,0 +1,164 @@
+// StageReplay: the rules by which the simulator replays a recorded stage at another P — the
+// recorded strategy or the --schedule one, owner-pinned stages split evenly (one task per PE),
+// re-dealt round-robin, or excluded with a reason — checked on hand-made stages with exact
+// makespans on the zero-cost network.
+#include <doctest/doctest.h>
+
+#include "common/parallel/simulator.h"
+#include "common/parallel/stage_replay.h"
+#include "common/util/error.h"
+
+using namespace pr::par;
+
+namespace {
+
+SimStage pinnedStage(const std::string& name, std::vector<double> costs, std::vector<int> owners) {
+  SimStage s;
+  s.name = name;
+  s.tasks = TaskSet::fromCosts(costs);
+  s.costs = std::move(costs);
+  s.messages.assign(s.costs.size(), 0);
+  s.bytes.assign(s.costs.size(), 0);
+  s.schedule = std::string(kOwnerPinnedSchedule);
+  s.runtimeSchedule = false;
+  s.owners = std::move(owners);
+  return s;
+}
+
+Workload recordedWorkload(std::vector<SimStage> stages, int pes) {
+  Workload w;
+  w.stages = std::move(stages);
+  w.schedule = "demand";
+  w.recordedPes = pes;
+  return w;
+}
+
+SimOptions at(int pes) {
+  SimOptions options;
+  options.pes = pes;
+  options.network = networkByName("zero");
+  return options;
+}
+
+}  // namespace
+
+TEST_CASE("StageReplay: one task per PE splits its total evenly over the new P") {
+  // Recorded at P = 2: PE 0 built 1 s of BVHs, PE 1 3 s. At P = 4 each owner gets 4 s / 4.
+  const Workload w = recordedWorkload({pinnedStage("build", {1.0, 3.0}, {0, 1})}, 2);
+  const Prediction four = predict(w, "", at(4));
+  REQUIRE(four.stages.size() == 1);
+  CHECK(four.stages[0].rule == "each PE");
+  CHECK(four.stages[0].schedule == kOwnerPinnedSchedule);
+  CHECK(four.stages[0].note.find("split evenly over 4 owners") != std::string::npos);
+  REQUIRE(four.record.stages.size() == 1);
+  CHECK(four.record.stages[0].schedule == kOwnerPinnedSchedule);
+  CHECK(four.record.stages[0].owners == std::vector<int>{0, 1, 2, 3});
+  CHECK(four.record.wallSeconds == doctest::Approx(1.0));
+  for (const PeStageRecord& pe : four.record.stages[0].pes) CHECK(pe.busySeconds == doctest::Approx(1.0));
+  // At the recorded P the recorded owners and costs stand: the slower PE sets the wall.
+  const Prediction two = predict(w, "", at(2));
+  CHECK(two.stages[0].rule == "as recorded");
+  CHECK(two.record.wallSeconds == doctest::Approx(3.0));
+  CHECK(predict(w, "", at(1)).record.wallSeconds == doctest::Approx(4.0));
+}
+
+TEST_CASE("StageReplay: regions pinned round-robin are re-dealt round-robin") {
+  // Six regions on two PEs, t mod 2. At P = 3: PE 0 has regions 0, 3 (1 + 4 s), PE 1 regions
+  // 1, 4 (2 + 5 s), PE 2 regions 2, 5 (3 + 6 s): the makespan is 9 s.
+  const Workload w = recordedWorkload({pinnedStage("regions", {1, 2, 3, 4, 5, 6}, {0, 1, 0, 1, 0, 1})}, 2);
+  const Prediction p = predict(w, "", at(3));
+  CHECK(p.stages[0].rule == "round-robin");
+  CHECK(p.record.stages[0].owners == std::vector<int>{0, 1, 2, 0, 1, 2});
+  CHECK(p.record.wallSeconds == doctest::Approx(9.0));
+  CHECK(p.record.stages[0].pes[0].busySeconds == doctest::Approx(5.0));
+}
+
+TEST_CASE("StageReplay: owners of an undescribed distribution are excluded, with the reason") {
+  // Voxels assigned by cost: task 0 on PE 1, tasks 1 and 2 on PE 0. Nothing in the record says
+  // how the method would assign them at P = 4.
+  const Workload w = recordedWorkload(
+      {pinnedStage("voxels", {2.0, 1.0, 1.0}, {1, 0, 0}), pinnedStage("build", {1.0, 1.0}, {0, 1})}, 2);
+  const Prediction p = predict(w, "", at(4));
+  REQUIRE(p.stages.size() == 2);
+  CHECK(p.stages[0].excluded);
+  CHECK(p.stages[0].rule == "excluded");
+  CHECK(p.stages[0].note.find("not predicted at P = 4") != std::string::npos);
+  CHECK_FALSE(p.stages[1].excluded);
+  REQUIRE(p.record.stages.size() == 1);  // only the predicted stage
+  CHECK(p.record.stages[0].name == "build");
+  CHECK(p.record.wallSeconds == doctest::Approx(0.5));
+  CHECK(formatStageNotes(p.stages).find("voxels: excluded: owners follow") != std::string::npos);
+  // One PE holds all the data: every task runs there.
+  const Prediction one = predict(w, "", at(1));
+  CHECK(one.stages[0].rule == "one PE");
+  CHECK(one.record.wallSeconds == doctest::Approx(4.0 + 2.0));
+}
+
+TEST_CASE("StageReplay: --schedule replaces only the run's own schedule; fixed strategies stay") {
+  SimStage traced;
+  traced.name = "trace";
+  traced.tasks = TaskSet::uniform(4);
+  traced.costs.assign(4, 1.0);
+  traced.schedule = "demand";
+  traced.runtimeSchedule = true;
+  SimStage prePass = traced;
+  prePass.name = "cost pre-pass";
+  prePass.schedule = "balanced";
+  prePass.runtimeSchedule = false;
+  const Workload w = recordedWorkload({prePass, traced}, 2);
+  const Prediction recorded = predict(w, "", at(2));
+  CHECK(recorded.record.stages[0].schedule == "balanced");
+  CHECK(recorded.record.stages[1].schedule == "demand");
+  CHECK(recorded.stages[1].note == "under the run's schedule");
+  const Prediction spiral = predict(w, "spiral", at(2));
+  CHECK(spiral.record.stages[0].schedule == "balanced");
+  CHECK(spiral.record.stages[1].schedule == "spiral");
+  CHECK(spiral.stages[1].note == "under --schedule spiral (recorded: demand)");
+  CHECK(spiral.record.schedule == "spiral");
+  // A cost table has no recorded schedule: one must be named.
+  Workload table = w;
+  table.stages[1].schedule.clear();
+  CHECK_THROWS_AS(predict(table, "", at(2)), pr::InputError);
+}
+
+TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split evenly at another") {
+  SimStage s;
+  s.handlers = {{3.0, 6, 4, 400}, {1.0, 2, 0, 0}};
+  s.schedule = "demand";
+  const StageReplay same = planReplay(s, 2, 2, "");
+  CHECK(same.handlers[0].seconds == 3.0);
+  CHECK(same.handlers[1].handled == 2);
+  const StageReplay four = planReplay(s, 2, 4, "");
+  REQUIRE(four.handlers.size() == 4);
+  for (const HandlerLoad& h : four.handlers) {
+    CHECK(h.seconds == doctest::Approx(1.0));
+    CHECK(h.handled == 2);
+    CHECK(h.messagesSent == 1);
+    CHECK(h.bytesSent == 100);
+  }
+  CHECK(planReplay(SimStage{}, 2, 3, "demand").handlers.size() == 3);  // none recorded: zero on every PE
+}
+
+TEST_CASE("StageReplay: on one PE no data message is charged; the work stays") {
+  SimStage s;
+  s.name = "trace";
+  s.tasks = TaskSet::uniform(2);
+  s.costs = {1.0, 1.0};
+  s.messages = {2, 0};
+  s.bytes = {800, 0};
+  s.schedule = "demand";
+  s.handlers = {{0.5, 3, 4, 400}, {0.5, 3, 0, 0}};
+  const StageReplay one = planReplay(s, 2, 1, "");
+  CHECK(one.stage.messages == std::vector<std::uint32_t>{0, 0});
+  CHECK(one.stage.bytes == std::vector<std::uint64_t>{0, 0});
+  REQUIRE(one.handlers.size() == 1);
+  CHECK(one.handlers[0].seconds == doctest::Approx(1.0));
+  CHECK(one.handlers[0].messagesSent == 0);
+  CHECK(one.note.find("its 6 data messages are to itself on one PE, not charged") != std::string::npos);
+  SimOptions options = at(1);
+  options.network = NetworkModel{"t", 1.0, 0.0, ""};  // 1 s per message: any charged message shows
+  const RunRecord r = simulate(recordedWorkload({s}, 2), "", options);
+  CHECK(r.stages[0].pes[0].messagesSent == 0);
+  CHECK(r.wallSeconds == doctest::Approx(2 * 2.0 + 3.0));  // 2 tasks, each a request and a packet of 1 s; 3 s of work
+  CHECK(planReplay(s, 2, 3, "").stage.messages == std::vector<std::uint32_t>{2, 0});  // kept at P > 1
+}
