@@ -1,19 +1,21 @@
 // Data management for partitioned data (seed chapter 4): every data item (voxel contents,
 // object set, photon-map block) has an owner PE; a PE that needs a remote item gets it through
 // its DataManager, which keeps a per-PE cache of remote items (LRU, fixed capacity), counts
-// hits and misses, fetches items known in advance (prefetch), and counts every fetch as a
-// request message to the owner and a reply message from it, in the running stage.
+// hits and misses, fetches items known in advance (prefetch); every fetch is a request message
+// to the owner and a reply message from it, both through Channels, served by the owner's PE.
 #pragma once
 
-#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <list>
+#include <string>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
+#include "common/parallel/await_reply.h"
+#include "common/parallel/channel.h"
 #include "common/parallel/pe.h"
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
@@ -92,30 +94,44 @@ class DataCache {
   std::unordered_map<ItemId, typename std::list<std::pair<ItemId, T>>::iterator> index_;
 };
 
+// Items of a partition move only as messages: a PE that misses sends a request ("<name>
+// requests", kind requests) to the item's owner, whose PE serves it in a message handler from
+// its own partition and sends the item back ("<name> items", kind data). The requesting PE
+// waits inside its task for the reply (booked as message waiting, not busy) and serves the
+// requests sent to it meanwhile, so PEs fetching from each other always make progress. An
+// owner busy in a long task answers at its next task boundary, as a single-threaded PE of a
+// distributed-memory machine would.
 template <class T>
 class DataManager {
  public:
-  // Reads item from its owner's partition: the copy is the transfer. Called on the requesting
-  // PE's thread; the owner's partition must be read-only during the stage.
-  using Loader = std::function<T(int owner, ItemId item)>;
+  // Reads item from the owner's own partition, on the owner's PE (inside its request handler,
+  // or for an item of the requester's own partition, on the requester).
+  using Loader = std::function<T(Pe& owner, ItemId item)>;
   using ByteSize = std::function<std::size_t(const T&)>;
 
-  DataManager(int pes, OwnerMap owners, std::size_t cacheCapacity, Loader load, ByteSize bytes = {})
-      : owners_(std::move(owners)), load_(std::move(load)), bytes_(std::move(bytes)) {
-    for (int p = 0; p < pes; ++p) caches_.emplace_back(cacheCapacity);
-    local_.resize(pes);
-    hits_.assign(pes, 0);
-    misses_.assign(pes, 0);
+  // Created between stages, like any Channel.
+  DataManager(Runtime& runtime, const std::string& name, OwnerMap owners, std::size_t cacheCapacity, Loader load,
+              ByteSize bytes = {})
+      : owners_(std::move(owners)),
+        load_(std::move(load)),
+        bytes_(std::move(bytes)),
+        items_(runtime, name + " items", MessageKind::Data),
+        requests_(runtime, name + " requests", MessageKind::Requests,
+                  [this](Pe& owner, Request&& r) { serve(owner, r); }) {
+    for (int p = 0; p < runtime.pes(); ++p) caches_.emplace_back(cacheCapacity);
+    local_.resize(static_cast<std::size_t>(runtime.pes()));
+    hits_.assign(static_cast<std::size_t>(runtime.pes()), 0);
+    misses_.assign(static_cast<std::size_t>(runtime.pes()), 0);
   }
 
   int owner(ItemId item) const { return owners_.owner(item); }
 
-  // On PE pe inside a task or handler: the item, from pe's own partition, its cache (a hit) or
-  // its owner (a miss: one request and one reply message). The reference stays valid until pe's
-  // next acquire or prefetch. Items of pe's own partition are neither hits nor misses.
+  // On PE pe inside a task: the item, from pe's own partition, its cache (a hit) or its owner
+  // (a miss: one request and one reply message). The reference stays valid until pe's next
+  // acquire or prefetch. Items of pe's own partition are neither hits nor misses.
   const T& acquire(Pe& pe, ItemId item) {
     const int owner = owners_.owner(item);
-    if (owner == pe.id()) return local_[pe.id()] = load_(owner, item);
+    if (owner == pe.id()) return local_[pe.id()] = load_(pe, item);
     DataCache<T>& cache = caches_[pe.id()];
     if (const T* cached = cache.find(item)) {
       ++hits_[pe.id()];
@@ -124,17 +140,28 @@ class DataManager {
     }
     ++misses_[pe.id()];
     pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
-    return fetch(pe, owner, item);
+    requests_.send(pe, owner, Request{item, pe.id()}, kItemRequestBytes);
+    Reply reply = awaitReply(pe);
+    PR_CHECK(reply.item == item, "DataManager: a reply for another item");
+    if (cache.capacity() == 0) return local_[pe.id()] = std::move(reply.value);
+    return cache.insert(item, std::move(reply.value));
   }
 
-  // Fetches items known in advance (a data-driven portion, a preferred-bias region) into pe's
-  // cache, so that later acquires hit. Counted as prefetches and messages, not as misses.
+  // On PE pe inside a task: fetches items known in advance (a data-driven portion, a
+  // preferred-bias region) into pe's cache, all requests first, so that later acquires hit.
+  // Counted as prefetches and messages, not as misses.
   void prefetch(Pe& pe, const std::vector<ItemId>& items) {
+    std::size_t asked = 0;
     for (ItemId item : items) {
       const int owner = owners_.owner(item);
       if (owner == pe.id() || caches_[pe.id()].contains(item)) continue;
       pe.counters().prefetches.fetch_add(1, std::memory_order_relaxed);
-      fetch(pe, owner, item);
+      requests_.send(pe, owner, Request{item, pe.id()}, kItemRequestBytes);
+      ++asked;
+    }
+    for (; asked > 0; --asked) {
+      Reply reply = awaitReply(pe);
+      if (caches_[pe.id()].capacity() > 0) caches_[pe.id()].insert(reply.item, std::move(reply.value));
     }
   }
 
@@ -143,21 +170,29 @@ class DataManager {
   const DataCache<T>& cache(int pe) const { return caches_[pe]; }
 
  private:
-  const T& fetch(Pe& pe, int owner, ItemId item) {
-    T value = [&] {
-      const SendReceiveTimer timer(pe);
-      return load_(owner, item);
-    }();
-    const std::size_t bytes = bytes_ ? bytes_(value) : sizeof(T);
-    pe.runtime().countMessage(pe.id(), owner, kItemRequestBytes);
-    pe.runtime().countMessage(owner, pe.id(), bytes);
-    if (caches_[pe.id()].capacity() == 0) return local_[pe.id()] = std::move(value);
-    return caches_[pe.id()].insert(item, std::move(value));
+  struct Request {
+    ItemId item;
+    int requester;
+  };
+  struct Reply {
+    ItemId item = 0;
+    T value{};
+  };
+
+  // On the owner's PE, in the request handler: the item from its own partition, sent back.
+  void serve(Pe& owner, const Request& r) {
+    Reply reply{r.item, load_(owner, r.item)};
+    const std::size_t bytes = bytes_ ? bytes_(reply.value) : sizeof(T);
+    items_.send(owner, r.requester, std::move(reply), bytes);
   }
+
+  Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, requests_, "a data item"); }
 
   OwnerMap owners_;
   Loader load_;
   ByteSize bytes_;
+  Channel<Reply> items_;
+  Channel<Request> requests_;
   std::vector<DataCache<T>> caches_;  // one per PE, touched only by that PE
   std::vector<T> local_;
   std::vector<std::uint64_t> hits_, misses_;

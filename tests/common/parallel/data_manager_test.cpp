@@ -1,7 +1,9 @@
 // DataManager: owner lookup, per-PE LRU cache of remote items, exact hit/miss counts for a
-// known access sequence, prefetch, and the fetch traffic counted in the stage.
+// known access sequence, prefetch, and the fetch traffic: requests and replies through Channels,
+// each item served by its owner's PE.
 #include <doctest/doctest.h>
 
+#include <atomic>
 #include <string>
 
 #include "common/parallel/data_manager.h"
@@ -40,7 +42,7 @@ TEST_CASE("DataManager: hit and miss counts are exact for a known access sequenc
   std::vector<std::string> partition(10);
   for (int i = 0; i < 10; ++i) partition[i] = std::string(static_cast<std::size_t>(i + 1), 'x');
   DataManager<std::string> data(
-      2, OwnerMap::blocks(10, 2), 2, [&](int, ItemId item) { return partition[item]; },
+      rt, "strings", OwnerMap::blocks(10, 2), 2, [&](Pe&, ItemId item) { return partition[item]; },
       [](const std::string& s) { return s.size(); });
   std::string seen;
   rt.runStage("read", TaskSet::uniform(2), [&](Pe& pe, TaskId) {
@@ -64,4 +66,36 @@ TEST_CASE("DataManager: hit and miss counts are exact for a known access sequenc
   CHECK(pe1.messagesSent == 7);
   CHECK(pe1.bytesSent == 6u + 7 + 8 + 7 + 6 + 9 + 10);
   CHECK(pe0.bytesReceived == pe1.bytesSent);
+}
+
+TEST_CASE("DataManager: items are served by their owner's PE through counted channels, PEs fetching from each other") {
+  // 12 items cyclic over 3 PEs (item i on PE i mod 3). Every PE reads every item once: 8 remote
+  // reads each, all misses (cache of 16), so 8 requests of 16 bytes and 8 replies of 8 bytes
+  // (sizeof(long)) per PE, each reply sent by the owner's PE from inside its request handler.
+  Runtime rt(3, "balanced");
+  std::atomic<int> servedElsewhere{0};
+  DataManager<long> data(rt, "numbers", OwnerMap::cyclic(12, 3), 16, [&](Pe& owner, ItemId item) {
+    if (static_cast<int>(item % 3) != owner.id()) ++servedElsewhere;
+    return static_cast<long>(item * item);
+  });
+  std::vector<long> sums(3, 0);
+  rt.runOnEachPe("read", [&](Pe& pe) {
+    for (ItemId item = 0; item < 12; ++item) sums[static_cast<std::size_t>(pe.id())] += data.acquire(pe, item);
+  });
+  CHECK(servedElsewhere == 0);
+  for (long s : sums) CHECK(s == 506);  // sum of i^2 for i < 12
+  const StageRecord& stage = rt.record().stages[0];
+  for (int p = 0; p < 3; ++p) {
+    const PeStageRecord& r = stage.pes[static_cast<std::size_t>(p)];
+    CHECK(r.cacheMisses == 8u);
+    CHECK(r.cacheHits == 0u);
+    CHECK(r.messagesSent == 16u);  // its 8 requests and the 8 replies it served
+    CHECK(r.bytesSent == 8u * kItemRequestBytes + 8u * sizeof(long));
+    CHECK(r.messagesHandled >= 8u);
+  }
+  REQUIRE(stage.channels.size() == 2u);
+  for (const ChannelTraffic& c : stage.channels) {
+    CHECK(c.messages == 24u);
+    CHECK(c.kind == (c.name == "numbers requests" ? "requests" : "data"));
+  }
 }
