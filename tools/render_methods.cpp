@@ -2,6 +2,7 @@
 // of the raytrace partition registry, so a new partition appears here with its registry line.
 #include "tools/render_methods.h"
 
+#include "common/parallel/metrics.h"
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
@@ -27,11 +28,19 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   rt::TraceResult result = rt::renderRays(job, name, r.runtime);
   RenderOutcome out;
   out.image = std::move(result.image);
-  out.rays = result.rays.total();
+  // The ray figures as the run record holds them (Rays/ counters, summed over PEs).
+  const par::RunSummary summary = par::summarize(r.runtime.record());
+  auto total = [&](const char* name) {
+    for (const par::CounterSummary& c : summary.counters)
+      if (c.name == name) return uint64_t(c.total);
+    return uint64_t{0};
+  };
+  const uint64_t camera = total("Rays/camera"), continuation = total("Rays/continuation"), shadow = total("Rays/shadow");
+  out.rays = camera + continuation + shadow;
   out.details = "integrator " + r.settings.ray.integrator + ", spp " + std::to_string(options.integrator.spp) +
                 ", max depth " + std::to_string(options.integrator.maxDepth) + "; rays: camera " +
-                std::to_string(result.rays.cameraRays) + ", continuation " + std::to_string(result.rays.continuationRays) +
-                ", shadow " + std::to_string(result.rays.shadowRays) + "; tasks " + std::to_string(result.tasks);
+                std::to_string(camera) + ", continuation " + std::to_string(continuation) + ", shadow " +
+                std::to_string(shadow) + "; tasks " + std::to_string(result.tasks);
   return out;
 }
 

@@ -59,7 +59,7 @@ class ImageSpacePartition final : public Partition {
     // Each tile is rendered into its own film and sent, finished, to the assembler.
     Film film(job.width, job.height, integrator.options().spp);
     FilmAssembly assembly(rt, film);
-    TraceCounters counters;
+    PerPeTraceStats counters(rt.pes());
     std::atomic<int64_t> done{0};
     const int64_t total = int64_t(tiles.size());
     rt.runStage("trace", set, [&](par::Pe& pe, par::TaskId id) {
@@ -70,11 +70,11 @@ class ImageSpacePartition final : public Partition {
       integrator.cameraRays(rect, queue);
       integrator.traceToCompletion(bvh, queue, tile, stats);
       assembly.deliver(pe, tile, rect, false);
-      counters.add(stats);
+      counters.of(pe.id()) += stats;
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job.options.progress) job.options.progress(n, total);
     });
-    return TraceResult{film.toImage(), counters.stats(), tiles.size()};
+    return TraceResult{film.toImage(), recordRayCounters(rt, counters.values()), tiles.size()};
   }
 
  private:

@@ -99,15 +99,17 @@ class ObjectFrame {
       figures.triangles.push_back(n);
       figures.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
     }
+    std::vector<TraceStats> raysTraced;
     for (int p = 0; p < pes; ++p) {
       const PeState& st = state_[size_t(p)];
       PR_CHECK(st.live == 0, "object partitioning: a ray still waits for hit replies after the stage");
-      result.rays += st.stats;
+      raysTraced.push_back(st.stats);
       figures.rayMessages += st.queriesSent;
       figures.hitMessages += st.repliesSent;
       rt_.addCounter("Partition/ray_queries_sent", p, double(st.queriesSent));
       rt_.addCounter("Partition/hit_replies_sent", p, double(st.repliesSent));
     }
+    result.rays = recordRayCounters(rt_, raysTraced);
     recordPartitionFigures(figures, rt_);
     return result;
   }

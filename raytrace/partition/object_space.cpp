@@ -92,12 +92,14 @@ class ObjectSpaceFrame {
       figures.geometryBytes[owners_[v]] += bvhs_[v].stats().memoryBytes + split_.triangles(v).size() * kTriangleVertexBytes;
       figures.triangles[owners_[v]] += split_.triangles(v).size();
     }
+    std::vector<TraceStats> raysTraced;
     for (int p = 0; p < pes; ++p) {
       const PeState& st = state_[size_t(p)];
-      result.rays += st.stats;
+      raysTraced.push_back(st.stats);
       figures.rayMessages += st.raysSent;
       rt_.addCounter("Partition/ray_messages_sent", p, double(st.raysSent));
     }
+    result.rays = recordRayCounters(rt_, raysTraced);
     recordPartitionFigures(figures, rt_);
     return result;
   }

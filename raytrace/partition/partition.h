@@ -39,20 +39,33 @@ struct TraceOptions {
   std::function<void(int64_t, int64_t)> progress;
 };
 
-// Per-PE counters merged after the run (atomics: a PE adds its task's counts once per task).
-struct TraceCounters {
-  std::atomic<uint64_t> cameraRays{0}, continuationRays{0}, shadowRays{0};
-  void add(const TraceStats& s) {
-    cameraRays.fetch_add(s.cameraRays, std::memory_order_relaxed);
-    continuationRays.fetch_add(s.continuationRays, std::memory_order_relaxed);
-    shadowRays.fetch_add(s.shadowRays, std::memory_order_relaxed);
+// The rays each PE traced, by kind, put in the run record as the per-PE counters Rays/camera,
+// Rays/continuation and Rays/shadow (the only way the figures leave a tracer, STYLE.md
+// section 4); returns their sum over PEs for TraceResult::rays. On the controlling thread,
+// after the tracer's last stage.
+TraceStats recordRayCounters(par::Runtime& rt, const std::vector<TraceStats>& perPe);
+
+// Per-PE ray counts written during a stage, each PE its own (padded against false sharing).
+class PerPeTraceStats {
+ public:
+  explicit PerPeTraceStats(int pes) : stats_(size_t(pes)) {}
+  TraceStats& of(int pe) { return stats_[size_t(pe)].stats; }
+  std::vector<TraceStats> values() const {
+    std::vector<TraceStats> out;
+    for (const Padded& p : stats_) out.push_back(p.stats);
+    return out;
   }
-  TraceStats stats() const { return {cameraRays.load(), continuationRays.load(), shadowRays.load()}; }
+
+ private:
+  struct alignas(64) Padded {
+    TraceStats stats;
+  };
+  std::vector<Padded> stats_;
 };
 
 struct TraceResult {
   image::Image image;
-  TraceStats rays;
+  TraceStats rays;  // the sum of the run record's Rays/ counters this render added
   size_t tasks = 0;  // tasks of the trace stage
 };
 

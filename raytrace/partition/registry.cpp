@@ -23,6 +23,17 @@ bool isPartition(std::string_view name) { return partitions().contains(name); }
 
 std::unique_ptr<Partition> makePartition(std::string_view name) { return partitions().find(name).make(); }
 
+TraceStats recordRayCounters(par::Runtime& rt, const std::vector<TraceStats>& perPe) {
+  TraceStats sum;
+  for (size_t p = 0; p < perPe.size(); ++p) {
+    rt.addCounter("Rays/camera", int(p), double(perPe[p].cameraRays));
+    rt.addCounter("Rays/continuation", int(p), double(perPe[p].continuationRays));
+    rt.addCounter("Rays/shadow", int(p), double(perPe[p].shadowRays));
+    sum += perPe[p];
+  }
+  return sum;
+}
+
 TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt) {
   auto range = [](const char* what, long value, long lo, long hi) {
     if (value < lo || value > hi)

@@ -27,15 +27,19 @@ class SequentialPartition final : public Partition {
   std::string_view name() const override { return "sequential"; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
+    // The BVH build is a stage of its own, timed like every tracer's build (Ts includes it).
     std::unique_ptr<Bvh> built;
-    if (!job.options.worldBvh) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+    if (!job.options.worldBvh)
+      rt.runStage("build", par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
+        built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+      });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
     Film film(job.width, job.height, integrator.options().spp);
-    TraceCounters counters;
-    rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
-      TraceStats stats;
+    PerPeTraceStats counters(rt.pes());
+    rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {
+      TraceStats& stats = counters.of(pe.id());
       std::vector<RayMessage> queue;
       // Row by row keeps the queue at one row of camera rays plus one path's messages; the
       // single task reports its progress in rows.
@@ -44,9 +48,8 @@ class SequentialPartition final : public Partition {
         integrator.traceToCompletion(bvh, queue, film, stats);
         if (job.options.progress) job.options.progress(y + 1, job.height);
       }
-      counters.add(stats);
     });
-    return TraceResult{film.toImage(), counters.stats(), 1};
+    return TraceResult{film.toImage(), recordRayCounters(rt, counters.values()), 1};
   }
 };
 
