@@ -115,6 +115,18 @@ void run(RenderArgs& a) {
   std::printf(", load imbalance %.3f, efficiency %.3f, messages %llu (%llu bytes), broadcast %.0f bytes per PE\n",
               summary.total.imbalance, summary.total.efficiency, (unsigned long long)summary.total.messages,
               (unsigned long long)summary.total.bytes, summary.total.figure("broadcastBytesReceived").mean);
+  if (!summary.total.byKind.empty()) {
+    std::printf("traffic by kind:");
+    const char* separator = " ";
+    for (const par::KindTraffic& k : summary.total.byKind) {
+      std::printf("%s%s %llu (%llu bytes)", separator, k.kind.c_str(), (unsigned long long)k.messages,
+                  (unsigned long long)k.bytes);
+      separator = ", ";
+    }
+    if (summary.total.computeToComm >= 0.0)
+      std::printf("; computation/communication %.1f", summary.total.computeToComm);
+    std::printf("\n");
+  }
 }
 
 }  // namespace
