@@ -48,6 +48,7 @@ class ObjectFrame {
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
+        views_(job, rt.pes()),
         state_(rt.pes()) {}
 
   TraceResult run(PartitionFigures& figures) {
@@ -56,6 +57,7 @@ class ObjectFrame {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
         bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);
+      views_.build(p, assignment_.triangles(p), integrator_->context().lights());
     });
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -183,7 +185,7 @@ class ObjectFrame {
       r.found = bvh.occluded(ray);
     } else if (bvh.intersect(ray, r.hit)) {
       r.found = true;
-      r.si = makeInteraction(job_.scene, ray, r.hit);
+      r.si = makeInteraction(views_.of(pe), ray, r.hit);
     }
     return r;
   }
@@ -229,6 +231,7 @@ class ObjectFrame {
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
+  SceneViews views_;
   std::vector<PeState> state_;
   par::Channel<RayQuery>* queries_ = nullptr;
   par::Channel<HitReply>* hits_ = nullptr;

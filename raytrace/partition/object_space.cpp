@@ -45,15 +45,20 @@ class ObjectSpaceFrame {
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(split_.voxels()),
+        views_(job, rt.pes()),
         state_(rt.pes()) {}
 
   TraceResult run(PartitionFigures& figures) {
     const int pes = rt_.pes();
     // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
     rt_.runOnEachPe("build", [&](par::Pe& pe) {
+      std::vector<uint32_t> held;
       for (int v = 0; v < split_.voxels(); ++v)
-        if (owners_[v] == pe.id() && !split_.triangles(v).empty())
+        if (owners_[v] == pe.id() && !split_.triangles(v).empty()) {
           bvhs_[v] = Bvh(job_.scene.positions, job_.scene.triangles, split_.triangles(v), job_.options.bvh);
+          held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
+        }
+      views_.build(pe.id(), held, integrator_->context().lights());
     });
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -154,7 +159,7 @@ class ObjectSpaceFrame {
       clipped.tMax = std::min(m.ray.tMax, st.spans[k].tExit);
       Hit hit;
       if (!bvh.intersect(clipped, hit)) continue;
-      integrator_->shade(makeInteraction(job_.scene, m.ray, hit), m, emit);
+      integrator_->shade(makeInteraction(views_.of(pe.id()), m.ray, hit), m, emit);
       for (const RayMessage& r : st.spawned) {
         ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
         st.work.push_back(TravellingRay{r, 0});
@@ -172,6 +177,7 @@ class ObjectSpaceFrame {
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
+  SceneViews views_;
   std::vector<PeState> state_;
   par::Channel<TravellingRay>* rays_ = nullptr;
 };
