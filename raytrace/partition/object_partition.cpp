@@ -51,7 +51,7 @@ class ObjectFrame {
         views_(job, rt.pes()),
         state_(rt.pes()) {}
 
-  TraceResult run(PartitionFigures& figures) {
+  TraceResult run() {
     const int pes = rt_.pes();
     rt_.runOnEachPe("build", [&](par::Pe& pe) {
       const int p = pe.id();
@@ -94,25 +94,23 @@ class ObjectFrame {
     }
 
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
-    figures = PartitionFigures{};
-    figures.partitions = int(assignment_.pieces().size());
+    PartitionHoldings held;
     for (int p = 0; p < pes; ++p) {
       const uint64_t n = assignment_.triangles(p).size();
-      figures.triangles.push_back(n);
-      figures.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
+      held.triangles.push_back(n);
+      held.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
+      held.partitionsOwned.push_back(assignment_.piecesOf(p).size());
     }
     std::vector<TraceStats> raysTraced;
     for (int p = 0; p < pes; ++p) {
       const PeState& st = state_[size_t(p)];
       PR_CHECK(st.live == 0, "object partitioning: a ray still waits for hit replies after the stage");
       raysTraced.push_back(st.stats);
-      figures.rayMessages += st.queriesSent;
-      figures.hitMessages += st.repliesSent;
       rt_.addCounter("Partition/ray_queries_sent", p, double(st.queriesSent));
       rt_.addCounter("Partition/hit_replies_sent", p, double(st.repliesSent));
     }
     result.rays = recordRayCounters(rt_, raysTraced);
-    recordPartitionFigures(figures, rt_);
+    recordPartitionHoldings(held, rt_);
     return result;
   }
 
@@ -241,7 +239,7 @@ class ObjectFrame {
 
 TraceResult ObjectPartition::render(const TraceJob& job, par::Runtime& rt) {
   ObjectFrame frame(job, rt, maxPieceTriangles_);
-  return frame.run(figures_);
+  return frame.run();
 }
 
 std::unique_ptr<Partition> makeObjectPartition() { return std::make_unique<ObjectPartition>(); }

@@ -21,12 +21,9 @@ class ObjectPartition final : public Partition {
   explicit ObjectPartition(uint32_t maxPieceTriangles = 0) : maxPieceTriangles_(maxPieceTriangles) {}
   std::string_view name() const override { return "object"; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
-  // Figures of the last render.
-  const PartitionFigures& figures() const { return figures_; }
 
  private:
   uint32_t maxPieceTriangles_;
-  PartitionFigures figures_;
 };
 
 }  // namespace pr::rt

@@ -48,7 +48,7 @@ class ObjectSpaceFrame {
         views_(job, rt.pes()),
         state_(rt.pes()) {}
 
-  TraceResult run(PartitionFigures& figures) {
+  TraceResult run() {
     const int pes = rt_.pes();
     // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
     rt_.runOnEachPe("build", [&](par::Pe& pe) {
@@ -89,23 +89,21 @@ class ObjectSpaceFrame {
     }
 
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
-    figures = PartitionFigures{};
-    figures.partitions = split_.voxels();
-    figures.geometryBytes.assign(pes, 0);
-    figures.triangles.assign(pes, 0);
+    PartitionHoldings held{std::vector<uint64_t>(size_t(pes), 0), std::vector<uint64_t>(size_t(pes), 0),
+                           std::vector<uint64_t>(size_t(pes), 0)};
     for (int v = 0; v < split_.voxels(); ++v) {
-      figures.geometryBytes[owners_[v]] += bvhs_[v].stats().memoryBytes + split_.triangles(v).size() * kTriangleVertexBytes;
-      figures.triangles[owners_[v]] += split_.triangles(v).size();
+      held.geometryBytes[owners_[v]] += bvhs_[v].stats().memoryBytes + split_.triangles(v).size() * kTriangleVertexBytes;
+      held.triangles[owners_[v]] += split_.triangles(v).size();
+      held.partitionsOwned[owners_[v]] += 1;
     }
     std::vector<TraceStats> raysTraced;
     for (int p = 0; p < pes; ++p) {
       const PeState& st = state_[size_t(p)];
       raysTraced.push_back(st.stats);
-      figures.rayMessages += st.raysSent;
       rt_.addCounter("Partition/ray_messages_sent", p, double(st.raysSent));
     }
     result.rays = recordRayCounters(rt_, raysTraced);
-    recordPartitionFigures(figures, rt_);
+    recordPartitionHoldings(held, rt_);
     return result;
   }
 
@@ -192,7 +190,7 @@ ObjectSpacePartition::ObjectSpacePartition(int voxelsPerPe) : voxelsPerPe_(voxel
 
 TraceResult ObjectSpacePartition::render(const TraceJob& job, par::Runtime& rt) {
   ObjectSpaceFrame frame(job, rt, voxelsPerPe_);
-  return frame.run(figures_);
+  return frame.run();
 }
 
 std::unique_ptr<Partition> makeObjectSpacePartition() { return std::make_unique<ObjectSpacePartition>(); }

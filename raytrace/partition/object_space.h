@@ -19,12 +19,9 @@ class ObjectSpacePartition final : public Partition {
   explicit ObjectSpacePartition(int voxelsPerPe = 1);
   std::string_view name() const override { return "object-space"; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
-  // Figures of the last render.
-  const PartitionFigures& figures() const { return figures_; }
 
  private:
   int voxelsPerPe_;
-  PartitionFigures figures_;
 };
 
 }  // namespace pr::rt

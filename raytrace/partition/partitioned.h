@@ -22,22 +22,21 @@
 
 namespace pr::rt {
 
-// Per-PE figures of one render. Message counts are algorithm counters kept next to each send
-// (STYLE.md §4), split by kind; their sum equals the run record's count of the trace stage.
-struct PartitionFigures {
-  std::vector<uint64_t> geometryBytes;   // per PE: its BVHs plus its triangles' vertex data
-  std::vector<uint64_t> triangles;       // per PE: triangles held (straddlers counted per holder)
-  uint64_t rayMessages = 0;              // rays (object-space) or ray queries (object) between PEs
-  uint64_t hitMessages = 0;              // hit records sent back (object partitioning)
-  int partitions = 0;                    // voxels or object pieces
+// What a partitioned tracer holds on each PE, gathered after its build, for the run record.
+struct PartitionHoldings {
+  std::vector<uint64_t> geometryBytes;    // per PE: its BVHs plus its triangles' vertex data
+  std::vector<uint64_t> triangles;        // per PE: triangles held (straddlers counted per holder)
+  std::vector<uint64_t> partitionsOwned;  // per PE: voxels or object pieces
 };
 
-// Puts the per-PE figures in the run record as named counters, beside the runtime's own
-// measurements, so `render` summaries and --metrics JSON report them.
-inline void recordPartitionFigures(const PartitionFigures& figures, par::Runtime& rt) {
+// Puts the holdings in the run record as the per-PE counters Partition/geometry_bytes,
+// Partition/triangles_held and Partition/partitions_owned: the only way these figures leave
+// the tracer (STYLE.md section 4); render summaries, --metrics JSON and tests read the record.
+inline void recordPartitionHoldings(const PartitionHoldings& h, par::Runtime& rt) {
   for (int p = 0; p < rt.pes(); ++p) {
-    rt.addCounter("Partition/geometry_bytes", p, double(figures.geometryBytes[size_t(p)]));
-    rt.addCounter("Partition/triangles_held", p, double(figures.triangles[size_t(p)]));
+    rt.addCounter("Partition/geometry_bytes", p, double(h.geometryBytes[size_t(p)]));
+    rt.addCounter("Partition/triangles_held", p, double(h.triangles[size_t(p)]));
+    rt.addCounter("Partition/partitions_owned", p, double(h.partitionsOwned[size_t(p)]));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <doctest/doctest.h>
 
@@ -20,11 +21,42 @@
 
 namespace pr::test {
 
+// The partitioned tracer's figures as its run record holds them (Partition/ counters).
+struct PartitionFigures {
+  std::vector<uint64_t> geometryBytes;  // per PE
+  std::vector<uint64_t> triangles;      // per PE: triangles held
+  uint64_t rayMessages = 0;             // rays (object-space) or ray queries (object) between PEs
+  uint64_t hitMessages = 0;             // hit records sent back (object partitioning)
+  int partitions = 0;                   // voxels or object pieces, over all PEs
+};
+
+inline PartitionFigures figuresFromRecord(const par::RunRecord& record) {
+  PartitionFigures f;
+  auto perPe = [&](const char* name) {
+    std::vector<uint64_t> values;
+    for (const par::CounterRecord& c : record.counters)
+      if (c.name == name)
+        for (double v : c.perPe) values.push_back(uint64_t(v));
+    return values;
+  };
+  auto total = [&](const char* name) {
+    uint64_t sum = 0;
+    for (uint64_t v : perPe(name)) sum += v;
+    return sum;
+  };
+  f.geometryBytes = perPe("Partition/geometry_bytes");
+  f.triangles = perPe("Partition/triangles_held");
+  f.rayMessages = total("Partition/ray_messages_sent") + total("Partition/ray_queries_sent");
+  f.hitMessages = total("Partition/hit_replies_sent");
+  f.partitions = int(total("Partition/partitions_owned"));
+  return f;
+}
+
 struct PartitionedRun {
   image::Image image;
   rt::TraceResult result;
   par::RunRecord record;
-  rt::PartitionFigures figures;
+  PartitionFigures figures;
 };
 
 inline rt::TraceOptions partitionedOptions(rt::IntegratorKind kind, int spp, int maxDepth = 5) {
@@ -46,7 +78,7 @@ PartitionedRun renderPartitioned(P& partition, const scene::Scene& s, const scen
   run.result = partition.render(rt::TraceJob{s, cam, w, h, opt}, runtime);
   run.image = run.result.image;
   run.record = runtime.record();
-  run.figures = partition.figures();
+  run.figures = figuresFromRecord(run.record);
   return run;
 }
 
