@@ -2,6 +2,7 @@
 // handler work the simulator runs at P'. Pure functions of the recorded stage and P'.
 #include "common/parallel/stage_replay.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <numeric>
 #include <utility>
@@ -17,6 +18,7 @@ std::string_view replayRuleName(ReplayRule rule) {
     case ReplayRule::AsRecorded: return "as recorded";
     case ReplayRule::EachPe: return "each PE";
     case ReplayRule::RoundRobin: return "round-robin";
+    case ReplayRule::SingleOwner: return "single owner";
     case ReplayRule::OnePe: return "one PE";
     case ReplayRule::Excluded: return "excluded";
   }
@@ -132,6 +134,11 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
     r.note = std::to_string(n) + " tasks re-dealt round-robin over " + std::to_string(pes) +
              " owners (assumes the regions do not depend on P" +
              (recordedPes == 1 ? "; a P = 1 record cannot tell round-robin from another split)" : ")");
+    return r;
+  }
+  if (n > 0 && owners[0] < pes && std::all_of(owners.begin(), owners.end(), [&](int o) { return o == owners[0]; })) {
+    r.rule = ReplayRule::SingleOwner;
+    r.note = "every task on PE " + std::to_string(owners[0]) + " at any P (work done once, by one PE)";
     return r;
   }
   if (pes == 1) {

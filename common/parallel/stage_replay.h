@@ -12,6 +12,8 @@
 //                 buffer on every PE) and for rounds whose count depends on P (binary swap).
 //   round-robin   owners[t] = t mod P with more tasks than PEs (screen regions dealt out):
 //                 re-dealt t mod P'. Assumes the set of regions does not depend on P.
+//   single owner  every task on one PE q < P' (work done once by a designated PE, e.g. the
+//                 world BVH built on the assembler's PE): kept on q at any P'.
 //   one PE        P' = 1: every task on the one PE (a single owner holds all the data).
 //   excluded      any other owner list follows a data distribution the record does not
 //                 describe (e.g. voxels assigned by cost): no prediction at P' for that stage.
@@ -37,8 +39,8 @@
 
 namespace pr::par {
 
-enum class ReplayRule { Scheduled, AsRecorded, EachPe, RoundRobin, OnePe, Excluded };
-// "scheduled", "as recorded", "each PE", "round-robin", "one PE", "excluded".
+enum class ReplayRule { Scheduled, AsRecorded, EachPe, RoundRobin, SingleOwner, OnePe, Excluded };
+// "scheduled", "as recorded", "each PE", "round-robin", "single owner", "one PE", "excluded".
 std::string_view replayRuleName(ReplayRule rule);
 
 struct StageReplay {

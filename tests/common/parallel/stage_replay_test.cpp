@@ -73,6 +73,19 @@ TEST_CASE("StageReplay: regions pinned round-robin are re-dealt round-robin") {
   CHECK(p.record.stages[0].pes[0].busySeconds == doctest::Approx(5.0));
 }
 
+TEST_CASE("StageReplay: work pinned to one PE stays on that PE at any P") {
+  // The world BVH built on the assembler (PE 0): 3 s on PE 0 at P = 2, and at P = 1 and 8.
+  const Workload w = recordedWorkload({pinnedStage("build", {3.0}, {0})}, 2);
+  for (int pes : {1, 2, 8}) {
+    CAPTURE(pes);
+    const Prediction p = predict(w, "", at(pes));
+    CHECK_FALSE(p.stages[0].excluded);
+    CHECK(p.record.wallSeconds == doctest::Approx(3.0));
+    CHECK(p.record.stages[0].pes[0].busySeconds == doctest::Approx(3.0));
+  }
+  CHECK(predict(w, "", at(8)).stages[0].rule == "single owner");
+}
+
 TEST_CASE("StageReplay: owners of an undescribed distribution are excluded, with the reason") {
   // Voxels assigned by cost: task 0 on PE 1, tasks 1 and 2 on PE 0. Nothing in the record says
   // how the method would assign them at P = 4.
