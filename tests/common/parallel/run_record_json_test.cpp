@@ -46,6 +46,31 @@ TEST_CASE("RunRecord: JSON round trip keeps every measured field") {
   const auto j = nlohmann::json::parse(toJsonText(a));
   CHECK(j["summary"]["perPe"]["busySeconds"].contains("max"));
   CHECK(j["stages"][0]["summary"].contains("imbalance"));
+  CHECK(j["figureProvenance"]["busySeconds"] == "measured");
+  CHECK(j["figureProvenance"]["schedulingBytes"].get<std::string>().rfind("modelled", 0) == 0);
+  CHECK(j["summary"]["trafficByKind"]["data"]["messages"] == 6);
+}
+
+TEST_CASE("RunRecord: JSON round trip keeps the channels, owners and communication times") {
+  Runtime rt(2, "demand");
+  Channel<int> ch(rt, "pixels", MessageKind::Pixels);
+  rt.runPinned("pinned", TaskSet::uniform(3), {1, 0, 1}, [&](Pe& pe, TaskId) { ch.send(pe, 1 - pe.id(), 0, 100); });
+  const RunRecord a = rt.record();
+  const RunRecord b = runRecordFromJsonText(toJsonText(a), "test");
+  REQUIRE(b.stages.size() == 1);
+  CHECK(b.stages[0].schedule == kOwnerPinnedSchedule);
+  CHECK(b.stages[0].owners == std::vector<int>{1, 0, 1});
+  REQUIRE(b.stages[0].channels.size() == 1);
+  CHECK(b.stages[0].channels[0].name == "pixels");
+  CHECK(b.stages[0].channels[0].kind == "pixels");
+  CHECK(b.stages[0].channels[0].messages == 3);
+  CHECK(b.stages[0].channels[0].bytes == 300);
+  for (int p = 0; p < 2; ++p) {
+    CHECK(b.stages[0].pes[p].sendReceiveSeconds == a.stages[0].pes[p].sendReceiveSeconds);
+    CHECK(b.stages[0].pes[p].messageWaitSeconds == a.stages[0].pes[p].messageWaitSeconds);
+  }
+  CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"owners":[0,0]}],"timeline":[]})", "bad"),
+                  pr::InputError);
 }
 
 TEST_CASE("RunRecord: Chrome trace has one complete event per span, in microseconds") {
