@@ -26,7 +26,8 @@ void RegionBufferPool::give(RegionFramebuffer&& buffer) {
 }
 
 FrameAssembly::FrameAssembly(par::Runtime& runtime, RegionFramebuffer& frame, RegionBufferPool& pool)
-    : frame_(frame),
+    : runtime_(runtime),
+      frame_(frame),
       pool_(pool),
       regions_(runtime, "frame regions", par::MessageKind::Results,
                [this](par::Pe&, RegionFramebuffer&& region) { store(std::move(region)); }) {}
@@ -39,6 +40,16 @@ RegionFramebuffer& FrameAssembly::frame(const par::Pe& pe) {
 void FrameAssembly::store(RegionFramebuffer&& region) {
   copyInto(region, frame_);
   pool_.give(std::move(region));
+}
+
+void FrameAssembly::serve(par::Pe& pe) {
+  if (!assembles(pe)) return;
+  // As the runtime does between tasks (and TilePull inside one): a handled message is done;
+  // the task calling this is still outstanding, so this is never the stage's last unit.
+  while (regions_.handleOne(pe)) {
+    pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+    runtime_.outstanding().done();
+  }
 }
 
 void FrameAssembly::deliver(par::Pe& pe, RegionFramebuffer&& region) {

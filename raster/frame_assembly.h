@@ -65,9 +65,16 @@ class FrameAssembly {
   // full-screen buffer); nothing when that part is empty.
   void deliver(par::Pe& pe, const RegionFramebuffer& src, const Rect& within);
 
+  // On the assembler inside one of its tasks: stores the region messages that have arrived.
+  // The runtime hands messages to their handler between tasks only, so an assembler drawing
+  // all its regions in one task calls this between them; otherwise every other PE's regions
+  // would stay in flight (and their buffers out of the pool, out of cache) until it is done.
+  void serve(par::Pe& pe);
+
  private:
   void store(RegionFramebuffer&& region);
 
+  par::Runtime& runtime_;
   RegionFramebuffer& frame_;
   RegionBufferPool& pool_;
   par::Channel<RegionFramebuffer> regions_;

@@ -62,11 +62,12 @@ void RegionDrawer::drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<con
   RegionFramebuffer& image = frame.frame(pe);
   if (rect.area() > kScratchTilePixels) {
     drawRegion(ctx, tris, image.window(rect));
-    return;
+  } else {
+    scratch_.reshape(rect);
+    drawRegion(ctx, tris, scratch_.window());
+    copyInto(scratch_, image);
   }
-  scratch_.reshape(rect);
-  drawRegion(ctx, tris, scratch_.window());
-  copyInto(scratch_, image);
+  frame.serve(pe);  // the regions other PEs finished meanwhile
 }
 
 }  // namespace pr::raster
