@@ -3,6 +3,7 @@
 #include "tools/render_methods.h"
 
 #include "common/parallel/run_record.h"
+#include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
@@ -84,6 +85,16 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
     out.details += "; compositor " + o.compositor + (o.sparse ? " (sparse)" : " (full frame)") + ", pixels sent " +
                    count("Sort/pixels_sent") + " in " + count("Sort/composite_messages") + " messages (" +
                    count("Sort/composite_bytes") + " bytes)";
+  // Image assembly: the finished regions sent to the assembler PE (channels of kind results).
+  uint64_t resultMessages = 0, resultBytes = 0;
+  for (const par::StageRecord& stage : record.stages)
+    for (const par::ChannelTraffic& c : stage.channels)
+      if (c.kind == par::toString(par::MessageKind::Results)) {
+        resultMessages += c.messages;
+        resultBytes += c.bytes;
+      }
+  out.details += "; regions to the assembler " + std::to_string(resultMessages) + " messages (" +
+                 std::to_string(resultBytes) + " bytes)";
   return out;
 }
 

@@ -144,6 +144,13 @@ TEST_CASE("SortCounters: render --metrics writes the Sort/ counters the details 
     CHECK(total(*c) == std::stod(printed[i + 1].str()));  // both are totals over the 2 frames
   }
   CHECK(std::stod(printed[1].str()) > 0.0);
+  // The finished regions PE 1 sent to the assembler, as the record's results channels hold them.
+  std::smatch results;
+  REQUIRE(std::regex_search(r.output, results, std::regex(R"(regions to the assembler (\d+) messages \((\d+) bytes\))")));
+  const test::ChannelSum sent = test::channelTraffic(record, "results");
+  CHECK(sent.messages > 0u);
+  CHECK(std::stoull(results[1].str()) == sent.messages);
+  CHECK(std::stoull(results[2].str()) == sent.bytes);
 }
 
 }  // namespace
