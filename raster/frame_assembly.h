@@ -23,8 +23,9 @@ inline constexpr int kAssemblerPe = 0;
 
 // A region message on the wire: a header naming the rectangle (x0, y0, x1, y1 as four int32)
 // and, per pixel, what the frame holds: the depth key (8 bytes) and the linear colour (three
-// floats, 12 bytes), row-major over the rectangle. The triangle indices do not travel: they
-// mean something only in the buffer that rasterized the pixel.
+// floats, 12 bytes), row-major over the rectangle. The message is the drawn buffer itself
+// (moved, not copied); its triangle indices are not part of the message and not counted: the
+// assembler never reads them (they mean something only in the buffer that rasterized them).
 inline constexpr size_t kRegionHeaderBytes = 4 * sizeof(int32_t);
 inline constexpr size_t kRegionPixelBytes = sizeof(uint64_t) + sizeof(glm::vec3);
 inline size_t regionMessageBytes(const Rect& r) {

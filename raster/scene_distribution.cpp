@@ -54,7 +54,9 @@ void distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view 
     }
   });
   for (int p = 0; p < rt.pes(); ++p) {
-    shares.drain(p);  // each PE now holds its share (the ids it names)
+    // The message names the share's id range and is counted as the share's data, which the
+    // receiving PE reads from the scene arrays from now on (as sort-first's primitive messages).
+    shares.drain(p);
     const auto [first, end] = primitiveShare(total, p, rt.pes());
     rt.addCounter("Scene/geometry_bytes_held", p, double(uint64_t(end - first) * kPrimitiveBytes));
     rt.addCounter("Scene/primitives_held", p, double(end - first));
