@@ -2,8 +2,6 @@
 // of the raytrace partition registry, so a new partition appears here with its registry line.
 #include "tools/render_methods.h"
 
-#include "common/parallel/run_record.h"
-#include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
