@@ -1,7 +1,8 @@
 // RegionFramebuffer: colour, depth key (depth + primitive order) and triangle index for one
-// screen rectangle (a tile, a strip, or the whole screen). The frame is one of these; region
-// owners draw into their regions of it through PixelWindows; sort-last PEs hold a full-screen
-// one each and resolveInto() composites them; copyInto() stores a finished region in the frame.
+// screen rectangle (a tile, a strip, or the whole screen). The frame is one of these, written
+// by the assembler PE only (frame_assembly.h): it draws its own regions in place through
+// PixelWindows and copyInto() stores the finished regions other PEs send it; sort-last PEs hold
+// a full-screen one each and resolveInto() composites them.
 #pragma once
 
 #include <cstdint>
@@ -19,9 +20,9 @@ namespace pr::raster {
 inline constexpr uint32_t kNoTriangle = 0xffffffffu;
 
 // A rectangle of some framebuffer's pixels, addressed in that framebuffer's rows: what the
-// rasterize and shade stages draw into. A region owner draws straight into its own region of
-// the frame through a window on it (regions are disjoint, so no two PEs write one pixel); a
-// RegionFramebuffer is also a window on all of itself.
+// rasterize and shade stages draw into. The sequential pipeline and the assembler PE draw a
+// region straight into the frame through a window on it; any other PE draws into a buffer of
+// its own and sends it (frame_assembly.h). A RegionFramebuffer is also a window on all of itself.
 struct PixelWindow {
   Rect rect;
   size_t stride = 0;               // pixels per row of the arrays below

@@ -7,25 +7,24 @@
 namespace pr::raster {
 
 void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view, const SortOptions& options,
-                 par::Runtime& runtime, RegionFramebuffer& image, SortCounters* counters) {
+                 par::Runtime& runtime, RegionFramebuffer& image) {
   checkRasterLimits("scene " + scene.source.string(), scene.triangles.size());
   const Rect screen{0, 0, view.width, view.height};
   if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
-  const SortCounters c = sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
-  if (counters) *counters += c;
+  sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
 }
 
 RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,
-                              const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
+                              const SortOptions& options, par::Runtime& runtime) {
   RegionFramebuffer image;
-  renderFrame(sortPoint, scene, view, options, runtime, image, counters);
+  renderFrame(sortPoint, scene, view, options, runtime, image);
   return image;
 }
 
 RegionFramebuffer renderParallel(const scene::Scene& scene, const FrameView& view, std::string_view method,
-                                 const SortOptions& options, par::Runtime& runtime, SortCounters* counters) {
+                                 const SortOptions& options, par::Runtime& runtime) {
   std::unique_ptr<SortPoint> sortPoint = makeSortPoint(method);
-  return renderFrame(*sortPoint, scene, view, options, runtime, counters);
+  return renderFrame(*sortPoint, scene, view, options, runtime);
 }
 
 scene::Camera orbitCamera(const scene::Camera& camera, glm::vec3 centre, float angleRadians) {

@@ -44,8 +44,20 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   return out;
 }
 
+// The total over PEs of the named per-PE counter in the run record (0 when not recorded).
+uint64_t counterTotal(const par::RunRecord& record, std::string_view name) {
+  for (const par::CounterRecord& c : record.counters)
+    if (c.name == name) {
+      double sum = 0.0;
+      for (double v : c.perPe) sum += v;
+      return static_cast<uint64_t>(sum);
+    }
+  return 0;
+}
+
 // One sort point over --frames frames (the camera turned 2 pi i / N about the scene centre
-// with --orbit); the image is the last frame's; the sort point is kept between frames.
+// with --orbit); the image is the last frame's; the sort point is kept between frames. The
+// summary reads the sort point's counters from the run record by name (totals over frames).
 RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   const RasterOptions& o = r.settings.raster;
   raster::SortOptions options;
@@ -54,31 +66,42 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   options.compositor = o.compositor;
   options.sparse = o.sparse;
   std::unique_ptr<raster::SortPoint> sortPoint = raster::makeSortPoint(name);
-  raster::SortCounters c;
   raster::RegionFramebuffer last;
   for (int frame = 0; frame < o.frames; ++frame) {
     const float angle = o.orbit ? 6.28318530718f * float(frame) / float(o.frames) : 0.0f;
     const scene::Camera camera = raster::orbitCamera(r.camera, r.scene.bounds.center(), angle);
     raster::renderFrame(*sortPoint, r.scene, raster::makeFrameView(camera, r.width, r.height), options, r.runtime,
-                        last, &c);
+                        last);
     if (r.progress) r.progress(frame + 1, o.frames);
   }
+  const par::RunRecord& record = r.runtime.record();
+  const auto count = [&](std::string_view counter) { return std::to_string(counterTotal(record, counter)); };
   RenderOutcome out;
   out.image = raster::toImage(last);
   out.details = "frames " + std::to_string(o.frames) + (o.orbit ? " (orbit)" : "") + ", regions " + o.regions +
                 ", tile " + std::to_string(o.tileSizePx) + " px";
   if (name == "sort-first")
-    out.details += "; primitives routed " + std::to_string(c.primitivesRouted) + ", sent " +
-                   std::to_string(c.primitivesSent) + ", duplicated " + std::to_string(c.primitivesDuplicated) +
-                   ", migrated " + std::to_string(c.primitivesMigrated) + ", pre-transforms " +
-                   std::to_string(c.preTransforms) + ", geometry repeated " + std::to_string(c.geometryRepeated);
+    out.details += "; primitives routed " + count("Sort/primitives_routed") + ", sent " + count("Sort/primitives_sent") +
+                   ", duplicated " + count("Sort/primitives_duplicated") + ", migrated " +
+                   count("Sort/primitives_migrated") + ", pre-transforms " + count("Sort/pre_transforms") +
+                   ", geometry repeated " + count("Sort/geometry_repeated");
   if (name == "sort-middle")
-    out.details += "; triangles routed " + std::to_string(c.trianglesRouted) + ", sent " +
-                   std::to_string(c.trianglesSent) + ", duplicated " + std::to_string(c.trianglesDuplicated);
+    out.details += "; triangles routed " + count("Sort/triangles_routed") + ", sent " + count("Sort/triangles_sent") +
+                   ", duplicated " + count("Sort/triangles_duplicated");
   if (name == "sort-last")
     out.details += "; compositor " + o.compositor + (o.sparse ? " (sparse)" : " (full frame)") + ", pixels sent " +
-                   std::to_string(c.pixelsSent) + " in " + std::to_string(c.compositeMessages) + " messages (" +
-                   std::to_string(c.compositeBytes) + " bytes)";
+                   count("Sort/pixels_sent") + " in " + count("Sort/composite_messages") + " messages (" +
+                   count("Sort/composite_bytes") + " bytes)";
+  // Image assembly: the finished regions sent to the assembler PE (channels of kind results).
+  uint64_t resultMessages = 0, resultBytes = 0;
+  for (const par::StageRecord& stage : record.stages)
+    for (const par::ChannelTraffic& c : stage.channels)
+      if (c.kind == par::toString(par::MessageKind::Results)) {
+        resultMessages += c.messages;
+        resultBytes += c.bytes;
+      }
+  out.details += "; regions to the assembler " + std::to_string(resultMessages) + " messages (" +
+                 std::to_string(resultBytes) + " bytes)";
   return out;
 }
 

@@ -29,8 +29,7 @@ class BinarySwap : public Compositor {
  public:
   std::string_view name() const override { return "binary-swap"; }
 
-  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
-                              std::vector<CompositeCounters>& counters) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse) override {
     const int pes = rt.pes();
     if (!std::has_single_bit(static_cast<unsigned>(pes)))
       throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +
@@ -40,6 +39,7 @@ class BinarySwap : public Compositor {
     // kept[p]: the rectangle PE p still composites; its pixels stay in buffers[p].
     std::vector<Rect> kept(pes, buffers[0].rect());
     std::vector<std::vector<PixelMessage>> inbox(pes);
+    std::vector<CompositeTally> counters(pes);
     for (int k = 0; k < rounds; ++k) {
       par::Channel<PixelMessage> pixels(rt, "binary-swap pixels", par::MessageKind::Pixels);
       rt.runOnEachPe("binary-swap round " + std::to_string(k), [&](par::Pe& pe) {
@@ -52,10 +52,7 @@ class BinarySwap : public Compositor {
                     kept[p] = keepLower ? lower : upper;
                     if (sparse && m.pixels() == 0) return;  // nothing covered there: no message
                     const size_t bytes = m.bytes(sparse);
-                    CompositeCounters& c = counters[p];
-                    c.pixelsSent += m.pixels();
-                    c.messages += 1;
-                    c.bytes += bytes;
+                    counters[p].count(m, bytes);
                     pixels.send(pe, p ^ (1 << k), std::move(m), bytes);
                   });
       for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
@@ -63,6 +60,7 @@ class BinarySwap : public Compositor {
     rt.runOnEachPe("binary-swap merge", [&](par::Pe& pe) {
       for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
+    recordCompositeTallies(rt, counters);
     return kept;
   }
 };

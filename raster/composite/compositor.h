@@ -42,10 +42,18 @@ PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool spar
 // Depth-composites a received message into dst (the receiver's own buffer), where they overlap.
 void mergePixels(const PixelMessage& message, RegionFramebuffer& dst);
 
-// Traffic a compositor caused, per PE (what the Channel counted, by kind).
-struct CompositeCounters {
+// Compositing traffic of one PE, kept while the compositor's stages run and then put in the
+// run record per PE (Sort/pixels_sent, Sort/composite_messages, Sort/composite_bytes: what
+// the Channel counted, in pixels).
+struct CompositeTally {
   uint64_t pixelsSent = 0, messages = 0, bytes = 0;
+  void count(const PixelMessage& m, size_t bytesSent) {
+    pixelsSent += m.pixels();
+    messages += 1;
+    bytes += bytesSent;
+  }
 };
+void recordCompositeTallies(par::Runtime& runtime, const std::vector<CompositeTally>& tallies);
 
 class Compositor {
  public:
@@ -55,10 +63,10 @@ class Compositor {
   // (full screen each); runs its own stages, merging received pixels into the receiver's own
   // buffer. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
   // (disjoint rectangles that cover the screen; empty for a PE left without one).
-  // counters[pe] receives PE pe's traffic. Throws pr::InputError when the method cannot run
-  // with this PE count.
-  virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers, bool sparse,
-                                      std::vector<CompositeCounters>& counters) = 0;
+  // Each PE's traffic goes to the run record (recordCompositeTallies). Throws pr::InputError
+  // when the method cannot run with this PE count.
+  virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers,
+                                      bool sparse) = 0;
 };
 
 // Factories, one per compositor file.

@@ -73,31 +73,37 @@ void mergePixels(const PixelMessage& m, RegionFramebuffer& dst) {
   }
 }
 
+void recordCompositeTallies(par::Runtime& rt, const std::vector<CompositeTally>& tallies) {
+  for (int p = 0; p < rt.pes(); ++p) {
+    rt.addCounter("Sort/pixels_sent", p, double(tallies[p].pixelsSent));
+    rt.addCounter("Sort/composite_messages", p, double(tallies[p].messages));
+    rt.addCounter("Sort/composite_bytes", p, double(tallies[p].bytes));
+  }
+}
+
 namespace {
 
 class DirectSend : public Compositor {
  public:
   std::string_view name() const override { return "direct-send"; }
 
-  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse,
-                              std::vector<CompositeCounters>& counters) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse) override {
     const int pes = rt.pes();
     const Rect screen = buffers[0].rect();
     // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
     std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
     const int owners = static_cast<int>(strips.size());
 
+    std::vector<CompositeTally> counters(pes);
     par::Channel<PixelMessage> pixels(rt, "composite pixels", par::MessageKind::Pixels);
     rt.runOnEachPe("direct-send", [&](par::Pe& pe) {
-      CompositeCounters& c = counters[pe.id()];
+      CompositeTally& c = counters[pe.id()];
       for (int o = 0; o < owners; ++o) {
         if (o == pe.id()) continue;
         PixelMessage m = packPixels(buffers[pe.id()], strips[o], sparse);
         if (sparse && m.pixels() == 0) continue;  // nothing covered there: no message
         const size_t bytes = m.bytes(sparse);
-        c.pixelsSent += m.pixels();
-        c.messages += 1;
-        c.bytes += bytes;
+        c.count(m, bytes);
         pixels.send(pe, o, std::move(m), bytes);
       }
     });
@@ -107,6 +113,7 @@ class DirectSend : public Compositor {
     rt.runOnEachPe("direct-send merge", [&](par::Pe& pe) {
       for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
     });
+    recordCompositeTallies(rt, counters);
     strips.resize(pes);  // PEs beyond the strips own nothing
     return strips;
   }

@@ -3,6 +3,7 @@
 #include "raster/sort/bins.h"
 
 #include <algorithm>
+#include <utility>
 
 #include "raster/stages/setup.h"
 
@@ -21,8 +22,8 @@ void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scr
   std::sort(owners.begin(), owners.end());
 }
 
-void RegionDrawer::draw(const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists,
-                        const RegionGrid& grid, std::span<const int> regions, RegionFramebuffer& frame) {
+void RegionDrawer::draw(par::Pe& pe, const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists,
+                        const RegionGrid& grid, std::span<const int> regions, FrameAssembly& frame) {
   slot_.assign(grid.regionCount(), -1);
   for (size_t i = 0; i < regions.size(); ++i) slot_[regions[i]] = static_cast<int>(i);
   // Count, then place: every triangle once per owned region it overlaps, in list order.
@@ -46,19 +47,27 @@ void RegionDrawer::draw(const ShadingContext& ctx, std::span<const std::vector<S
       });
   for (size_t i = 0; i < regions.size(); ++i) {
     const std::span<const ScreenTriangle> bin(storage_.get() + start_[i], start_[i + 1] - start_[i]);
-    drawOne(ctx, bin, grid.region(regions[i]), frame);
+    drawOne(pe, ctx, bin, grid.region(regions[i]), frame);
   }
 }
 
-void RegionDrawer::drawOne(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const Rect& rect,
-                           RegionFramebuffer& frame) {
-  if (rect.area() > kScratchTilePixels) {
-    drawRegion(ctx, tris, frame.window(rect));
+void RegionDrawer::drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<const ScreenTriangle> tris,
+                           const Rect& rect, FrameAssembly& frame) {
+  if (!frame.assembles(pe)) {
+    RegionFramebuffer region = frame.buffer(rect);
+    drawRegion(ctx, tris, region.window());
+    frame.deliver(pe, std::move(region));
     return;
   }
-  scratch_.reshape(rect);
-  drawRegion(ctx, tris, scratch_.window());
-  copyInto(scratch_, frame);
+  RegionFramebuffer& image = frame.frame(pe);
+  if (rect.area() > kScratchTilePixels) {
+    drawRegion(ctx, tris, image.window(rect));
+  } else {
+    scratch_.reshape(rect);
+    drawRegion(ctx, tris, scratch_.window());
+    copyInto(scratch_, image);
+  }
+  frame.serve(pe);  // the regions other PEs finished meanwhile
 }
 
 }  // namespace pr::raster

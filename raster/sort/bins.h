@@ -1,6 +1,7 @@
 // Binning, the step on both sides of a sort: a sender groups what it has by the owners of the
 // screen regions it overlaps (one message per owner), and an owner groups what it received by
-// its own regions before drawing them. Shared by sort-first and sort-middle.
+// its own regions before drawing them and delivering each finished region to the assembler
+// (frame_assembly.h). Shared by sort-first and sort-middle.
 #pragma once
 
 #include <cstdint>
@@ -8,6 +9,8 @@
 #include <span>
 #include <vector>
 
+#include "common/parallel/pe.h"
+#include "raster/frame_assembly.h"
 #include "raster/framebuffer.h"
 #include "raster/sort/region_assignment.h"
 #include "raster/stages/draw_region.h"
@@ -22,20 +25,22 @@ void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scr
 
 // An owner's regions drawn from the screen triangles it holds: each triangle is binned to every
 // one of those regions its pixel bounds overlap (a counting sort into one array, whose storage
-// is kept from frame to frame), then each region is drawn (drawOne). One per PE; used only by
-// that PE.
+// is kept from frame to frame), then each region is drawn and delivered (drawOne). One per PE;
+// used only by that PE, inside its tasks.
 inline constexpr long long kScratchTilePixels = 128 * 128;
 class RegionDrawer {
  public:
   // Draws regions (indices into grid) from the triangles of every list in lists.
-  void draw(const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists, const RegionGrid& grid,
-            std::span<const int> regions, RegionFramebuffer& frame);
+  void draw(par::Pe& pe, const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists,
+            const RegionGrid& grid, std::span<const int> regions, FrameAssembly& frame);
 
-  // Draws region rect of the frame from tris. A region up to kScratchTilePixels is drawn in
-  // this PE's scratch buffer, where clearing, depth tests and shading stay in cache, and then
-  // stored into the frame once (copyInto); a larger one (a strip) is drawn in place.
-  void drawOne(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const Rect& rect,
-               RegionFramebuffer& frame);
+  // Draws region rect from tris and delivers it to the frame. On the assembler a region up to
+  // kScratchTilePixels is drawn in this PE's scratch buffer, where clearing, depth tests and
+  // shading stay in cache, and then stored into the frame once (copyInto); a larger one (a
+  // strip) is drawn in place. Any other PE draws the region in a message buffer of the
+  // assembly's pool and sends that buffer as it is (no copy on the sender).
+  void drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const Rect& rect,
+               FrameAssembly& frame);
 
   // Triangles binned by the last draw (a triangle counts once per region it went to).
   size_t binned() const { return binned_; }

@@ -1,9 +1,20 @@
 // Sort-first: the sort sits before geometry. Scene primitives start on PEs in contiguous
 // batches (or, from the second frame of a sequence, where the previous frame left them: frame
 // coherence); each PE pre-transforms the primitives it holds just enough to find the screen
-// regions they overlap and sends their ids to the region owners, who run the whole pipeline
-// (geometry again, rasterize, shade) on their regions. The scene itself is replicated
-// read-only data (world model); a message carries 4-byte primitive ids.
+// regions they overlap and sends them to the region owners, who run the whole pipeline
+// (geometry again, rasterize, shade) on their regions and deliver each finished region to the
+// assembler (frame_assembly.h).
+//
+// What a primitive message costs. A distributed sort-first holds only its share of the
+// geometry, so sending a primitive means sending its data; we count exactly that: each
+// primitive in a message is kPrimitiveBytes (its id, index triple and material, and its three
+// vertices' position, normal and uv; scene_distribution.h), and the first frame counts the
+// initial distribution of the shares (distributeShares) besides the replicated shading data.
+// We chose to count the data rather than to copy it into the message because the stages
+// (shared with sort-middle and sort-last) read a primitive by id from the scene arrays: the
+// message carries the ids, and the receiver reads from the scene the very bytes the message
+// is counted as carrying. This makes sort-first's primitive traffic comparable with
+// sort-middle's 80-byte ScreenTriangles.
 #include <algorithm>
 #include <numeric>
 #include <optional>
@@ -11,6 +22,8 @@
 
 #include "common/parallel/channel.h"
 #include "common/util/error.h"
+#include "raster/frame_assembly.h"
+#include "raster/scene_distribution.h"
 #include "raster/sort/bins.h"
 #include "raster/sort/sort_point.h"
 #include "raster/sort/tile_pull.h"
@@ -58,45 +71,70 @@ std::vector<Rect> primitiveBounds(const scene::Scene& scene, const FrameView& vi
   return bounds;
 }
 
+// One PE's counts of a frame, kept per PE while the stages run and put in the run record after
+// them (Sort/primitives_*, sort_point.h).
+struct Tally {
+  uint64_t routed = 0, sent = 0, duplicated = 0, migrated = 0, preTransforms = 0, geometryRepeated = 0;
+};
+
+void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
+  for (int p = 0; p < rt.pes(); ++p) {
+    const Tally& t = tallies[p];
+    rt.addCounter("Sort/primitives_routed", p, double(t.routed));
+    rt.addCounter("Sort/primitives_sent", p, double(t.sent));
+    rt.addCounter("Sort/primitives_duplicated", p, double(t.duplicated));
+    rt.addCounter("Sort/primitives_migrated", p, double(t.migrated));
+    rt.addCounter("Sort/pre_transforms", p, double(t.preTransforms));
+    rt.addCounter("Sort/geometry_repeated", p, double(t.geometryRepeated));
+  }
+}
+
 class SortFirst : public SortPoint {
  public:
   std::string_view name() const override { return "sort-first"; }
 
-  SortCounters renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
+  void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    declareSortCounters(name(), rt);
+    // The first frame on a scene and runtime hands every PE its initial share; each PE keeps
+    // that share, so a later loss of coherence (below) starts again from it at no cost.
+    const bool firstFrame = distribution_.firstFrame(f.scene, rt);
+    if (firstFrame) distributeShares(rt, f.scene, "sort-first distribute");
+    FrameAssembly frame(rt, image, pool_);
     if (grid.dynamic()) {
       previous_.reset();  // no owner to keep primitives on between frames
-      return renderDynamic(f, rt, grid, ctx, image);
+      return renderDynamic(f, rt, grid, ctx, frame);
     }
 
     // Frame coherence holds only for the same scene, PE count and region assignment.
-    const bool coherent = previous_.has_value() && scene_ == &f.scene && triangles_ == total &&
+    const bool coherent = !firstFrame && previous_.has_value() && scene_ == &f.scene && triangles_ == total &&
                           previous_->grid.owners() == grid.owners() && held_.size() == size_t(pes) &&
                           previous_->view.width == f.view.width && previous_->view.height == f.view.height;
     if (!coherent) {
       // First frame: contiguous batches of primitive ids, one per PE.
       held_.assign(pes, {});
       for (int p = 0; p < pes; ++p) {
-        const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);
-        const uint32_t hi = static_cast<uint32_t>(uint64_t(total) * (p + 1) / pes);
+        const auto [lo, hi] = primitiveShare(total, p, pes);
         for (uint32_t i = lo; i < hi; ++i) held_[p].push_back(i);
       }
       previous_.reset();
     }
 
-    std::vector<SortCounters> counters(pes);
+    std::vector<Tally> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
     par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
-    // the lowest of its previous owners (its primary); an unseen primitive has one holder.
+    // the lowest of its previous owners (its primary); an unseen primitive has one holder. The
+    // primary also counts a migration when the primitive's owner set differs from last frame's
+    // (a new owner, a lost one, or entering or leaving the screen).
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
-      SortCounters& c = counters[p];
+      Tally& c = counters[p];
       std::vector<std::vector<uint32_t>> out(pes);
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
@@ -113,19 +151,19 @@ class SortFirst : public SortPoint {
         const bool ownNow = std::binary_search(owners.begin(), owners.end(), p);
         if (ownNow || (primary && owners.empty())) kept[p].push_back(id);  // keeper of an unseen one
         if (!primary) continue;
-        c.primitivesRouted += owners.size();
-        if (!owners.empty()) c.primitivesDuplicated += owners.size() - 1;
+        c.routed += owners.size();
+        if (!owners.empty()) c.duplicated += owners.size() - 1;
+        if (previous_ && owners != before) c.migrated += 1;
         for (int o : owners) {
           if (std::binary_search(before.begin(), before.end(), o)) continue;  // already holds it
           if (o == p) continue;
           out[o].push_back(id);
-          c.primitivesSent += 1;
-          if (previous_) c.primitivesMigrated += 1;
+          c.sent += 1;
         }
       }
       for (int o = 0; o < pes; ++o) {
         if (out[o].empty()) continue;
-        const size_t bytes = out[o].size() * sizeof(uint32_t);
+        const size_t bytes = out[o].size() * kPrimitiveBytes;  // the primitives' data (see the top)
         primitives.send(pe, o, std::move(out[o]), bytes);
       }
     });
@@ -146,32 +184,31 @@ class SortFirst : public SortPoint {
       std::vector<ScreenTriangle> tris;
       transformPrimitives(f.scene, f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
-      drawers_[p].draw(ctx, std::span(&tris, 1), grid, grid.regionsOf(p), image);
+      drawers_[p].draw(pe, ctx, std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
 
     held_ = std::move(kept);
     previous_.emplace(Previous{f.view, grid});
     scene_ = &f.scene;
     triangles_ = total;
-    return recordSortCounters(name(), counters, rt);
+    recordTallies(rt, counters);
   }
 
  private:
   // Dynamic regions: each PE pre-transforms its contiguous share and keeps the ids binned per
   // tile; tiles are handed out on demand and the PE taking a tile pulls the ids from every PE
   // and runs the whole pipeline on that tile (so a primitive's geometry runs once per tile).
-  SortCounters renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid,
-                             const ShadingContext& ctx, RegionFramebuffer& image) {
+  void renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid, const ShadingContext& ctx,
+                     FrameAssembly& frame) {
     const int pes = rt.pes();
     const int tiles = grid.regionCount();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
-    std::vector<SortCounters> counters(pes);
+    std::vector<Tally> counters(pes);
     std::vector<std::vector<std::vector<uint32_t>>> bins(pes, std::vector<std::vector<uint32_t>>(tiles));
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
-      SortCounters& c = counters[p];
-      const uint32_t lo = static_cast<uint32_t>(uint64_t(total) * p / pes);
-      const uint32_t hi = static_cast<uint32_t>(uint64_t(total) * (p + 1) / pes);
+      Tally& c = counters[p];
+      const auto [lo, hi] = primitiveShare(total, p, pes);
       std::vector<uint32_t> held(hi - lo);
       std::iota(held.begin(), held.end(), lo);
       const std::vector<Rect> bounds = primitiveBounds(f.scene, f.view, held);
@@ -183,14 +220,14 @@ class SortFirst : public SortPoint {
           ++n;
         });
         c.preTransforms += 1;
-        c.primitivesRouted += n;
-        if (n > 0) c.primitivesDuplicated += n - 1;
+        c.routed += n;
+        if (n > 0) c.duplicated += n - 1;
       }
     });
 
     drawers_.resize(pes);
     {
-      TilePull<uint32_t> pull(rt, "sort-first tile", bins);
+      TilePull<uint32_t> pull(rt, "sort-first tile", bins, kPrimitiveBytes);  // ids counted as their data
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
         std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
@@ -198,11 +235,11 @@ class SortFirst : public SortPoint {
         std::vector<ScreenTriangle> tris;
         transformPrimitives(f.scene, f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
-        drawers_[pe.id()].drawOne(ctx, tris, grid.region(static_cast<int>(t)), image);
+        drawers_[pe.id()].drawOne(pe, ctx, tris, grid.region(static_cast<int>(t)), frame);
       });
-      for (int p = 0; p < pes; ++p) counters[p].primitivesSent += pull.itemsSent(p);
+      for (int p = 0; p < pes; ++p) counters[p].sent += pull.itemsSent(p);
     }
-    return recordSortCounters(name(), counters, rt);
+    recordTallies(rt, counters);
   }
 
   struct Previous {
@@ -210,6 +247,8 @@ class SortFirst : public SortPoint {
     RegionGrid grid;
   };
   std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
+  RegionBufferPool pool_;              // region message storage, kept between frames
+  SceneDistribution distribution_;
   // Between frames: the primitives each PE holds, and the view and regions they were sorted by.
   std::vector<std::vector<uint32_t>> held_;
   std::optional<Previous> previous_;

@@ -1,10 +1,14 @@
 // Sort-last: the sort sits after rasterization. Each PE renders its own primitives (geometry
 // batches under the runtime's schedule) over the whole screen into its own full-screen colour
 // and depth buffers, shades them, and the Compositor (direct-send or binary-swap, full frame
-// or sparse) redistributes pixels by screen region and keeps the nearest fragment per pixel.
+// or sparse) redistributes pixels by screen region and keeps the nearest fragment per pixel;
+// each PE then delivers its composited rectangle to the assembler (frame_assembly.h). The scene
+// is replicated (world model: any PE may take any geometry batch).
 #include <algorithm>
 
 #include "raster/composite/compositor.h"
+#include "raster/frame_assembly.h"
+#include "raster/scene_distribution.h"
 #include "raster/sort/sort_point.h"
 #include "raster/stages/rasterize.h"
 #include "raster/stages/shade.h"
@@ -16,12 +20,14 @@ class SortLast : public SortPoint {
  public:
   std::string_view name() const override { return "sort-last"; }
 
-  SortCounters renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
+  void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     // The compositor is chosen (and a bad name rejected) before any work is done.
     std::unique_ptr<Compositor> compositor = makeCompositor(f.options.compositor);
     const Rect screen{0, 0, f.view.width, f.view.height};
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    declareSortCounters(name(), rt);
+    if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
 
     // Every PE clears its own full-screen buffer (kept from frame to frame).
     buffers_.resize(pes);
@@ -50,25 +56,19 @@ class SortLast : public SortPoint {
     // Stage 2, shading of each PE's visible pixels, in its own buffer.
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
 
-    // Stage 3, the sort: depth compositing by screen region.
-    std::vector<CompositeCounters> traffic(pes);
-    const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse, traffic);
-    // Each PE stores the region it composited into the frame.
-    rt.runOnEachPe("sort-last store", [&](par::Pe& pe) {
-      copyInto(buffers[pe.id()], image, regions[pe.id()]);
+    // Stage 3, the sort: depth compositing by screen region (its counters go to the record).
+    const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse);
+    // Each PE delivers the rectangle it composited to the assembler (in place on PE 0).
+    FrameAssembly frame(rt, image, pool_);
+    rt.runOnEachPe("sort-last assemble", [&](par::Pe& pe) {
+      frame.deliver(pe, buffers[pe.id()], regions[pe.id()]);
     });
-
-    std::vector<SortCounters> counters(pes);
-    for (int p = 0; p < pes; ++p) {
-      counters[p].pixelsSent = traffic[p].pixelsSent;
-      counters[p].compositeMessages = traffic[p].messages;
-      counters[p].compositeBytes = traffic[p].bytes;
-    }
-    return recordSortCounters(name(), counters, rt);
   }
 
  private:
   std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
+  RegionBufferPool pool_;                   // region message storage, kept between frames
+  SceneDistribution distribution_;
 };
 
 }  // namespace

@@ -1,11 +1,13 @@
 // Sort-middle: the sort sits between geometry and rasterization. PEs transform and light
 // their share of the scene triangles (geometry batches under the runtime's schedule), bin the
 // screen triangles by region owner and send them as messages; each owner then rasterizes and
-// shades its regions, straight into its own regions of the frame. The redistributed PDI is the
-// 80-byte ScreenTriangle.
+// shades its regions and delivers each finished one to the assembler (frame_assembly.h). The
+// redistributed PDI is the 80-byte ScreenTriangle; the scene is replicated (world model).
 #include <algorithm>
 
 #include "common/parallel/channel.h"
+#include "raster/frame_assembly.h"
+#include "raster/scene_distribution.h"
 #include "raster/sort/bins.h"
 #include "raster/sort/sort_point.h"
 #include "raster/sort/tile_pull.h"
@@ -16,16 +18,33 @@
 namespace pr::raster {
 namespace {
 
+// One PE's counts of a frame, kept per PE while the stages run and put in the run record after
+// them (Sort/triangles_*, sort_point.h).
+struct Tally {
+  uint64_t routed = 0, sent = 0, duplicated = 0;
+};
+
+void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
+  for (int p = 0; p < rt.pes(); ++p) {
+    rt.addCounter("Sort/triangles_routed", p, double(tallies[p].routed));
+    rt.addCounter("Sort/triangles_sent", p, double(tallies[p].sent));
+    rt.addCounter("Sort/triangles_duplicated", p, double(tallies[p].duplicated));
+  }
+}
+
 class SortMiddle : public SortPoint {
  public:
   std::string_view name() const override { return "sort-middle"; }
 
-  SortCounters renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
+  void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
     const ShadingContext ctx = makeShadingContext(f.scene, f.view);
-    if (grid.dynamic()) return renderDynamic(f, rt, grid, ctx, image);
-    std::vector<SortCounters> counters(pes);
+    declareSortCounters(name(), rt);
+    if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
+    FrameAssembly frame(rt, image, pool_);
+    if (grid.dynamic()) return renderDynamic(f, rt, grid, ctx, frame);
+    std::vector<Tally> counters(pes);
     par::Channel<std::vector<ScreenTriangle>> triangles(rt, "screen triangles", par::MessageKind::Primitives);
 
     // Stage 1, geometry and the sort: one task per batch of scene triangles, on any PE.
@@ -36,7 +55,7 @@ class SortMiddle : public SortPoint {
       const uint32_t first = static_cast<uint32_t>(t) * batch;
       std::vector<ScreenTriangle> tris;
       processTriangles(f.scene, f.view, first, std::min(batch, total - first), tris);
-      SortCounters& c = counters[pe.id()];
+      Tally& c = counters[pe.id()];
       // One owner for the whole batch (always so at P = 1): the batch is the message as it is.
       std::vector<int> owner(tris.size());
       std::vector<char> scratch(pes, 0);
@@ -44,19 +63,19 @@ class SortMiddle : public SortPoint {
       bool single = true;
       for (size_t i = 0; i < tris.size(); ++i) {
         ownersOf(grid, pixelBounds(tris[i]), scratch, owners);
-        c.trianglesRouted += owners.size();
+        c.routed += owners.size();
         if (owners.empty()) {
           owner[i] = -1;
           single = false;
           continue;
         }
-        c.trianglesDuplicated += owners.size() - 1;
+        c.duplicated += owners.size() - 1;
         owner[i] = owners.size() == 1 ? owners[0] : pes;  // pes: several owners
         if (owner[i] != owner[0]) single = false;
       }
       if (tris.empty()) return;
       if (single && owner[0] < pes) {
-        if (owner[0] != pe.id()) c.trianglesSent += tris.size();
+        if (owner[0] != pe.id()) c.sent += tris.size();
         const size_t bytes = tris.size() * sizeof(ScreenTriangle);
         triangles.send(pe, owner[0], std::move(tris), bytes);
         return;
@@ -73,7 +92,7 @@ class SortMiddle : public SortPoint {
       }
       for (int o = 0; o < pes; ++o) {
         if (out[o].empty()) continue;
-        if (o != pe.id()) c.trianglesSent += out[o].size();
+        if (o != pe.id()) c.sent += out[o].size();
         const size_t bytes = out[o].size() * sizeof(ScreenTriangle);
         triangles.send(pe, o, std::move(out[o]), bytes);
       }
@@ -83,25 +102,24 @@ class SortMiddle : public SortPoint {
     std::vector<std::vector<std::vector<ScreenTriangle>>> inbox(pes);
     for (int p = 0; p < pes; ++p) inbox[p] = triangles.drain(p);
 
-    // Stage 2, rasterize and shade: each owner draws its regions of the frame from its own
-    // triangles.
+    // Stage 2, rasterize and shade: each owner draws its regions from its own triangles and
+    // delivers them to the assembler as they are finished.
     drawers_.resize(pes);
     rt.runOnEachPe("sort-middle rasterize", [&](par::Pe& pe) {
       const int p = pe.id();
-      drawers_[p].draw(ctx, inbox[p], grid, grid.regionsOf(p), image);
+      drawers_[p].draw(pe, ctx, inbox[p], grid, grid.regionsOf(p), frame);
     });
-
-    return recordSortCounters(name(), counters, rt);
+    recordTallies(rt, counters);
   }
 
  private:
   // Dynamic regions: each PE bins its screen triangles per tile and keeps them; tiles are then
   // handed out on demand and the PE taking a tile pulls that tile's bins from every PE.
-  SortCounters renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid,
-                             const ShadingContext& ctx, RegionFramebuffer& image) {
+  void renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid, const ShadingContext& ctx,
+                     FrameAssembly& frame) {
     const int pes = rt.pes();
     const int tiles = grid.regionCount();
-    std::vector<SortCounters> counters(pes);
+    std::vector<Tally> counters(pes);
     std::vector<std::vector<std::vector<ScreenTriangle>>> bins(pes, std::vector<std::vector<ScreenTriangle>>(tiles));
 
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
@@ -111,15 +129,15 @@ class SortMiddle : public SortPoint {
       const uint32_t first = static_cast<uint32_t>(t) * batch;
       std::vector<ScreenTriangle> tris;
       processTriangles(f.scene, f.view, first, std::min(batch, total - first), tris);
-      SortCounters& c = counters[pe.id()];
+      Tally& c = counters[pe.id()];
       for (const ScreenTriangle& tri : tris) {
         uint64_t n = 0;
         grid.forEachOverlapped(pixelBounds(tri), [&](int r) {
           bins[pe.id()][r].push_back(tri);
           ++n;
         });
-        c.trianglesRouted += n;
-        if (n > 0) c.trianglesDuplicated += n - 1;
+        c.routed += n;
+        if (n > 0) c.duplicated += n - 1;
       }
     });
 
@@ -129,14 +147,16 @@ class SortMiddle : public SortPoint {
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-middle rasterize", set, [&](par::Pe& pe, par::TaskId t) {
         const std::vector<ScreenTriangle> tris = pull.gather(pe, static_cast<int>(t));
-        drawers_[pe.id()].drawOne(ctx, tris, grid.region(static_cast<int>(t)), image);
+        drawers_[pe.id()].drawOne(pe, ctx, tris, grid.region(static_cast<int>(t)), frame);
       });
-      for (int p = 0; p < pes; ++p) counters[p].trianglesSent += pull.itemsSent(p);
+      for (int p = 0; p < pes; ++p) counters[p].sent += pull.itemsSent(p);
     }
-    return recordSortCounters(name(), counters, rt);
+    recordTallies(rt, counters);
   }
 
   std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
+  RegionBufferPool pool_;              // region message storage, kept between frames
+  SceneDistribution distribution_;
 };
 
 }  // namespace

@@ -1,4 +1,4 @@
-// The sort-point registry (name -> factory -> description) and counter arithmetic: what the
+// The sort-point registry (name -> factory -> description) and the counters' names: what the
 // render command and the tests use to pick sort-first, sort-middle or sort-last by name.
 #include "raster/sort/sort_point.h"
 
@@ -6,62 +6,22 @@
 
 namespace pr::raster {
 
-SortCounters& SortCounters::operator+=(const SortCounters& o) {
-  primitivesRouted += o.primitivesRouted;
-  primitivesSent += o.primitivesSent;
-  primitivesDuplicated += o.primitivesDuplicated;
-  primitivesMigrated += o.primitivesMigrated;
-  preTransforms += o.preTransforms;
-  geometryRepeated += o.geometryRepeated;
-  trianglesRouted += o.trianglesRouted;
-  trianglesSent += o.trianglesSent;
-  trianglesDuplicated += o.trianglesDuplicated;
-  pixelsSent += o.pixelsSent;
-  compositeMessages += o.compositeMessages;
-  compositeBytes += o.compositeBytes;
-  return *this;
+const std::vector<std::string_view>& sortCounterNames(std::string_view sortPoint) {
+  static const std::vector<std::string_view> kFirst = {
+      "Sort/primitives_routed", "Sort/primitives_sent", "Sort/primitives_duplicated",
+      "Sort/primitives_migrated", "Sort/pre_transforms", "Sort/geometry_repeated"};
+  static const std::vector<std::string_view> kMiddle = {"Sort/triangles_routed", "Sort/triangles_sent",
+                                                       "Sort/triangles_duplicated"};
+  static const std::vector<std::string_view> kLast = {"Sort/pixels_sent", "Sort/composite_messages",
+                                                     "Sort/composite_bytes"};
+  if (sortPoint == "sort-first") return kFirst;
+  if (sortPoint == "sort-middle") return kMiddle;
+  PR_CHECK(sortPoint == "sort-last", "no sort counters belong to '" + std::string(sortPoint) + "'");
+  return kLast;
 }
 
-namespace {
-
-// Which sort point fills each counter, and its name in the run record (Category/what).
-struct SortCounterField {
-  std::string_view sortPoint;
-  std::string_view name;
-  uint64_t SortCounters::*value;
-};
-constexpr SortCounterField kSortCounterFields[] = {
-    {"sort-first", "Sort/primitives_routed", &SortCounters::primitivesRouted},
-    {"sort-first", "Sort/primitives_sent", &SortCounters::primitivesSent},
-    {"sort-first", "Sort/primitives_duplicated", &SortCounters::primitivesDuplicated},
-    {"sort-first", "Sort/primitives_migrated", &SortCounters::primitivesMigrated},
-    {"sort-first", "Sort/pre_transforms", &SortCounters::preTransforms},
-    {"sort-first", "Sort/geometry_repeated", &SortCounters::geometryRepeated},
-    {"sort-middle", "Sort/triangles_routed", &SortCounters::trianglesRouted},
-    {"sort-middle", "Sort/triangles_sent", &SortCounters::trianglesSent},
-    {"sort-middle", "Sort/triangles_duplicated", &SortCounters::trianglesDuplicated},
-    {"sort-last", "Sort/pixels_sent", &SortCounters::pixelsSent},
-    {"sort-last", "Sort/composite_messages", &SortCounters::compositeMessages},
-    {"sort-last", "Sort/composite_bytes", &SortCounters::compositeBytes},
-};
-
-}  // namespace
-
-SortCounters recordSortCounters(std::string_view sortPoint, const std::vector<SortCounters>& perPe,
-                                par::Runtime& runtime) {
-  PR_CHECK(perPe.size() == size_t(runtime.pes()),
-           "sort counters for " + std::to_string(perPe.size()) + " PEs on a runtime of " +
-               std::to_string(runtime.pes()));
-  bool known = false;
-  for (const SortCounterField& f : kSortCounterFields) {
-    if (f.sortPoint != sortPoint) continue;
-    known = true;
-    for (int p = 0; p < runtime.pes(); ++p) runtime.addCounter(f.name, p, double(perPe[size_t(p)].*f.value));
-  }
-  PR_CHECK(known, "no sort counters belong to '" + std::string(sortPoint) + "'");
-  SortCounters sum;
-  for (const SortCounters& c : perPe) sum += c;
-  return sum;
+void declareSortCounters(std::string_view sortPoint, par::Runtime& runtime) {
+  for (std::string_view name : sortCounterNames(sortPoint)) runtime.addCounter(name, 0, 0.0);
 }
 
 const SortPointRegistry& sortPoints() {

@@ -29,35 +29,24 @@ struct SortOptions {
   bool sparse = false;                                   // sort-last: --sparse (covered pixels only)
 };
 
-// The algorithm counters of one frame (Sort/...), summed over PEs. Messages and bytes
-// themselves are in the runtime's RunRecord (counted by the Channels); these say what they were.
-struct SortCounters {
-  // sort-first
-  uint64_t primitivesRouted = 0;      // (primitive, owner) deliveries, the sender's own included
-  uint64_t primitivesSent = 0;        // deliveries to another PE (Channel messages carry them)
-  uint64_t primitivesDuplicated = 0;  // deliveries beyond the first owner of a primitive
-  uint64_t primitivesMigrated = 0;    // sent to an owner that did not hold them last frame
-  uint64_t preTransforms = 0;         // primitives pre-transformed to find their regions
-  uint64_t geometryRepeated = 0;      // primitives whose geometry an owner ran again
-  // sort-middle
-  uint64_t trianglesRouted = 0;       // (screen triangle, owner) deliveries
-  uint64_t trianglesSent = 0;         // deliveries to another PE
-  uint64_t trianglesDuplicated = 0;   // deliveries beyond the first owner of a triangle
-  // sort-last
-  uint64_t pixelsSent = 0;            // pixels in compositing messages
-  uint64_t compositeMessages = 0;
-  uint64_t compositeBytes = 0;
-
-  SortCounters& operator+=(const SortCounters& o);
-};
-
-// Puts each PE's counters of one frame in the run record as named per-PE counters
-// (Sort/triangles_sent, ...; only those that belong to sortPoint, e.g. "sort-middle") and
-// returns their sum over PEs, the frame's SortCounters. Runtime::addCounter adds, so after N
-// frames the record holds the totals the render command prints. Called by each sort point's
-// renderFrame on the controlling thread, after its last stage; perPe has one entry per PE.
-SortCounters recordSortCounters(std::string_view sortPoint, const std::vector<SortCounters>& perPe,
-                                par::Runtime& runtime);
+// The algorithm counters of the sort points, named per PE in the run record (Sort/...): the
+// only way figures leave a sort point. Each renderFrame adds its frame's values per PE with
+// Runtime::addCounter, so after N frames the record holds the totals the render command prints.
+// Messages and bytes themselves are counted by the Channels; these say what they were.
+//   sort-first:  Sort/primitives_routed     (primitive, owner) deliveries, the sender's own included
+//                Sort/primitives_sent       deliveries to another PE (Channel messages carry them)
+//                Sort/primitives_duplicated deliveries beyond the first owner of a primitive
+//                Sort/primitives_migrated   primitives whose owner set changed since the last frame
+//                Sort/pre_transforms        primitives pre-transformed to find their regions
+//                Sort/geometry_repeated     primitives whose geometry an owner ran again
+//   sort-middle: Sort/triangles_routed, Sort/triangles_sent, Sort/triangles_duplicated (the same
+//                for screen triangles)
+//   sort-last:   Sort/pixels_sent, Sort/composite_messages, Sort/composite_bytes (compositing)
+// The names of sortPoint's counters ("sort-first" ...), in the order above.
+const std::vector<std::string_view>& sortCounterNames(std::string_view sortPoint);
+// Creates sortPoint's counters at zero for every PE (so a frame that adds nothing still
+// records them). Called by each renderFrame on the controlling thread before its stages.
+void declareSortCounters(std::string_view sortPoint, par::Runtime& runtime);
 
 // One frame to render.
 struct FrameInputs {
@@ -73,8 +62,10 @@ class SortPoint {
   // Renders one frame on the runtime's PEs into image (full screen), writing every pixel: what
   // it held before does not matter, so a caller can reuse one image from frame to frame.
   // Called by the controlling thread; runs one or more stages; may keep state between frames
-  // (sort-first's frame coherence, binning storage).
-  virtual SortCounters renderFrame(const FrameInputs& frame, par::Runtime& runtime, RegionFramebuffer& image) = 0;
+  // (sort-first's frame coherence, binning storage). The image is assembled on the assembler
+  // PE from counted region messages (frame_assembly.h); the frame's counters go to the run
+  // record (Sort/..., Scene/... in the first frame), nothing else leaves.
+  virtual void renderFrame(const FrameInputs& frame, par::Runtime& runtime, RegionFramebuffer& image) = 0;
 };
 
 std::unique_ptr<SortPoint> makeSortFirst();

@@ -20,15 +20,19 @@ template <class Item>
 class TilePull {
  public:
   // bins[pe][tile]: what PE pe binned for each tile; a PE reads and moves out its own only.
-  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins)
+  // itemBytes: what one item costs in a reply (sort-first counts a primitive id as the
+  // primitive's data, kPrimitiveBytes).
+  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins,
+           size_t itemBytes = sizeof(Item))
       : runtime_(runtime),
         bins_(bins),
         name_(name),
+        itemBytes_(itemBytes),
         sent_(runtime.pes(), 0),
         replies_(runtime, name + " replies", par::MessageKind::Primitives),
         requests_(runtime, name + " requests", par::MessageKind::Requests, [this](par::Pe& pe, Request&& r) {
           std::vector<Item>& bin = bins_[pe.id()][r.tile];
-          const size_t bytes = bin.size() * sizeof(Item);
+          const size_t bytes = bin.size() * itemBytes_;
           sent_[pe.id()] += bin.size();
           replies_.send(pe, r.pe, std::move(bin), bytes);
         }) {}
@@ -77,6 +81,7 @@ class TilePull {
   par::Runtime& runtime_;
   std::vector<std::vector<std::vector<Item>>>& bins_;
   std::string name_;
+  size_t itemBytes_;
   std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
   par::Channel<std::vector<Item>> replies_;
   par::Channel<Request> requests_;

@@ -1,6 +1,7 @@
-// SortCounters in the run record: every sort point puts its per-PE counters (Sort/...) in the
-// runtime's RunRecord, only those that belong to it, as totals over the frames of a run; the
-// render command's --metrics JSON holds the same totals its details line prints.
+// Sort counters in the run record, the only way figures leave a sort point: every sort point
+// puts its per-PE counters (Sort/...) in the runtime's RunRecord, only those that belong to it,
+// as totals over the frames of a run, agreeing with what its Channels counted; the render
+// command's --metrics JSON holds the same totals its details line prints.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -11,34 +12,12 @@
 #include "common/parallel/run_record.h"
 #include "common/parallel/runtime.h"
 #include "raster/parallel_pipeline.h"
+#include "raster/scene_distribution.h"
 #include "raster/sort/sort_test_support.h"
 #include "test_support.h"
 
 namespace pr::raster {
 namespace {
-
-struct ExpectedCounter {
-  const char* name;
-  uint64_t SortCounters::*value;
-};
-
-// The counters each sort point fills (sort_point.h), under their run-record names.
-std::vector<ExpectedCounter> countersOf(const std::string& method) {
-  if (method == "sort-first")
-    return {{"Sort/primitives_routed", &SortCounters::primitivesRouted},
-            {"Sort/primitives_sent", &SortCounters::primitivesSent},
-            {"Sort/primitives_duplicated", &SortCounters::primitivesDuplicated},
-            {"Sort/primitives_migrated", &SortCounters::primitivesMigrated},
-            {"Sort/pre_transforms", &SortCounters::preTransforms},
-            {"Sort/geometry_repeated", &SortCounters::geometryRepeated}};
-  if (method == "sort-middle")
-    return {{"Sort/triangles_routed", &SortCounters::trianglesRouted},
-            {"Sort/triangles_sent", &SortCounters::trianglesSent},
-            {"Sort/triangles_duplicated", &SortCounters::trianglesDuplicated}};
-  return {{"Sort/pixels_sent", &SortCounters::pixelsSent},
-          {"Sort/composite_messages", &SortCounters::compositeMessages},
-          {"Sort/composite_bytes", &SortCounters::compositeBytes}};
-}
 
 const par::CounterRecord* findCounter(const par::RunRecord& record, const std::string& name) {
   for (const par::CounterRecord& c : record.counters)
@@ -71,6 +50,20 @@ scene::Scene ring() {
   return s;
 }
 
+// The channel that carries what a sort point's "sent" counter counts, and the bytes per item.
+struct SentChannel {
+  std::string counter, channel;
+  uint64_t itemBytes;
+};
+SentChannel sentChannel(const std::string& method, RegionStrategy regions) {
+  const bool dynamic = regions == RegionStrategy::Dynamic;
+  if (method == "sort-first")
+    return {"Sort/primitives_sent", dynamic ? "sort-first tile replies" : "scene primitives", kPrimitiveBytes};
+  if (method == "sort-middle")
+    return {"Sort/triangles_sent", dynamic ? "sort-middle tile replies" : "screen triangles", sizeof(ScreenTriangle)};
+  return {"Sort/composite_bytes", "pixels", 1};
+}
+
 TEST_CASE("SortCounters: each sort point's per-PE counters reach the run record as totals over the frames") {
   const scene::Scene s = ring();
   const scene::Camera start = test::lookAtCamera({0.0f, 4.0f, 9.0f}, {0.0f, 0.0f, 0.0f});
@@ -84,23 +77,29 @@ TEST_CASE("SortCounters: each sort point's per-PE counters reach the run record 
       options.batchSize = 4;  // several geometry tasks, so both PEs send
       par::Runtime rt(2, "demand");
       std::unique_ptr<SortPoint> sortPoint = makeSortPoint(method);
-      SortCounters sum;  // what renderFrame returned, added over the frames
       for (int frame = 0; frame < 3; ++frame) {
         const scene::Camera cam = orbitCamera(start, glm::vec3(0.0f), 6.2831853f * frame / 16.0f);
-        renderFrame(*sortPoint, s, makeFrameView(cam, 40, 32), options, rt, &sum);
+        renderFrame(*sortPoint, s, makeFrameView(cam, 40, 32), options, rt);
       }
-      const std::vector<ExpectedCounter> expected = countersOf(method);
+      const std::vector<std::string_view>& expected = sortCounterNames(method);
       CHECK(sortCounterCount(rt.record()) == expected.size());  // no other sort point's counters
-      for (const ExpectedCounter& e : expected) {
-        CAPTURE(e.name);
-        const par::CounterRecord* c = findCounter(rt.record(), e.name);
+      for (std::string_view name : expected) {
+        CAPTURE(name);
+        const par::CounterRecord* c = findCounter(rt.record(), std::string(name));
         REQUIRE(c != nullptr);
         CHECK(c->perPe.size() == 2u);
-        CHECK(total(*c) == double(sum.*e.value));
       }
+      // The "sent" counter agrees with the Channel that carried it, over all three frames.
+      const SentChannel sent = sentChannel(method, regions);
+      const double items = total(*findCounter(rt.record(), sent.counter));
+      CHECK(items > 0.0);
+      CHECK(uint64_t(items) * sent.itemBytes == test::channelTraffic(rt.record(), sent.channel).bytes);
+      if (std::string(method) == "sort-last")
+        CHECK(total(*findCounter(rt.record(), "Sort/composite_messages")) ==
+              double(test::channelTraffic(rt.record(), "pixels").messages));
       // The runs are not empty: the equalities above compare real traffic.
-      CHECK(total(*findCounter(rt.record(), expected[0].name)) > 0.0);
-      CHECK(total(*findCounter(rt.record(), expected[1].name)) > 0.0);
+      CHECK(total(*findCounter(rt.record(), std::string(expected[0]))) > 0.0);
+      CHECK(total(*findCounter(rt.record(), std::string(expected[1]))) > 0.0);
     }
   }
 }
@@ -145,6 +144,13 @@ TEST_CASE("SortCounters: render --metrics writes the Sort/ counters the details 
     CHECK(total(*c) == std::stod(printed[i + 1].str()));  // both are totals over the 2 frames
   }
   CHECK(std::stod(printed[1].str()) > 0.0);
+  // The finished regions PE 1 sent to the assembler, as the record's results channels hold them.
+  std::smatch results;
+  REQUIRE(std::regex_search(r.output, results, std::regex(R"(regions to the assembler (\d+) messages \((\d+) bytes\))")));
+  const test::ChannelSum sent = test::channelTraffic(record, "results");
+  CHECK(sent.messages > 0u);
+  CHECK(std::stoull(results[1].str()) == sent.messages);
+  CHECK(std::stoull(results[2].str()) == sent.bytes);
 }
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
+#include "raster/frame_assembly.h"
 #include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
 #include "raster/sort/sort_test_support.h"
@@ -27,9 +28,9 @@ void checkAnalyticVolume(const char* compositor, int pes) {
   SortOptions options;
   options.compositor = compositor;
   par::Runtime rt(pes, "balanced");
-  SortCounters c;
-  RegionFramebuffer image = renderParallel(s, view, "sort-last", options, rt, &c);
+  RegionFramebuffer image = renderParallel(s, view, "sort-last", options, rt);
   CHECK(identical(image, renderSequential(s, view)));
+  test::CounterTotals c = test::counterTotals(rt.record());
   const uint64_t area = uint64_t(kW) * kH;
   const uint64_t perPeBytes = kFullPixelBytes * area * (pes - 1) / pes;  // b A (1 - 1/P)
   const uint64_t perPeMessages =
@@ -41,10 +42,16 @@ void checkAnalyticVolume(const char* compositor, int pes) {
     CHECK(t.messagesSent == perPeMessages);
     CHECK(t.bytesReceived == perPeBytes);
   }
-  CHECK(c.compositeBytes == perPeBytes * pes);
-  CHECK(c.pixelsSent == area * (pes - 1));
+  CHECK(c["Sort/composite_bytes"] == perPeBytes * pes);
+  CHECK(c["Sort/pixels_sent"] == area * (pes - 1));
   // Rendering itself moves nothing: each PE draws into its own buffer.
-  CHECK(test::stageTraffic(rt.record(), "sort-last").bytesSent == 0);
+  CHECK(test::stageTraffic(rt.record(), "sort-last clear").bytesSent == 0);
+  CHECK(test::stageTraffic(rt.record(), "sort-last render").bytesSent == 0);
+  CHECK(test::stageTraffic(rt.record(), "sort-last shade").bytesSent == 0);
+  // Assembly: every PE but the assembler sends its composited 1/P of the screen, one message.
+  const test::StageTraffic assemble = test::stageTraffic(rt.record(), "sort-last assemble");
+  CHECK(assemble.messagesSent == uint64_t(pes - 1));
+  CHECK(assemble.bytesSent == uint64_t(pes - 1) * (kRegionHeaderBytes + area / pes * kRegionPixelBytes));
 }
 
 TEST_CASE("SortLast: full-frame direct-send moves b*A*(1-1/P) bytes in P-1 messages per PE") {
@@ -54,10 +61,12 @@ TEST_CASE("SortLast: full-frame direct-send moves b*A*(1-1/P) bytes in P-1 messa
       const scene::Scene s = test::threeTriangles();
       const FrameView view = makeFrameView(test::pixelOrthoCamera(kH), kW, kH);
       par::Runtime rt(3, "balanced");
-      SortCounters c;
-      renderParallel(s, view, "sort-last", SortOptions{}, rt, &c);
-      CHECK(c.pixelsSent == uint64_t(kW) * kH * 2);
-      CHECK(c.compositeMessages == 6);
+      renderParallel(s, view, "sort-last", SortOptions{}, rt);
+      CHECK(test::counterTotal(rt.record(), "Sort/pixels_sent") == uint64_t(kW) * kH * 2);
+      CHECK(test::counterTotal(rt.record(), "Sort/composite_messages") == 6);
+      // Strips of 10, 11 and 11 rows (stripRegions): PEs 1 and 2 send theirs to PE 0.
+      CHECK(test::channelTraffic(rt.record(), "results").bytes ==
+            2 * kRegionHeaderBytes + uint64_t(kW) * (11 + 11) * kRegionPixelBytes);
       continue;
     }
     checkAnalyticVolume("direct-send", pes);
@@ -77,8 +86,8 @@ TEST_CASE("SortLast: sparse compositing sends only covered pixels, with their in
     options.compositor = compositor;
     options.sparse = true;
     par::Runtime rt(2, "balanced");
-    SortCounters c;
-    RegionFramebuffer image = renderParallel(s, view, "sort-last", options, rt, &c);
+    RegionFramebuffer image = renderParallel(s, view, "sort-last", options, rt);
+    test::CounterTotals c = test::counterTotals(rt.record());
     CHECK(identical(image, renderSequential(s, view)));
     // batchSize 4096: PE 0 renders all three triangles and PE 1 none, so PE 0 sends its
     // covered pixels of PE 1's half and PE 1 sends nothing.
@@ -89,11 +98,11 @@ TEST_CASE("SortLast: sparse compositing sends only covered pixels, with their in
       return n;
     }();
     CHECK(coveredInLower > 0);
-    CHECK(c.pixelsSent == coveredInLower);
-    CHECK(c.compositeMessages == 1);
-    CHECK(c.compositeBytes == coveredInLower * kSparsePixelBytes);
+    CHECK(c["Sort/pixels_sent"] == coveredInLower);
+    CHECK(c["Sort/composite_messages"] == 1);
+    CHECK(c["Sort/composite_bytes"] == coveredInLower * kSparsePixelBytes);
     const test::StageTraffic t = test::stageTraffic(rt.record(), compositor);
-    CHECK(t.bytesSent == c.compositeBytes);
+    CHECK(t.bytesSent == c["Sort/composite_bytes"]);
     CHECK(t.bytesReceived == t.bytesSent);
   }
 }

@@ -1,8 +1,9 @@
 // Helpers for the sort-point tests: the hand-checked three-triangle scene and sums over the
-// runtime's run record.
+// runtime's run record (stage traffic, channel traffic by kind or name, named counters).
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <string>
 
 #include "common/parallel/runtime.h"
@@ -42,6 +43,59 @@ inline StageTraffic stageTraffic(const par::RunRecord& record, const std::string
     }
   }
   return t;
+}
+
+struct ChannelSum {
+  uint64_t messages = 0, bytes = 0;
+};
+
+// Traffic between PEs through the channels whose kind ("results", "primitives", "pixels",
+// "requests", "data") or name equals what, over the stages whose name starts with prefix.
+inline ChannelSum channelTraffic(const par::RunRecord& record, const std::string& what, const std::string& prefix = "") {
+  ChannelSum sum;
+  for (const par::StageRecord& s : record.stages) {
+    if (s.name.rfind(prefix, 0) != 0) continue;
+    for (const par::ChannelTraffic& c : s.channels) {
+      if (c.kind != what && c.name != what) continue;
+      sum.messages += c.messages;
+      sum.bytes += c.bytes;
+    }
+  }
+  return sum;
+}
+
+// The named per-PE counter of the run record, summed over PEs (pe < 0) or of one PE; 0 when
+// it was never recorded.
+inline double counterTotal(const par::RunRecord& record, const std::string& name, int pe = -1) {
+  double sum = 0.0;
+  for (const par::CounterRecord& c : record.counters) {
+    if (c.name != name) continue;
+    for (size_t p = 0; p < c.perPe.size(); ++p)
+      if (pe < 0 || int(p) == pe) sum += c.perPe[p];
+  }
+  return sum;
+}
+
+// Every counter of the record summed over PEs, by name.
+using CounterTotals = std::map<std::string, double>;
+inline CounterTotals counterTotals(const par::RunRecord& record) {
+  CounterTotals totals;
+  for (const par::CounterRecord& c : record.counters)
+    for (double v : c.perPe) totals[c.name] += v;
+  return totals;
+}
+
+// What one frame added to each counter: render it with fn, compare totals before and after.
+template <class Fn>
+CounterTotals frameCounters(const par::Runtime& rt, Fn&& fn) {
+  const CounterTotals before = counterTotals(rt.record());
+  fn();
+  CounterTotals after = counterTotals(rt.record());
+  for (auto& [name, value] : after) {
+    const auto it = before.find(name);
+    if (it != before.end()) value -= it->second;
+  }
+  return after;
 }
 
 }  // namespace pr::test
