@@ -21,6 +21,7 @@
 #include <span>
 
 #include "common/parallel/channel.h"
+#include "common/scene/poisoned_view.h"
 #include "common/util/error.h"
 #include "raster/frame_assembly.h"
 #include "raster/scene_distribution.h"
@@ -89,6 +90,24 @@ void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
   }
 }
 
+// The scene as a PE may read it for the primitives `ids` it holds or was sent: the shared one,
+// or under SortOptions::poisonForeignGeometry a copy in which only those are intact.
+class ReadableScene {
+ public:
+  ReadableScene(const FrameInputs& f, std::span<const uint32_t> ids)
+      : shared_(f.scene), view_(f.options.poisonForeignGeometry ? scene::poisonedView(f.scene, ids) : nullptr) {
+    if (view_) shading_ = makeShadingContext(*view_, f.view);
+  }
+  const scene::Scene& scene() const { return view_ ? *view_ : shared_; }
+  // The shading context over the same scene (deferred shading reads vertex attributes).
+  const ShadingContext& shading(const ShadingContext& shared) const { return view_ ? *shading_ : shared; }
+
+ private:
+  const scene::Scene& shared_;
+  std::unique_ptr<scene::Scene> view_;
+  std::optional<ShadingContext> shading_;
+};
+
 class SortFirst : public SortPoint {
  public:
   std::string_view name() const override { return "sort-first"; }
@@ -139,8 +158,10 @@ class SortFirst : public SortPoint {
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
       const std::vector<uint32_t>& held = held_[p];  // sorted
-      const std::vector<Rect> now = primitiveBounds(f.scene, f.view, held);
-      const std::vector<Rect> then = previous_ ? primitiveBounds(f.scene, previous_->view, held) : std::vector<Rect>();
+      const ReadableScene readable(f, held);
+      const std::vector<Rect> now = primitiveBounds(readable.scene(), f.view, held);
+      const std::vector<Rect> then =
+          previous_ ? primitiveBounds(readable.scene(), previous_->view, held) : std::vector<Rect>();
       c.preTransforms += held.size() + then.size();
       for (size_t k = 0; k < held.size(); ++k) {
         const uint32_t id = held[k];
@@ -182,9 +203,10 @@ class SortFirst : public SortPoint {
       std::sort(mine.begin(), mine.end());
       mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
       std::vector<ScreenTriangle> tris;
-      transformPrimitives(f.scene, f.view, mine, tris);
+      const ReadableScene readable(f, mine);
+      transformPrimitives(readable.scene(), f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
-      drawers_[p].draw(pe, ctx, std::span(&tris, 1), grid, grid.regionsOf(p), frame);
+      drawers_[p].draw(pe, readable.shading(ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
 
     held_ = std::move(kept);
@@ -211,7 +233,7 @@ class SortFirst : public SortPoint {
       const auto [lo, hi] = primitiveShare(total, p, pes);
       std::vector<uint32_t> held(hi - lo);
       std::iota(held.begin(), held.end(), lo);
-      const std::vector<Rect> bounds = primitiveBounds(f.scene, f.view, held);
+      const std::vector<Rect> bounds = primitiveBounds(ReadableScene(f, held).scene(), f.view, held);
       for (size_t k = 0; k < held.size(); ++k) {
         const uint32_t id = held[k];
         uint64_t n = 0;
@@ -233,9 +255,10 @@ class SortFirst : public SortPoint {
         std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
         std::sort(ids.begin(), ids.end());  // arrival order -> id order, for runs of ids
         std::vector<ScreenTriangle> tris;
-        transformPrimitives(f.scene, f.view, ids, tris);
+        const ReadableScene readable(f, ids);
+        transformPrimitives(readable.scene(), f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
-        drawers_[pe.id()].drawOne(pe, ctx, tris, grid.region(static_cast<int>(t)), frame);
+        drawers_[pe.id()].drawOne(pe, readable.shading(ctx), tris, grid.region(static_cast<int>(t)), frame);
       });
       for (int p = 0; p < pes; ++p) counters[p].sent += pull.itemsSent(p);
     }

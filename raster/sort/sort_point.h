@@ -27,6 +27,9 @@ struct SortOptions {
   uint32_t batchSize = 4096;                             // scene triangles per geometry task
   std::string compositor = "direct-send";                // sort-last: --compositor
   bool sparse = false;                                   // sort-last: --sparse (covered pixels only)
+  // A check for tests (common/scene/poisoned_view.h): sort-first PEs read geometry from a scene
+  // copy holding only the primitives they hold or were sent, so an uncounted read shows.
+  bool poisonForeignGeometry = false;
 };
 
 // The algorithm counters of the sort points, named per PE in the run record (Sort/...): the

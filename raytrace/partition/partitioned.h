@@ -16,6 +16,7 @@
 #include "common/parallel/runtime.h"
 #include "common/parallel/task.h"
 #include "common/util/error.h"
+#include "common/scene/poisoned_view.h"
 #include "common/scene/scene.h"
 #include "raytrace/integrators/integrator.h"
 #include "raytrace/partition/partition.h"
@@ -72,33 +73,13 @@ inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const 
   rt.recordBroadcast(shadingDataBytes(s) + emitters + directoryBytes);
 }
 
-// PE p's copy of the scene for TraceOptions::poisonForeignGeometry: every vertex that no held
-// triangle and no emitter uses is NaN (position, normal, uv, colour). Built on PE p.
-inline std::unique_ptr<scene::Scene> poisonedView(const scene::Scene& s, std::span<const uint32_t> held,
-                                                  std::span<const uint32_t> emitters) {
-  auto view = std::make_unique<scene::Scene>(s);
-  std::vector<char> keep(s.positions.size(), 0);
-  for (std::span<const uint32_t> list : {held, emitters})
-    for (uint32_t t : list)
-      for (uint32_t v : s.triangles[t].v) keep[v] = 1;
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (size_t v = 0; v < keep.size(); ++v) {
-    if (keep[v]) continue;
-    view->positions[v] = glm::vec3(nan);
-    if (v < view->normals.size()) view->normals[v] = glm::vec3(nan);
-    if (v < view->uvs.size()) view->uvs[v] = glm::vec2(nan);
-    if (v < view->colors.size()) view->colors[v] = glm::vec4(nan);
-  }
-  return view;
-}
-
 // The scene a PE shades from: the shared one, or its poisoned view when the check is on.
 class SceneViews {
  public:
   explicit SceneViews(const TraceJob& job, int pes) : job_(job), views_(job.options.poisonForeignGeometry ? pes : 0) {}
   // On PE p, in the build stage: its view, from the triangles it holds.
   void build(int p, std::span<const uint32_t> held, const LightSampler& lights) {
-    if (!views_.empty()) views_[size_t(p)] = poisonedView(job_.scene, held, lights.emitters());
+    if (!views_.empty()) views_[size_t(p)] = scene::poisonedView(job_.scene, held, lights.emitters());
   }
   const scene::Scene& of(int p) const { return views_.empty() ? job_.scene : *views_[size_t(p)]; }
 

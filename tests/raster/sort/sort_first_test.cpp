@@ -153,5 +153,28 @@ TEST_CASE("SortFirst: a camera move that takes one triangle from the top strip t
   CHECK(third["Sort/primitives_migrated"] == 0);
 }
 
+TEST_CASE("SortFirst: with every PE's foreign geometry poisoned an orbit still gives the sequential frames") {
+  // Each PE reads geometry (pre-transform, geometry again, deferred shading) from a scene copy
+  // whose vertices of primitives it neither holds nor was sent are NaN: any read of another
+  // PE's primitives outside a counted message would change the frame.
+  const scene::Scene s = ring();
+  const scene::Camera start = test::lookAtCamera({0.0f, 4.0f, 9.0f}, {0.0f, 0.0f, 0.0f});
+  for (RegionStrategy regions : {RegionStrategy::StaticTiles, RegionStrategy::StaticStrips, RegionStrategy::Dynamic}) {
+    CAPTURE(regionStrategyName(regions));
+    SortOptions options;
+    options.regions = regions;
+    options.tileSizePx = 8;
+    options.poisonForeignGeometry = true;
+    par::Runtime rt(3, "balanced");
+    std::unique_ptr<SortPoint> sf = makeSortPoint("sort-first");
+    for (int frame = 0; frame < 3; ++frame) {
+      CAPTURE(frame);
+      const scene::Camera cam = orbitCamera(start, glm::vec3(0.0f), 6.2831853f * frame / 16.0f);
+      const FrameView view = makeFrameView(cam, 40, 32);
+      CHECK(identical(renderFrame(*sf, s, view, options, rt), renderSequential(s, view)));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace pr::raster

@@ -105,7 +105,7 @@ TEST_CASE("Results: a poisoned view keeps the held triangles and the emitters, a
   const rt::LightSampler lights(s);
   std::vector<uint32_t> held;
   for (uint32_t t = 0; t < uint32_t(s.triangles.size()) / 2; ++t) held.push_back(t);
-  const std::unique_ptr<scene::Scene> view = rt::poisonedView(s, held, lights.emitters());
+  const std::unique_ptr<scene::Scene> view = scene::poisonedView(s, held, lights.emitters());
   std::vector<char> kept(s.positions.size(), 0);
   for (uint32_t t : held)
     for (uint32_t v : s.triangles[t].v) kept[v] = 1;
