@@ -2,7 +2,8 @@
 # Installs every Debian package parrender needs to build, test and benchmark.
 # Idempotent: when everything is present it only checks and returns (no apt traffic).
 #   tools/setup.sh          build and test dependencies
-#   tools/setup.sh --bench  also the benchmark anchors: Intel Embree 3, Mesa llvmpipe over EGL
+#   tools/setup.sh --bench  also the benchmark anchors: Intel Embree 3, Mesa llvmpipe over EGL,
+#                           nanoflann (kd-tree, header-only)
 set -euo pipefail
 
 bench=0
@@ -25,6 +26,7 @@ if [ "$bench" -eq 1 ]; then
   packages+=(
     libembree-dev                                  # Embree 3 ray tracing anchor
     libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # llvmpipe raster anchor (EGL surfaceless)
+    libnanoflann-dev                               # nanoflann kd-tree anchor (bench_photonmap)
   )
 fi
 
