@@ -129,8 +129,9 @@ bool any(const std::vector<MaterialUse>& used, Pick pick) {
 // with the camera outside it, which then sees front sides only. Coplanar triangles (the whole
 // scene in one plane) satisfy the test for either side. Vertices within a tolerance of a plane
 // count as on it (1e-5 of the scene extent, far above float rounding of the plane test and far
-// below any modelled gap). The test is O(triangles x vertices); above a work limit it is not
-// run and the answer is "yes, they can" (conservative).
+// below any modelled gap). The test is O(triangles x vertices) but stops at the first triangle
+// with geometry on both sides, which in most scenes is the first; past a work limit the answer
+// is "yes, they can" (conservative).
 struct Visibility {
   bool canSee = true;
   std::string reason;
@@ -139,12 +140,13 @@ struct Visibility {
 Visibility surfacesSeeEachOther(const Scene& scene, const std::vector<Camera>& cameras, bool transmission) {
   constexpr double kWorkLimit = 2.0e8;
   if (scene.triangles.empty()) return {false, "no triangles"};
-  if (double(scene.triangles.size()) * double(scene.positions.size()) > kWorkLimit)
-    return {true, "scene too large for the convexity test (assumed)"};
   const glm::vec3 extent = scene.bounds.extent();
   const float tolerance = 1.0e-5f * std::max({extent.x, extent.y, extent.z, 1.0e-6f});
   bool allFrontEmpty = true, coplanar = true, cameraDecides = true;
+  double work = 0.0;  // vertex-plane tests so far; most scenes stop at their first triangle
   for (const Triangle& t : scene.triangles) {
+    work += double(scene.positions.size());
+    if (work > kWorkLimit) return {true, "scene too large for the convexity test (assumed)"};
     const glm::vec3 a = scene.positions[t.v[0]], b = scene.positions[t.v[1]], c = scene.positions[t.v[2]];
     const glm::vec3 n = glm::cross(b - a, c - a);
     const float len = glm::length(n);
@@ -155,7 +157,7 @@ Visibility surfacesSeeEachOther(const Scene& scene, const std::vector<Camera>& c
       const float d = glm::dot(p - a, u);
       front |= d > tolerance;
       back |= d < -tolerance;
-      if (front && back) return {true, "surfaces face each other (geometry on both sides of a triangle)"};
+      if (front && back) return {true, "surfaces face each other"};
     }
     allFrontEmpty &= !front;
     coplanar &= !front && !back;
@@ -366,7 +368,7 @@ RenderPlan analyzeEffects(const Scene& scene, const Camera* camera) {
     decide(Effect::IndirectDiffuse, false, "no surface can receive light from another: " + vis.reason);
   else
     decide(Effect::IndirectDiffuse, true, what("diffuse", [](const MaterialUse& u) { return u.traits.diffuse; }) +
-                                              " can receive light other surfaces reflect (" + vis.reason + ")");
+                                              " can receive light other surfaces reflect: " + vis.reason);
 
   // Material features.
   const bool anisotropic = has([](const MaterialUse& u) { return u.traits.anisotropic; });
