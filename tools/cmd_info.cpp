@@ -1,5 +1,6 @@
 // `parrender info SCENE [--json] [--camera SEL]`: loads a glTF scene into the render-ready
-// layout and prints its statistics (common/scene/scene_stats.h) as an aligned table or JSON.
+// layout and prints its statistics (common/scene/scene_stats.h) and the RenderPlan of the
+// effect analysis (common/scene/effect_analysis.h) as an aligned table or JSON.
 // The same loader and camera selection as `render`, so what it prints is what renderers get.
 #include <cstdio>
 #include <memory>
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "common/scene/camera_select.h"
+#include "common/scene/effect_analysis.h"
 #include "common/scene/gltf_loader.h"
 #include "common/scene/scene_stats.h"
 #include "tools/commands.h"
@@ -52,7 +54,17 @@ constexpr scene::MaterialKind kKinds[] = {scene::MaterialKind::Diffuse, scene::M
                                           scene::MaterialKind::Glass, scene::MaterialKind::Emissive,
                                           scene::MaterialKind::Anisotropic};
 
-nlohmann::json toJson(const scene::SceneStats& s, const scene::Camera& camera) {
+// "plan": {"direct": {"on": true, "forced": false, "reason": "..."}, ...} in plan order.
+nlohmann::json planJson(const scene::RenderPlan& plan) {
+  nlohmann::json out = nlohmann::json::object();
+  for (scene::Effect e : scene::allEffects()) {
+    const scene::EffectDecision& d = plan[e];
+    out[std::string(scene::toString(e))] = {{"on", d.on}, {"forced", d.forced}, {"reason", d.reason}};
+  }
+  return out;
+}
+
+nlohmann::json toJson(const scene::SceneStats& s, const scene::Camera& camera, const scene::RenderPlan& plan) {
   using nlohmann::json;
   auto vec = [](glm::vec3 v) { return json::array({v.x, v.y, v.z}); };
   json materials = {{"total", s.materials}};
@@ -78,10 +90,11 @@ nlohmann::json toJson(const scene::SceneStats& s, const scene::Camera& camera) {
       {"extensions_used", s.extensionsUsed},
       {"warnings", s.warnings},
       {"memory_bytes", s.memoryBytes},
+      {"plan", planJson(plan)},
   };
 }
 
-std::string toTable(const scene::SceneStats& s, const scene::Camera& camera) {
+std::string toTable(const scene::SceneStats& s, const scene::Camera& camera, const scene::RenderPlan& plan) {
   std::ostringstream out;
   auto row = [&](const char* key, const std::string& value) {
     char label[24];
@@ -109,6 +122,8 @@ std::string toTable(const scene::SceneStats& s, const scene::Camera& camera) {
   row("warnings", s.warnings.empty() ? "none" : std::to_string(s.warnings.size()));
   for (const std::string& w : s.warnings) row("", w);
   row("memory_bytes", bytesText(s.memoryBytes));
+  row("plan", "effects a render simulates (force with render --effects NAME=on|off)");
+  for (scene::Effect e : scene::allEffects()) row("", plan.line(e));
   return out.str();
 }
 
@@ -116,10 +131,11 @@ void runInfo(const InfoOptions& options) {
   scene::Scene scene = scene::loadGltf(options.scene);
   scene::Camera camera = scene::selectCamera(scene, options.camera, kInfoAspect);
   scene::SceneStats stats = scene::computeStats(scene);
+  const scene::RenderPlan plan = scene::analyzeEffects(scene, &camera);
   if (options.json) {
-    std::printf("%s\n", toJson(stats, camera).dump(2).c_str());
+    std::printf("%s\n", toJson(stats, camera, plan).dump(2).c_str());
   } else {
-    std::printf("%s", toTable(stats, camera).c_str());
+    std::printf("%s", toTable(stats, camera, plan).c_str());
   }
 }
 
@@ -132,8 +148,8 @@ void addInfoCommand(CLI::App& app) {
       "Load a glTF 2.0 scene (.gltf or .glb) and print what the renderers will receive: triangles, "
       "vertices, objects (drawn mesh primitives), materials used by kind (diffuse, specular, glass, "
       "emissive, anisotropic), lights by kind (point, spot, directional, emissive area triangles), "
-      "textures and texels, cameras and the selected one, world bounds, extensions used, warnings and "
-      "the memory of the render-ready scene. Bad input exits with status 2.");
+      "textures and texels, cameras and the selected one, world bounds, extensions used, warnings, "
+      "the memory of the render-ready scene, and the render plan: each effect on or off with the reason. Bad input exits with status 2.");
   cmd->add_option("scene", options->scene, "glTF 2.0 file to inspect (.gltf with external or data: buffers, or .glb)")
       ->required();
   cmd->add_flag("--json", options->json, "print JSON (snake_case keys named like the table rows) instead of a table");

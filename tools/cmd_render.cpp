@@ -17,6 +17,7 @@
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_options.h"
 #include "common/scene/camera_select.h"
+#include "common/scene/effect_analysis.h"
 #include "common/scene/gltf_loader.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
@@ -34,6 +35,7 @@ struct RenderArgs {
   std::string camera;
   int threads = 1;
   bool quiet = false;
+  std::string effects;  // --effects NAME=on|off,...
   par::ScheduleOptions schedule;
   par::RunOutputOptions outputs;
   RenderSettings settings;
@@ -86,6 +88,7 @@ std::string defaultOutput(const std::string& scene, const std::string& method) {
 void run(RenderArgs& a) {
   const RenderMethod& method = findRenderMethod(a.method);
   checkFamilyOptions(method, a.family);
+  const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
   if (a.output.empty()) a.output = defaultOutput(a.scene, a.method);
   const std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr")
@@ -93,10 +96,11 @@ void run(RenderArgs& a) {
 
   const scene::Scene scene = scene::loadGltf(a.scene);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
+  const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
 
   par::Runtime runtime(par::RuntimeOptions{a.threads, a.schedule.schedule, a.schedule.params, true});
   ProgressBar bar(!a.quiet && isatty(STDERR_FILENO));
-  const RenderRequest request{scene, camera, a.width, a.height, a.settings, runtime,
+  const RenderRequest request{scene, camera, a.width, a.height, a.settings, plan, runtime,
                               [&bar](int64_t done, int64_t total) { bar.update(done, total); }};
   RenderOutcome outcome = method.make(method.name, request);
   bar.finish();
@@ -108,6 +112,9 @@ void run(RenderArgs& a) {
   const double wall = summary.wallSeconds;
   std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
               a.threads, a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+  std::printf("effects:\n");
+  for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());
+  if (!outcome.effects.empty()) std::printf("%s\n", outcome.effects.c_str());
   if (!outcome.details.empty()) std::printf("%s\n", outcome.details.c_str());
   std::printf("wall %.3f s", wall);
   if (outcome.rays > 0)
@@ -143,6 +150,11 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--camera", args->camera, "camera: index, name, or 'auto' (default: the file's first)");
   cmd->add_option("--threads", args->threads, "P, the number of PEs")->check(CLI::Range(1, 4096))->capture_default_str();
   cmd->add_flag("--quiet", args->quiet, "no progress bar");
+  std::string effectNames;
+  for (scene::Effect e : scene::allEffects()) effectNames += (effectNames.empty() ? "" : ", ") + std::string(scene::toString(e));
+  cmd->add_option("--effects", args->effects,
+                  "force effects of the render plan on or off, e.g. caustics=off,indirect=on; names: " + effectNames +
+                      " (ray tracers skip the work of effects that are off; rasterization reports the plan only)");
   par::addScheduleOptions(*cmd, args->schedule);
   par::addRunOutputOptions(*cmd, args->outputs);
   addRayOptions(*cmd, args->settings, args->family);

@@ -14,8 +14,17 @@ namespace pr::cli {
 
 namespace {
 
+// "glossy, caustics" for the effects of `plan` that are on but not in `simulated`.
+std::string notSimulated(const scene::RenderPlan& plan, scene::EffectSet simulated) {
+  std::string out;
+  for (scene::Effect e : scene::allEffects())
+    if (plan.on(e) && !simulated.has(e)) out += (out.empty() ? "" : ", ") + std::string(scene::toString(e));
+  return out;
+}
+
 RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   rt::TraceOptions options;
+  options.integrator.effects = r.plan.enabled();
   options.integrator.spp = r.settings.ray.spp;
   options.integrator.maxDepth = r.settings.ray.maxDepth;
   options.integrator.seed = r.settings.ray.seed;
@@ -37,6 +46,15 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   };
   const uint64_t camera = total("Rays/camera"), continuation = total("Rays/continuation"), shadow = total("Rays/shadow");
   out.rays = camera + continuation + shadow;
+  // The work the plan skipped, from the Plan/ counters of the run record.
+  std::string skipped;
+  for (const par::CounterSummary& c : summary.counters)
+    if (c.name.starts_with("Plan/") && c.total > 0.0)
+      skipped += (skipped.empty() ? "" : ", ") + c.name.substr(5) + " " + std::to_string(uint64_t(c.total));
+  const std::string missing = notSimulated(r.plan, job.integrator->simulated());
+  out.effects = "integrator " + r.settings.ray.integrator + " simulates the plan's effects" +
+                (missing.empty() ? "" : " except " + missing + " (not implemented by it)") +
+                "; skipped work: " + (skipped.empty() ? "none" : skipped);
   out.details = "integrator " + r.settings.ray.integrator + ", spp " + std::to_string(options.integrator.spp) +
                 ", max depth " + std::to_string(options.integrator.maxDepth) + "; rays: camera " +
                 std::to_string(camera) + ", continuation " + std::to_string(continuation) + ", shadow " +
@@ -75,9 +93,19 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
     if (r.progress) r.progress(frame + 1, o.frames);
   }
   const par::RunRecord& record = r.runtime.record();
+  // The raster stages (raster/stages/shade.cpp) shade each visible pixel once: direct light
+  // from punctual lights (a headlight without them) with its glossy highlight, emission and
+  // textures; no shadows, reflection or refraction rays, so there is no plan work to skip.
+  scene::EffectSet rasterEffects = scene::EffectSet::none();
+  for (scene::Effect e : {scene::Effect::DirectLight, scene::Effect::Emission, scene::Effect::Textures})
+    rasterEffects.set(e, true);
+  const std::string missing = notSimulated(r.plan, rasterEffects);
   const auto count = [&](std::string_view counter) { return std::to_string(counterTotal(record, counter)); };
   RenderOutcome out;
   out.image = raster::toImage(last);
+  out.effects = "rasterization simulates direct light (punctual lights, no shadows), emission and textures" +
+                (missing.empty() ? std::string() : "; not simulated: " + missing) +
+                "; the plan is reported, not applied (no rays to skip)";
   out.details = "frames " + std::to_string(o.frames) + (o.orbit ? " (orbit)" : "") + ", regions " + o.regions +
                 ", tile " + std::to_string(o.tileSizePx) + " px";
   if (name == "sort-first")

@@ -18,6 +18,7 @@
 #include "common/image/image.h"
 #include "common/parallel/runtime.h"
 #include "common/scene/camera.h"
+#include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
 #include "common/util/registry.h"
 
@@ -58,6 +59,7 @@ struct RenderRequest {
   const scene::Camera& camera;
   int width = 0, height = 0;
   const RenderSettings& settings;
+  const scene::RenderPlan& plan;  // the effects to simulate (analysis + --effects)
   par::Runtime& runtime;
   std::function<void(int64_t, int64_t)> progress;  // (tasks done, total), thread-safe
 };
@@ -66,6 +68,7 @@ struct RenderOutcome {
   image::Image image;
   uint64_t rays = 0;     // rays traced (ray family), 0 otherwise
   std::string details;   // one extra summary line (family-specific), may be empty
+  std::string effects;   // which of the plan's effects the method simulates, and what it skipped
 };
 
 // Registry: name -> render function -> description, and the method's family.

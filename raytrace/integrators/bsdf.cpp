@@ -35,15 +35,23 @@ float ggxPdf(float alpha, const glm::vec3& wo, const glm::vec3& wi) {
   return ggxD(alpha, h.z) * h.z / (4.0f * oh);
 }
 
-glm::vec4 textureOr(const scene::Scene& scene, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
+glm::vec4 textureLookup(const scene::Scene& scene, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
   if (!ref.present() || size_t(ref.texture) >= scene.textures.size()) return glm::vec4(1.0f);
   return scene.textures[size_t(ref.texture)].sample(ref.transformUv(uv), srgb);
 }
 
 }  // namespace
 
-ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si) {
+bool usesTextures(const scene::Material& mat) {
+  return mat.baseColorTexture.present() || mat.metallicRoughnessTexture.present() || mat.transmissionTexture.present() ||
+         (mat.isEmissive() && mat.emissiveTexture.present());
+}
+
+ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures) {
   const scene::Material& mat = scene.materials[si.material];
+  auto textureOr = [&](const scene::Scene& sc, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
+    return textures ? textureLookup(sc, ref, uv, srgb) : glm::vec4(1.0f);
+  };
   ShadingMaterial m;
   const glm::vec4 base = mat.baseColorFactor * textureOr(scene, mat.baseColorTexture, si.uv, true);
   m.baseColor = glm::clamp(glm::vec3(base), 0.0f, 1.0f);

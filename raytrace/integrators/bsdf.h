@@ -47,7 +47,11 @@ struct ShadingMaterial {
   float dielectricWeight() const { return transmission * (1.0f - metallic); }
 };
 
-ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si);
+// textures = false evaluates the material from its factors alone (the plan's textures off).
+ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures = true);
+// Whether evalMaterial reads a texture for this material (base colour, metallic-roughness,
+// transmission or emission).
+bool usesTextures(const scene::Material& material);
 
 // Radiance emitted towards wo: the material's emission on its front side (both sides when
 // double-sided), zero otherwise.

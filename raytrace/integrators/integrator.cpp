@@ -14,7 +14,7 @@ std::string_view toString(IntegratorKind kind) { return kind == IntegratorKind::
 
 IntegratorContext::IntegratorContext(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
                                      const IntegratorOptions& options)
-    : scene_(&scene), camera_(camera), width_(width), height_(height), options_(options), lights_(scene) {
+    : scene_(&scene), camera_(camera), width_(width), height_(height), options_(options), lights_(scene, options.effects.has(scene::Effect::Textures)) {
   PR_CHECK(width > 0 && height > 0, "image size must be positive");
   PR_CHECK(options.spp >= 1 && options.spp <= kMaxSpp, "spp out of range: " + std::to_string(options.spp));
   PR_CHECK(options.maxDepth >= 1 && options.maxDepth <= kMaxDepthLimit,
@@ -36,10 +36,29 @@ ShadingFrame::ShadingFrame(const SurfaceInteraction& si)
   woLocal.z = std::max(woLocal.z, 1.0e-6f);  // wo lies in the upper hemisphere by construction
 }
 
+ShadingMaterial IntegratorContext::material(const SurfaceInteraction& si, Emit& out) const {
+  if (simulates(scene::Effect::Textures)) return evalMaterial(*scene_, si);
+  if (usesTextures(scene_->materials[si.material])) ++out.stats().textureEvaluationsSkipped;
+  return evalMaterial(*scene_, si, false);
+}
+
+glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const {
+  const glm::vec3 le = emittedRadiance(m, si);
+  if (simulates(scene::Effect::Emission) || !(maxComponent(le) > 0.0f)) return le;
+  ++out.stats().emissionSkipped;
+  return glm::vec3(0.0f);
+}
+
 void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
                                     const glm::vec3& woLocal, const RayMessage& msg, float opaqueWeight, bool mis,
                                     Emit& out) const {
   if (!(opaqueWeight > 0.0f)) return;
+  const bool area = lights_.hasAreaLights();
+  if (!simulates(scene::Effect::DirectLight)) {
+    out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? 1u : 0u);
+    return;
+  }
+  const bool shadows = simulates(scene::Effect::Shadows);
   // Light from behind the geometric surface cannot reach an opaque side (no leaks through
   // thin walls whose interpolated normal leans towards the light).
   const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
@@ -63,13 +82,20 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
     shadow.sample = msg.sample;
     shadow.depth = msg.depth;
     shadow.kind = RayKind::Shadow;
-    out.push(shadow);
+    if (shadows) {
+      out.push(shadow);
+    } else {
+      ++out.stats().shadowTestsSkipped;
+      out.addRadiance(shadow.pixel, shadow.throughput);  // what Integrator::miss adds for it
+    }
   };
   LightSample ls;
   for (const scene::PunctualLight& light : scene_->lights)
     if (lights_.samplePunctual(light, si, ls)) addSample(ls);
-  if (lights_.hasAreaLights() &&
-      lights_.sampleArea(si, sample(msg, Dim::kLightPick), sample(msg, Dim::kLightU), sample(msg, Dim::kLightV), ls))
+  if (area && !simulates(scene::Effect::Emission))
+    ++out.stats().lightSamplesSkipped;
+  else if (area &&
+           lights_.sampleArea(si, sample(msg, Dim::kLightPick), sample(msg, Dim::kLightU), sample(msg, Dim::kLightV), ls))
     addSample(ls);
 }
 

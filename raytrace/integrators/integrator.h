@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/scene/camera.h"
+#include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
 #include "common/util/registry.h"
 #include "raytrace/core/interaction.h"
@@ -23,6 +24,7 @@
 #include "raytrace/integrators/light_sampler.h"
 #include "raytrace/integrators/ray_message.h"
 #include "raytrace/integrators/sampling.h"
+#include "raytrace/integrators/trace_stats.h"
 
 namespace pr::rt {
 
@@ -39,19 +41,27 @@ struct IntegratorOptions {
   int spp = 1;        // samples per pixel, stratified (--spp)
   int maxDepth = 8;   // surface interactions a path may shade (--max-depth); >= 1
   uint64_t seed = 1;  // --seed
+  // The effects to simulate: the RenderPlan's (common/scene/effect_analysis.h), filled by
+  // tools/ from analyzeEffects and --effects. The work of an effect that is off is skipped
+  // and counted in TraceStats; the random numbers of the rest do not move, since each is a
+  // function of (seed, pixel, sample, depth, dim). Everything on by default.
+  scene::EffectSet effects = scene::EffectSet::all();
 };
 
-// Where shading results go: radiance into the Film, spawned rays into the caller's queue. A
-// tracer that routes rays to other PEs takes them from the queue after the call.
+// Where shading results go: radiance into the Film, spawned rays into the caller's queue,
+// skipped work into the PE's TraceStats. A tracer that routes rays to other PEs takes them
+// from the queue after the call.
 class Emit {
  public:
-  Emit(Film& film, std::vector<RayMessage>& rays) : film_(&film), rays_(&rays) {}
+  Emit(Film& film, std::vector<RayMessage>& rays, TraceStats& stats) : film_(&film), rays_(&rays), stats_(&stats) {}
   void addRadiance(uint32_t pixel, const glm::vec3& radiance) { film_->add(pixel, radiance); }
   void push(const RayMessage& message) { rays_->push_back(message); }
+  TraceStats& stats() { return *stats_; }
 
  private:
   Film* film_;
   std::vector<RayMessage>* rays_;
+  TraceStats* stats_;
 };
 
 
@@ -70,11 +80,25 @@ class IntegratorContext {
   float sample(const RayMessage& m, uint32_t dim) const {
     return sample1D(options_.seed, m.pixel, m.sample, m.depth, dim);
   }
+  bool simulates(scene::Effect e) const { return options_.effects.has(e); }
+  // The material at a hit, its textures ignored when the plan turns textures off (counted).
+  ShadingMaterial material(const SurfaceInteraction& si, Emit& out) const;
+  // The emitted radiance at a hit towards wo; zero (counted) when emission is off.
+  glm::vec3 emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const;
   // Next-event estimation at a hit: one shadow ray per punctual light and one area-light
   // sample, each carrying throughput * f * L * cos / pdf (times the MIS weight against BSDF
-  // sampling when mis is set). opaqueWeight scales the diffuse + glossy part.
+  // sampling when mis is set). opaqueWeight scales the diffuse + glossy part. Plan: nothing
+  // with direct light off, no area sample with emission off, and with shadows off the
+  // contribution goes straight to the film (what an unoccluded shadow ray adds on its miss).
   void directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame, const glm::vec3& woLocal,
                    const RayMessage& msg, float opaqueWeight, bool mis, Emit& out) const;
+  // Pushes ray when the plan simulates `effect`, else counts it in TraceStats::*skipped.
+  void spawn(scene::Effect effect, uint64_t TraceStats::*skipped, const RayMessage& ray, Emit& out) const {
+    if (simulates(effect))
+      out.push(ray);
+    else
+      ++(out.stats().*skipped);
+  }
   // A continuation ray from si in direction wi.
   RayMessage continuation(const SurfaceInteraction& si, const RayMessage& msg, const glm::vec3& wi,
                           const glm::vec3& throughput, float bsdfPdf) const;
@@ -120,6 +144,9 @@ class Integrator {
   const IntegratorOptions& options() const { return ctx_.options(); }
   const IntegratorContext& context() const { return ctx_; }
 
+  // The effects this integrator simulates at all (the render prints the others as not
+  // simulated); the plan's work is skipped only among these.
+  virtual scene::EffectSet simulated() const { return scene::EffectSet::all(); }
   // Primary rays of every pixel of `rect`, options().spp stratified samples each, appended to
   // out in pixel order then sample order.
   void cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const { cameraRays(rect, options().spp, out); }

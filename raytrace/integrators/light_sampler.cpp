@@ -31,7 +31,8 @@ float spotFactor(const scene::PunctualLight& light, const glm::vec3& towardsPoin
 }
 }  // namespace
 
-LightSampler::LightSampler(const scene::Scene& scene) : scene_(&scene), lightOf_(scene.triangles.size(), kNotALight) {
+LightSampler::LightSampler(const scene::Scene& scene, bool textures)
+    : scene_(&scene), textures_(textures), lightOf_(scene.triangles.size(), kNotALight) {
   double total = 0.0;
   std::vector<double> power;
   std::vector<float> area;
@@ -97,7 +98,7 @@ bool LightSampler::sampleArea(const SurfaceInteraction& si, float pick, float u,
   const float d = std::sqrt(d2);
   out.wi = toLight / d;
   const float cosLight = std::fabs(glm::dot(ls.geometricNormal, out.wi));
-  const ShadingMaterial m = evalMaterial(*scene_, ls);
+  const ShadingMaterial m = evalMaterial(*scene_, ls, textures_);
   const glm::vec3 le = emittedRadiance(m, ls);
   if (maxComponent(le) <= 0.0f) return false;
   out.pdf = areaPdf(tri, d, cosLight);

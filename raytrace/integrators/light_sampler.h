@@ -24,7 +24,8 @@ struct LightSample {
 
 class LightSampler {
  public:
-  explicit LightSampler(const scene::Scene& scene);
+  // textures = false: emitters are evaluated without their emissive texture (plan: textures off).
+  explicit LightSampler(const scene::Scene& scene, bool textures = true);
 
   bool hasAreaLights() const { return !cdf_.empty(); }
   // The emissive triangles sampled as area lights (scene triangle indices).
@@ -49,6 +50,7 @@ class LightSampler {
 
  private:
   const scene::Scene* scene_;
+  bool textures_ = true;
   std::vector<uint32_t> triangles_;   // area-light triangles, in scene order
   std::vector<float> cdf_;            // running power, normalised to end at 1
   std::vector<float> probability_;    // per area light: power share / area

@@ -2,6 +2,9 @@
 // against: emission weighted against light sampling by MIS, next-event estimation, one
 // sampled continuation (dielectric or opaque lobe), Russian roulette from depth 3 on. Each
 // hit spawns at most one continuation, so a path is a chain of messages. Runs on any PE.
+// The RenderPlan's effects that are off end the path where the lobe chosen for the next ray
+// belongs to them (counted in TraceStats); the lobe is chosen from the same random numbers as
+// always, so paths of the effects that stay on are unchanged.
 #include <algorithm>
 #include <cmath>
 
@@ -18,11 +21,11 @@ constexpr float kMaxSurvival = 0.95f;
 
 void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
   const IntegratorContext& ctx = context();
-  const ShadingMaterial m = evalMaterial(ctx.scene(), si);
+  const ShadingMaterial m = ctx.material(si, out);
 
   // Emission: full weight for camera rays and after delta events; otherwise MIS against the
   // light sample taken at the previous vertex (power heuristic).
-  const glm::vec3 le = emittedRadiance(m, si);
+  const glm::vec3 le = ctx.emitted(m, si, out);
   if (maxComponent(le) > 0.0f) {
     float weight = 1.0f;
     if (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f) {
@@ -43,10 +46,17 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
   // Choose the part: the dielectric with probability `dielectric` (its selection probability
   // cancels its weight), else the opaque lobes.
   const float lobe = ctx.sample(msg, Dim::kLobe);
+  // A path that arrived by a diffuse or glossy bounce (a non-delta BSDF sample, bsdfPdf > 0)
+  // and continues through an ideal mirror or a refraction is a caustic path (L S+ D E read
+  // from the light).
+  const bool afterRoughBounce = msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f;
+  auto skip = [&](uint64_t TraceStats::*counter) { ++(out.stats().*counter); };
   glm::vec3 wi;
   glm::vec3 throughput;
   float pdf = 0.0f;
   if (lobe < dielectric) {
+    if (!ctx.simulates(scene::Effect::Transmission)) return skip(&TraceStats::transmissionRaysSkipped);
+    if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
     const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
     const float cosI = glm::dot(sf.ns, si.wo);
     const float fr = fresnelDielectric(cosI, eta);
@@ -61,9 +71,19 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
       throughput = msg.throughput * m.baseColor;
     }
   } else {
-    const float u = dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe;
-    const BsdfSample s = sampleOpaque(m, sf.woLocal, std::min(u, kOneMinusEpsilon), ctx.sample(msg, Dim::kBsdfU),
-                                      ctx.sample(msg, Dim::kBsdfV));
+    const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, kOneMinusEpsilon);
+    // The lobe sampleOpaque will take for u (its own test): specular below the probability.
+    if (u < specularProbability(m, sf.woLocal.z)) {
+      if (m.deltaSpecular()) {
+        if (!ctx.simulates(scene::Effect::IdealSpecular)) return skip(&TraceStats::specularRaysSkipped);
+        if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
+      } else if (!ctx.simulates(scene::Effect::GlossySpecular)) {
+        return skip(&TraceStats::glossyRaysSkipped);
+      }
+    } else if (!ctx.simulates(scene::Effect::IndirectDiffuse)) {
+      return skip(&TraceStats::indirectRaysSkipped);
+    }
+    const BsdfSample s = sampleOpaque(m, sf.woLocal, u, ctx.sample(msg, Dim::kBsdfU), ctx.sample(msg, Dim::kBsdfV));
     if (!s.valid) return;
     wi = sf.frame.toWorld(s.wi);
     // A reflection must leave on the side it arrived from (no leaks through the surface).

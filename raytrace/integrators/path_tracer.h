@@ -13,6 +13,12 @@ class PathIntegrator final : public IntegratorBase<PathIntegrator> {
   using IntegratorBase::IntegratorBase;
   std::string_view name() const override { return "path"; }
   void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
+  // Every effect but anisotropy: the BSDF (bsdf.h) is isotropic.
+  scene::EffectSet simulated() const override {
+    scene::EffectSet s = scene::EffectSet::all();
+    s.set(scene::Effect::Anisotropy, false);
+    return s;
+  }
 };
 
 }  // namespace pr::rt

@@ -23,7 +23,7 @@ namespace pr::rt {
 template <class Shader>
 void traceLoop(const Shader& integrator, const scene::Scene& scene, const Bvh& bvh, std::vector<RayMessage>& queue,
                Film& film, TraceStats& stats) {
-  Emit emit(film, queue);
+  Emit emit(film, queue, stats);
   while (!queue.empty()) {
     const RayMessage msg = queue.back();
     queue.pop_back();

@@ -1,7 +1,8 @@
 // Whitted-style shading of one hit (Whitted 1980; seed section 5.1): emission, direct light
 // through shadow rays, an ideal mirror ray for mirror-like metals, and a Fresnel split into
 // reflection and refraction at dielectrics (total internal reflection included). Diffuse and
-// glossy surfaces get direct light only. Runs on the PE holding the message.
+// glossy surfaces get direct light only. Runs on the PE holding the message. The RenderPlan's
+// effects (IntegratorOptions::effects) that are off skip their rays, counted in TraceStats.
 #include <cmath>
 
 #include "raytrace/integrators/whitted.h"
@@ -15,10 +16,10 @@ constexpr float kMinThroughput = 1.0f / 4096.0f;
 
 void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
   const IntegratorContext& ctx = context();
-  const ShadingMaterial m = evalMaterial(ctx.scene(), si);
+  const ShadingMaterial m = ctx.material(si, out);
   // Every ray of a Whitted tracer reaches an emitter only through camera, mirror or
   // refraction paths, which light sampling never covers, so emission counts fully.
-  const glm::vec3 le = emittedRadiance(m, si);
+  const glm::vec3 le = ctx.emitted(m, si, out);
   if (maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= ctx.options().maxDepth) return;
 
@@ -33,7 +34,8 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& ms
     const glm::vec3 t = msg.throughput * f;
     if (maxComponent(t) > kMinThroughput) {
       const glm::vec3 wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-      if (glm::dot(wi, sf.ng) > 0.0f) out.push(ctx.continuation(si, msg, wi, t, 0.0f));
+      if (glm::dot(wi, sf.ng) > 0.0f)
+        ctx.spawn(scene::Effect::IdealSpecular, &TraceStats::specularRaysSkipped, ctx.continuation(si, msg, wi, t, 0.0f), out);
     }
   }
 
@@ -45,11 +47,14 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& ms
     const float fr = fresnelDielectric(cosI, eta);
     const glm::vec3 reflected = 2.0f * cosI * sf.ns - si.wo;
     const glm::vec3 tr = msg.throughput * (dielectric * fr);
-    if (maxComponent(tr) > kMinThroughput) out.push(ctx.continuation(si, msg, glm::normalize(reflected), tr, 0.0f));
+    if (maxComponent(tr) > kMinThroughput)
+      ctx.spawn(scene::Effect::Transmission, &TraceStats::transmissionRaysSkipped,
+                ctx.continuation(si, msg, glm::normalize(reflected), tr, 0.0f), out);
     glm::vec3 wt;
     if (fr < 1.0f && refractDirection(si.wo, sf.ns, eta, wt)) {
       const glm::vec3 tt = msg.throughput * m.baseColor * (dielectric * (1.0f - fr));
-      if (maxComponent(tt) > kMinThroughput) out.push(ctx.continuation(si, msg, wt, tt, 0.0f));
+      if (maxComponent(tt) > kMinThroughput)
+        ctx.spawn(scene::Effect::Transmission, &TraceStats::transmissionRaysSkipped, ctx.continuation(si, msg, wt, tt, 0.0f), out);
     }
   }
 }

@@ -12,6 +12,15 @@ class WhittedIntegrator final : public IntegratorBase<WhittedIntegrator> {
   using IntegratorBase::IntegratorBase;
   std::string_view name() const override { return "whitted"; }
   void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
+  // Diffuse and glossy surfaces get direct light only: no glossy reflection rays, no indirect
+  // diffuse, hence no caustics; the BSDF is isotropic.
+  scene::EffectSet simulated() const override {
+    scene::EffectSet s = scene::EffectSet::all();
+    for (scene::Effect e : {scene::Effect::GlossySpecular, scene::Effect::IndirectDiffuse, scene::Effect::Caustics,
+                            scene::Effect::Anisotropy})
+      s.set(e, false);
+    return s;
+  }
 };
 
 }  // namespace pr::rt

@@ -145,7 +145,7 @@ class ObjectFrame {
   void launch(par::Pe& pe, PeState& st, const RayMessage& m) {
     assignment_.ownersAlong(m.ray, st.owners);
     if (st.owners.empty()) {
-      Emit emit(*films_[size_t(pe.id())], st.spawned);
+      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
       integrator_->miss(m, emit);  // reaches no object: nothing to ask
       return;
     }
@@ -206,7 +206,7 @@ class ObjectFrame {
     const Pending done = p;
     st.freeSlots.push_back(r.slot);
     --st.live;
-    Emit emit(*films_[size_t(pe.id())], st.spawned);
+    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
     if (done.message.kind == RayKind::Shadow) {
       if (!done.best.found) integrator_->miss(done.message, emit);
       return;

@@ -136,7 +136,7 @@ class ObjectSpaceFrame {
       st.spans.push_back(s);
       return true;
     });
-    Emit emit(*films_[size_t(pe.id())], st.spawned);
+    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
     for (size_t k = item.span; k < st.spans.size(); ++k) {
       const uint32_t v = st.spans[k].voxel;
       if (split_.triangles(v).empty()) continue;  // nothing to hit: no owner needs the ray

@@ -45,7 +45,8 @@ struct TraceOptions {
 };
 
 // The rays each PE traced, by kind, put in the run record as the per-PE counters Rays/camera,
-// Rays/continuation and Rays/shadow (the only way the figures leave a tracer, STYLE.md
+// Rays/continuation and Rays/shadow, and the work the RenderPlan skipped as Plan/... counters
+// (Plan/shadow_tests_skipped, ...; trace_stats.h) (the only way the figures leave a tracer, STYLE.md
 // section 4); returns their sum over PEs for TraceResult::rays. On the controlling thread,
 // after the tracer's last stage.
 TraceStats recordRayCounters(par::Runtime& rt, const std::vector<TraceStats>& perPe);
