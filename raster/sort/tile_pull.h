@@ -6,12 +6,11 @@
 #pragma once
 
 #include <cstdint>
-#include <stdexcept>
 #include <string>
-#include <thread>
 #include <utility>
 #include <vector>
 
+#include "common/parallel/await_reply.h"
 #include "common/parallel/channel.h"
 
 namespace pr::raster {
@@ -48,24 +47,9 @@ class TilePull {
     parts[pe.id()] = std::move(bins_[pe.id()][tile]);
     for (int p = 0; p < pes; ++p)
       if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()}, sizeof(Request));
-    std::vector<Item> reply;
-    for (int got = 0; got < pes - 1;) {
-      if (runtime_.aborting())
-        throw std::runtime_error("'" + name_ + "': stage aborted while PE " + std::to_string(pe.id()) +
-                                 " waited for the bins of tile " + std::to_string(tile));
-      if (replies_.tryReceive(pe, reply)) {
-        for (Item& item : reply) parts[pe.id()].push_back(std::move(item));
-        ++got;
-      } else if (requests_.handleOne(pe)) {
-        pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
-        runtime_.outstanding().done();  // this task is still counted, so never the last unit
-      } else {
-        // Waiting for a reply is communication, not work: booked as such, not as busy.
-        const double t0 = runtime_.now();
-        std::this_thread::yield();
-        pe.recordWait(runtime_.now() - t0);
-      }
-    }
+    const std::string what = "'" + name_ + "': the bins of tile " + std::to_string(tile);
+    for (int got = 0; got < pes - 1; ++got)
+      for (Item& item : par::awaitReply(pe, replies_, requests_, what)) parts[pe.id()].push_back(std::move(item));
     return std::move(parts[pe.id()]);
   }
 
