@@ -1,0 +1,543 @@
+// Photon tracing, pass 1 (see photon_tracer.h). The controlling thread builds the emitter
+// table and the projection map, then each batch of photons is one task of stage "photon trace"
+// on whichever PE the schedule picks; a task reads only the Scene and Bvh and writes only its
+// own batch's lists, which the controlling thread concatenates in batch order afterwards.
+#include "photonmap/photon_tracer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "common/parallel/runtime.h"
+#include "raytrace/core/bvh.h"
+#include "raytrace/core/interaction.h"
+#include "raytrace/integrators/bsdf.h"
+#include "raytrace/integrators/integrator.h"
+#include "raytrace/integrators/sampling.h"
+
+namespace pr::pm {
+
+namespace {
+
+using rt::kPi;
+
+// Stream selectors of sample1D(seed, photon, map, depth, dim): depth 0 is emission, depth
+// k + 1 the k-th surface interaction (rt::Dim numbers are reused there).
+constexpr std::uint32_t kGlobalStream = 0, kCausticStream = 1;
+namespace EmitDim {
+constexpr std::uint32_t kPick = 0, kPosU = 1, kPosV = 2, kDirU = 3, kDirV = 4, kTarget = 5;
+}
+
+// glTF KHR_lights_punctual range window and spot falloff, as raytrace/integrators/
+// light_sampler.cpp applies them to direct light (the photons must carry the same light).
+float rangeWindow(float distance, float range) {
+  if (!std::isfinite(range) || range <= 0.0f) return 1.0f;
+  const float r = distance / range;
+  const float w = std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
+  return w * w;
+}
+float spotFactor(const scene::PunctualLight& light, const glm::vec3& dir) {
+  const float cosOuter = std::cos(light.outerConeAngle);
+  const float cosInner = std::cos(light.innerConeAngle);
+  const float scale = 1.0f / std::max(1.0e-3f, cosInner - cosOuter);
+  const float t = std::clamp((glm::dot(light.direction, dir) - cosOuter) * scale, 0.0f, 1.0f);
+  return t * t;
+}
+// int over the sphere of spotFactor: the factor t^2 with t = (c - cosOuter) s, s the scale
+// above, clamped to 1 at c >= cosOuter + 1/s, so 2 pi [ (1 - c1) + (c1 - cosOuter) / 3 ].
+double spotSolidAngle(const scene::PunctualLight& light) {
+  const double cosOuter = std::cos(double(light.outerConeAngle));
+  const double s = 1.0 / std::max(1.0e-3, std::cos(double(light.innerConeAngle)) - cosOuter);
+  const double c1 = std::min(1.0, cosOuter + 1.0 / s);
+  return 2.0 * double(kPi) * ((1.0 - c1) + (c1 - cosOuter) / 3.0);
+}
+
+// A unit direction uniformly inside the cone of half-angle acos(cosMax) around axis.
+glm::vec3 uniformCone(const glm::vec3& axis, float cosMax, float u, float v) {
+  const float c = 1.0f - u * (1.0f - cosMax);
+  const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));
+  const float phi = 2.0f * kPi * v;
+  return rt::Frame(axis).toWorld({s * std::cos(phi), s * std::sin(phi), c});
+}
+glm::vec2 concentricDisc(float u, float v) {
+  const float a = 2.0f * u - 1.0f, b = 2.0f * v - 1.0f;
+  if (a == 0.0f && b == 0.0f) return {0.0f, 0.0f};
+  float r, phi;
+  if (std::fabs(a) > std::fabs(b)) {
+    r = a;
+    phi = (kPi / 4.0f) * (b / a);
+  } else {
+    r = b;
+    phi = kPi / 2.0f - (kPi / 4.0f) * (a / b);
+  }
+  return {r * std::cos(phi), r * std::sin(phi)};
+}
+
+// ---- projection map: bounding spheres of the specular objects --------------------------------
+// Jensen's projection map marks the directions from a light in which specular objects lie.
+// parrender keeps it exact and cell-free: the bounding sphere of every specular object (per
+// object and material) is the target, and a caustic photon's direction is drawn uniformly from
+// the cone a target subtends (for a directional light: from the target's disc on the emission
+// plane), the target picked in proportion to its solid angle (area). A direction inside m
+// overlapping cones has pdf sum_i [inside i] / Omega_total, so its photon carries
+// Phi(direction) Omega_total / (N m) - unbiased for the light that reaches the union of the
+// spheres, with no photon wasted on a cell that is only partly covered.
+struct Target {
+  glm::vec3 centre;
+  float radius;
+};
+
+// A material that can bend light into a caustic: a smooth dielectric part, or an opaque lobe
+// that may be an ideal mirror (conservative for textured roughness, as scene::EffectAnalysis).
+bool canFocus(const scene::Material& m) {
+  const bool textured = m.metallicRoughnessTexture.present();
+  const float roughnessMin = textured ? 0.0f : std::clamp(m.roughnessFactor, 0.0f, 1.0f);
+  const float metallicMin = textured ? 0.0f : std::clamp(m.metallicFactor, 0.0f, 1.0f);
+  const bool dielectric = (m.transmissionFactor > 0.0f || m.transmissionTexture.present()) && metallicMin < 1.0f;
+  return dielectric || roughnessMin < scene::kIdealSpecularRoughness;
+}
+
+std::vector<Target> specularTargets(const scene::Scene& scene) {
+  std::vector<Target> targets;
+  auto addRange = [&](std::uint32_t first, std::uint32_t count) {
+    std::vector<scene::Bounds> byMaterial(scene.materials.size());
+    for (std::uint32_t t = first; t < first + count && t < scene.triangles.size(); ++t) {
+      const scene::Triangle& tri = scene.triangles[t];
+      if (!canFocus(scene.materials[tri.material])) continue;
+      for (std::uint32_t v : tri.v) byMaterial[tri.material].extend(scene.positions[v]);
+    }
+    for (const scene::Bounds& b : byMaterial)
+      if (!b.empty()) {
+        // 0.1 % larger than the box's half diagonal: rounding cannot cut off a silhouette.
+        const float r = 0.5f * glm::length(b.extent());
+        targets.push_back({b.center(), r * 1.001f + 1.0e-6f});
+      }
+  };
+  if (scene.objects.empty()) addRange(0, std::uint32_t(scene.triangles.size()));
+  for (const scene::Object& o : scene.objects) addRange(o.firstTriangle, o.triangleCount);
+  return targets;
+}
+
+// ---- emitters -------------------------------------------------------------------------------
+// One entry per punctual light, and one for all emissive triangles together (sampled by power,
+// as LightSampler does). power: luminance of the emitted flux, used to split the photons.
+struct Emitter {
+  int light = -1;  // index into Scene::lights, -1 = the area lights
+  double power = 0.0;
+};
+
+struct Setup {
+  const scene::Scene* scene;
+  const rt::Bvh* bvh;
+  const PhotonOptions* options;
+  std::vector<Emitter> emitters;
+  std::vector<std::size_t> firstPhoton[2];  // per map: emitter e owns photons [first[e], first[e+1])
+  std::vector<std::uint32_t> areaTriangles;
+  std::vector<float> areaCdf;     // by luminance(emission factor) * area * sides
+  std::vector<float> areaProb;    // pick probability of each area triangle
+  std::vector<Target> targets;
+  glm::vec3 sceneCentre{0.0f};
+  float sceneRadius = 0.0f;
+  bool simulate[2] = {true, true};
+};
+
+bool twoSided(const scene::Material& m) { return m.doubleSided; }
+
+// The photons of one map are split over the emitters in proportion to their power, by largest
+// remainder (the counts sum to n exactly and depend only on the scene).
+std::vector<std::size_t> splitPhotons(const std::vector<double>& power, std::size_t n) {
+  std::vector<std::size_t> first(power.size() + 1, 0);
+  const double total = std::accumulate(power.begin(), power.end(), 0.0);
+  if (!(total > 0.0) || n == 0) return first;
+  std::vector<std::size_t> count(power.size());
+  std::vector<std::pair<double, std::size_t>> rest;
+  std::size_t given = 0;
+  for (std::size_t e = 0; e < power.size(); ++e) {
+    const double exact = double(n) * power[e] / total;
+    count[e] = std::size_t(std::floor(exact));
+    given += count[e];
+    rest.push_back({-(exact - std::floor(exact)), e});
+  }
+  std::sort(rest.begin(), rest.end());
+  for (std::size_t i = 0; given < n && i < rest.size(); ++i, ++given) ++count[rest[i].second];
+  for (std::size_t e = 0; e < power.size(); ++e) first[e + 1] = first[e] + count[e];
+  return first;
+}
+
+// Solid angle a sphere subtends from p (4 pi when p is inside it), and the cone's cosine.
+float coneOf(const Target& t, const glm::vec3& p, float& cosMax, glm::vec3& axis) {
+  const glm::vec3 d = t.centre - p;
+  const float dist2 = glm::dot(d, d);
+  if (dist2 <= t.radius * t.radius) {
+    cosMax = -1.0f;
+    axis = glm::vec3(0, 0, 1);
+    return 4.0f * kPi;
+  }
+  const float dist = std::sqrt(dist2);
+  axis = d / dist;
+  cosMax = std::sqrt(std::max(0.0f, 1.0f - t.radius * t.radius / dist2));
+  return 2.0f * kPi * (1.0f - cosMax);
+}
+
+// A caustic direction from p towards the targets (see the projection map above): returns the
+// weight Omega_total / m, 0 when there is no target.
+float sampleTowardsTargets(const Setup& s, const glm::vec3& p, float pick, float u, float v, glm::vec3& dir) {
+  float total = 0.0f;
+  std::vector<float> omega(s.targets.size());
+  std::vector<float> cosMax(s.targets.size());
+  std::vector<glm::vec3> axis(s.targets.size());
+  for (std::size_t i = 0; i < s.targets.size(); ++i) total += omega[i] = coneOf(s.targets[i], p, cosMax[i], axis[i]);
+  if (!(total > 0.0f)) return 0.0f;
+  std::size_t chosen = s.targets.size() - 1;
+  float running = 0.0f;
+  for (std::size_t i = 0; i < s.targets.size(); ++i) {
+    running += omega[i];
+    if (pick * total < running) {
+      chosen = i;
+      break;
+    }
+  }
+  dir = uniformCone(axis[chosen], cosMax[chosen], u, v);
+  int inside = 0;
+  for (std::size_t i = 0; i < s.targets.size(); ++i)
+    if (cosMax[i] <= -1.0f || glm::dot(dir, axis[i]) >= cosMax[i] * (1.0f - 1.0e-6f)) ++inside;
+  return total / float(std::max(inside, 1));
+}
+
+// Stratified (u, v) of photon j of n: a jittered cell of an m x m grid, m = floor(sqrt(n)).
+glm::vec2 stratified(std::size_t j, std::size_t n, float u, float v) {
+  const std::size_t m = std::max<std::size_t>(1, std::size_t(std::sqrt(double(n))));
+  const std::size_t cell = j % (m * m);
+  return {std::min((float(cell % m) + u) / float(m), rt::kOneMinusEpsilon),
+          std::min((float(cell / m) + v) / float(m), rt::kOneMinusEpsilon)};
+}
+
+struct EmittedPhoton {
+  rt::Ray ray;
+  glm::vec3 power{0.0f};
+  const scene::PunctualLight* light = nullptr;  // for the range window at the first hit
+};
+
+// Photon `index` (global within its map) of emitter e, which owns n photons from `first` on.
+bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhoton& out) {
+  const std::uint64_t seed = s.options->seed;
+  const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, std::uint32_t(index), map, 0, dim); };
+  const std::size_t first = s.firstPhoton[map][e], n = s.firstPhoton[map][e + 1] - first;
+  const std::size_t j = index - first;
+  const glm::vec2 dirUv = stratified(j, n, sample(EmitDim::kDirU), sample(EmitDim::kDirV));
+  const bool caustic = map == kCausticStream;
+  const Emitter& em = s.emitters[e];
+  const scene::Scene& scene = *s.scene;
+  if (em.light >= 0) {
+    const scene::PunctualLight& light = scene.lights[std::size_t(em.light)];
+    const glm::vec3 colour = light.color * light.intensity;
+    out.light = &light;
+    if (light.type == scene::LightType::Directional) {
+      // A disc of the scene's bounding sphere, perpendicular to the light, upstream of it:
+      // flux E pi R^2 (E in lux at normal incidence).
+      const rt::Frame f(light.direction);
+      const glm::vec3 plane = s.sceneCentre - light.direction * (s.sceneRadius * 1.01f);
+      glm::vec3 origin;
+      float area;
+      if (caustic) {
+        // Targets project to discs of their radius on the emission plane.
+        float total = 0.0f;
+        for (const Target& t : s.targets) total += kPi * t.radius * t.radius;
+        if (!(total > 0.0f)) return false;
+        std::size_t chosen = s.targets.size() - 1;
+        float running = 0.0f;
+        for (std::size_t i = 0; i < s.targets.size(); ++i) {
+          running += kPi * s.targets[i].radius * s.targets[i].radius;
+          if (sample(EmitDim::kTarget) * total < running) {
+            chosen = i;
+            break;
+          }
+        }
+        const Target& t = s.targets[chosen];
+        const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * t.radius;
+        const glm::vec3 c = f.toLocal(t.centre - plane);
+        origin = plane + f.toWorld({c.x + d.x, c.y + d.y, 0.0f});
+        int inside = 0;
+        for (const Target& o : s.targets) {
+          const glm::vec3 q = f.toLocal(o.centre - origin);
+          if (q.x * q.x + q.y * q.y <= o.radius * o.radius * 1.000001f) ++inside;
+        }
+        area = total / float(std::max(inside, 1));
+      } else {
+        const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * s.sceneRadius;
+        origin = plane + f.toWorld({d.x, d.y, 0.0f});
+        area = kPi * s.sceneRadius * s.sceneRadius;
+      }
+      out.ray = rt::Ray{origin, 0.0f, light.direction, rt::kInfinity};
+      out.power = colour * area / float(n);
+      out.light = nullptr;
+      return true;
+    }
+    glm::vec3 dir;
+    float solidAngle;
+    if (caustic) {
+      solidAngle = sampleTowardsTargets(s, light.position, sample(EmitDim::kTarget), dirUv.x, dirUv.y, dir);
+      if (!(solidAngle > 0.0f)) return false;
+    } else if (light.type == scene::LightType::Spot) {
+      const float cosOuter = std::cos(light.outerConeAngle);
+      dir = uniformCone(light.direction, cosOuter, dirUv.x, dirUv.y);
+      solidAngle = 2.0f * kPi * (1.0f - cosOuter);
+    } else {
+      dir = uniformCone(glm::vec3(0, 0, 1), -1.0f, dirUv.x, dirUv.y);
+      solidAngle = 4.0f * kPi;
+    }
+    float factor = 1.0f;
+    if (light.type == scene::LightType::Spot) factor = spotFactor(light, dir);
+    out.ray = rt::Ray{light.position, 0.0f, dir, rt::kInfinity};
+    out.power = colour * (factor * solidAngle / float(n));  // I(w) / (N pdf(w)), pdf = 1 / solidAngle
+    return factor > 0.0f;
+  }
+  // Area lights: a triangle by power, a point uniformly on it, a cosine-weighted direction on
+  // its emitting side (flux L cos / (pdf_A pdf_w) = L pi / pdf_A for the cosine lobe). Only the
+  // direction is stratified: stratifying the pick by j as well would tie each triangle to a
+  // band of direction cells.
+  const float pick = sample(EmitDim::kPick);
+  const std::size_t k = std::min(std::size_t(std::upper_bound(s.areaCdf.begin(), s.areaCdf.end(), pick) - s.areaCdf.begin()),
+                                 s.areaCdf.size() - 1);
+  const std::uint32_t tri = s.areaTriangles[k];
+  const scene::Triangle& t = scene.triangles[tri];
+  const glm::vec2 b = rt::uniformTriangle(sample(EmitDim::kPosU), sample(EmitDim::kPosV));
+  const glm::vec3 p0 = scene.positions[t.v[0]], p1 = scene.positions[t.v[1]], p2 = scene.positions[t.v[2]];
+  const glm::vec3 q = (1.0f - b.x - b.y) * p0 + b.x * p1 + b.y * p2;
+  const glm::vec3 cr = glm::cross(p1 - p0, p2 - p0);
+  const float area = 0.5f * glm::length(cr);
+  if (!(area > 0.0f)) return false;
+  const glm::vec3 ng = cr / (2.0f * area);
+  const scene::Material& mat = scene.materials[t.material];
+  // Which side: the front, or either with equal probability when double-sided.
+  const bool sides = twoSided(mat);
+  float u = dirUv.x;
+  glm::vec3 side = ng;
+  if (sides) {
+    if (u < 0.5f) {
+      u *= 2.0f;
+    } else {
+      u = std::min(2.0f * u - 1.0f, rt::kOneMinusEpsilon);
+      side = -ng;
+    }
+  }
+  // The emitter's material at q, textures applied, seen from the emitting side.
+  const rt::SurfaceInteraction si =
+      rt::makeInteraction(scene, rt::Ray{q + side, 0.0f, -side, rt::kInfinity}, rt::Hit{1.0f, tri, b.x, b.y});
+  const glm::vec3 le = rt::evalMaterial(scene, si, s.options->textures).emission;
+  const float pdfArea = s.areaProb[k] / area;
+  glm::vec3 dir;
+  float weight;  // cos / pdf_w over the side's hemisphere
+  if (caustic) {
+    weight = sampleTowardsTargets(s, q, sample(EmitDim::kTarget), u, dirUv.y, dir);
+    weight *= std::max(0.0f, glm::dot(dir, side));
+  } else {
+    dir = rt::Frame(side).toWorld(rt::cosineHemisphere(u, dirUv.y));
+    weight = kPi;
+  }
+  if (!(weight > 0.0f)) return false;
+  out.ray = rt::Ray{rt::spawnOrigin(si, dir), 0.0f, dir, rt::kInfinity};
+  out.power = le * (weight * (sides ? 2.0f : 1.0f) / (pdfArea * float(n)));
+  out.light = nullptr;
+  return rt::maxComponent(out.power) > 0.0f && rt::isFinite(out.power);
+}
+
+// Follows one photon: stores it at every surface with a Lambertian part (global map) or at
+// the first such surface after specular bounces only (caustic map), then continues by
+// Russian roulette over the BSDF's parts until absorbed.
+void trace(const Setup& s, int map, std::uint32_t index, EmittedPhoton photon, std::vector<Photon>& store) {
+  const scene::Scene& scene = *s.scene;
+  const bool caustic = map == kCausticStream;
+  const std::uint64_t seed = s.options->seed;
+  rt::Ray ray = photon.ray;
+  glm::vec3 power = photon.power;
+  for (int bounce = 0; bounce < s.options->maxBounces; ++bounce) {
+    rt::Hit hit;
+    if (!s.bvh->intersect(ray, hit)) return;
+    const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
+    if (bounce == 0 && photon.light) power *= rangeWindow(hit.t * glm::length(ray.direction), photon.light->range);
+    const rt::ShadingMaterial m = rt::evalMaterial(scene, si, s.options->textures);
+    const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
+
+    // Storage: the photon's incident flux wherever the surface has a diffuse part.
+    if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
+      if (caustic) {
+        if (bounce > 0) store.push_back(Photon::make(si.position, power, si.wo, PhotonMapKind::Caustic, bounce));
+        return;  // a caustic path ends at its first diffuse surface
+      }
+      store.push_back(Photon::make(si.position, power, si.wo, PhotonMapKind::Global, bounce));
+    }
+
+    // Choose the part like the path tracer: the dielectric with probability equal to its
+    // weight, reflection against refraction by the Fresnel term, else the opaque lobes by
+    // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
+    // left, f cos / pdf, is the part's albedo along the sampled direction.
+    const rt::ShadingFrame sf(si);
+    const float dielectric = m.dielectricWeight();
+    const float opaque = 1.0f - dielectric;
+    const float lobe = sample(rt::Dim::kLobe);
+    glm::vec3 wi, factor;
+    bool specular;
+    if (lobe < dielectric) {
+      const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+      const float cosI = glm::dot(sf.ns, si.wo);
+      const float fr = rt::fresnelDielectric(cosI, eta);
+      glm::vec3 wt;
+      if (lobe / dielectric < fr || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
+        wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+        factor = glm::vec3(1.0f);
+      } else {
+        wi = wt;
+        factor = m.baseColor;  // flux is conserved through refraction: no eta^2 (that is radiance)
+      }
+      specular = true;
+    } else {
+      const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, rt::kOneMinusEpsilon);
+      const rt::BsdfSample b = rt::sampleOpaque(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));
+      if (!b.valid) return;
+      wi = sf.frame.toWorld(b.wi);
+      if (glm::dot(wi, sf.ng) <= 0.0f) return;  // a reflection leaves on the side it arrived from
+      factor = b.weight;
+      specular = b.delta;
+    }
+    if (caustic && !specular) return;  // glossy or diffuse: no longer an L S+ D path
+
+    // Absorption by Russian roulette (Jensen): survive with q = the largest channel of the
+    // factor (capped at 1), and carry power * factor / q, so E[power'] = power * factor.
+    // For a Lambertian surface of albedo rho this is Jensen's rule: survive with rho, keep Phi.
+    const float q = std::min(1.0f, rt::maxComponent(factor));
+    if (!(q > 0.0f) || sample(rt::Dim::kRoulette) >= q) return;
+    power *= factor / q;
+    if (!(rt::maxComponent(power) > 0.0f) || !rt::isFinite(power)) return;
+    ray = rt::spawnRay(si, wi);
+  }
+}
+
+Setup makeSetup(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptions& options) {
+  Setup s{&scene, &bvh, &options, {}, {}, {}, {}, {}, {}, {}, 0.0f, {true, true}};
+  scene::Bounds bounds = scene.bounds;
+  if (bounds.empty())
+    for (const glm::vec3& p : scene.positions) bounds.extend(p);
+  s.sceneCentre = bounds.center();
+  s.sceneRadius = std::max(0.5f * glm::length(bounds.extent()), 1.0e-6f);
+  s.targets = specularTargets(scene);
+
+  std::vector<double> causticPower;
+  for (std::size_t i = 0; i < scene.lights.size(); ++i) {
+    const scene::PunctualLight& l = scene.lights[i];
+    const double lum = double(rt::luminance(glm::max(l.color * l.intensity, glm::vec3(0.0f))));
+    double power = 0.0;
+    switch (l.type) {
+      case scene::LightType::Point: power = 4.0 * double(kPi) * lum; break;
+      case scene::LightType::Spot: power = spotSolidAngle(l) * lum; break;
+      case scene::LightType::Directional: power = double(kPi) * s.sceneRadius * s.sceneRadius * lum; break;
+    }
+    if (!(power > 0.0) || !std::isfinite(power)) continue;
+    s.emitters.push_back({int(i), power});
+  }
+  double areaPower = 0.0;
+  std::vector<double> triPower;
+  for (const scene::AreaLight& a : scene.areaLights) {
+    if (a.triangle >= scene.triangles.size() || !(a.area > 0.0f) || !std::isfinite(a.area)) continue;
+    const scene::Material& m = scene.materials[scene.triangles[a.triangle].material];
+    const double p = double(rt::luminance(glm::max(m.emission(), glm::vec3(0.0f)))) * a.area * double(kPi) *
+                     (m.doubleSided ? 2.0 : 1.0);
+    if (!(p > 0.0) || !std::isfinite(p)) continue;
+    s.areaTriangles.push_back(a.triangle);
+    triPower.push_back(p);
+    areaPower += p;
+  }
+  double running = 0.0;
+  for (std::size_t i = 0; i < triPower.size(); ++i) {
+    running += triPower[i];
+    s.areaCdf.push_back(i + 1 == triPower.size() ? 1.0f : float(running / areaPower));
+    s.areaProb.push_back(float(triPower[i] / areaPower));
+  }
+  if (areaPower > 0.0) s.emitters.push_back({-1, areaPower});
+
+  // The caustic photons are split by the power each emitter sends towards the targets (the
+  // projection map's solid angle fraction), so each carries about the same flux.
+  std::vector<double> power;
+  for (const Emitter& e : s.emitters) {
+    power.push_back(e.power);
+    double fraction = 0.0;
+    if (!s.targets.empty()) {
+      if (e.light >= 0 && scene.lights[std::size_t(e.light)].type == scene::LightType::Directional) {
+        for (const Target& t : s.targets) fraction += double(t.radius * t.radius) / double(s.sceneRadius * s.sceneRadius);
+      } else {
+        const glm::vec3 p = e.light >= 0 ? scene.lights[std::size_t(e.light)].position : s.sceneCentre;
+        for (const Target& t : s.targets) {
+          float c;
+          glm::vec3 axis;
+          fraction += double(coneOf(t, p, c, axis)) / (4.0 * double(kPi));
+        }
+        if (e.light < 0) fraction = std::max(fraction, 1.0e-3);  // area lights: a rough share, never zero
+      }
+    }
+    causticPower.push_back(e.power * std::min(fraction, 1.0));
+  }
+  if (options.plan) {
+    s.simulate[kGlobalStream] = options.plan->on(scene::Effect::IndirectDiffuse);
+    s.simulate[kCausticStream] = options.plan->on(scene::Effect::Caustics);
+  }
+  if (s.targets.empty()) s.simulate[kCausticStream] = false;
+  s.firstPhoton[kGlobalStream] = splitPhotons(power, s.simulate[kGlobalStream] ? options.globalPhotons : 0);
+  s.firstPhoton[kCausticStream] = splitPhotons(causticPower, s.simulate[kCausticStream] ? options.causticPhotons : 0);
+  return s;
+}
+
+}  // namespace
+
+PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptions& options,
+                             par::Runtime& runtime) {
+  const Setup s = makeSetup(scene, bvh, options);
+  PhotonLists out;
+  const std::size_t emitted[2] = {s.firstPhoton[kGlobalStream].back(), s.firstPhoton[kCausticStream].back()};
+  out.stats.globalEmitted = emitted[kGlobalStream];
+  out.stats.causticEmitted = emitted[kCausticStream];
+  out.stats.globalSkipped = options.globalPhotons - emitted[kGlobalStream];
+  out.stats.causticSkipped = options.causticPhotons - emitted[kCausticStream];
+  out.stats.causticTargets = s.targets.size();
+
+  // Batches: the global map's first, then the caustic map's; a batch never mixes maps.
+  const std::size_t batch = std::max<std::size_t>(1, options.batchSize);
+  const std::size_t batches[2] = {(emitted[0] + batch - 1) / batch, (emitted[1] + batch - 1) / batch};
+  const std::size_t tasks = batches[0] + batches[1];
+  out.stats.tasks = tasks;
+  std::vector<std::vector<Photon>> lists(tasks);
+  if (tasks > 0) {
+    runtime.runStage("photon trace", par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId t) {
+      const std::size_t task = std::size_t(t);
+      const int map = task < batches[0] ? kGlobalStream : kCausticStream;
+      const std::size_t b = map == kGlobalStream ? task : task - batches[0];
+      const std::size_t begin = b * batch, end = std::min(emitted[map], begin + batch);
+      const std::vector<std::size_t>& first = s.firstPhoton[map];
+      std::vector<Photon>& store = lists[task];
+      std::size_t e = std::size_t(std::upper_bound(first.begin(), first.end(), begin) - first.begin()) - 1;
+      for (std::size_t i = begin; i < end; ++i) {
+        while (i >= first[e + 1]) ++e;
+        EmittedPhoton photon;
+        if (emit(s, map, e, i, photon)) trace(s, map, std::uint32_t(i), photon, store);
+      }
+    });
+  }
+  for (std::size_t t = 0; t < tasks; ++t) {
+    std::vector<Photon>& dst = t < batches[0] ? out.global : out.caustic;
+    dst.insert(dst.end(), lists[t].begin(), lists[t].end());
+  }
+  out.stats.globalStored = out.global.size();
+  out.stats.causticStored = out.caustic.size();
+  return out;
+}
+
+PhotonMaps tracePhotons(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptions& options,
+                        par::Runtime& runtime) {
+  PhotonLists lists = tracePhotonLists(scene, bvh, options, runtime);
+  PhotonMaps maps;
+  maps.stats = lists.stats;
+  maps.global = KdTree::build(std::move(lists.global), runtime);
+  maps.caustic = KdTree::build(std::move(lists.caustic), runtime);
+  return maps;
+}
+
+}  // namespace pr::pm
