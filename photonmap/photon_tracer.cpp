@@ -5,6 +5,7 @@
 #include "photonmap/photon_tracer.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numeric>
 
@@ -505,8 +506,10 @@ PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, cons
   const std::size_t tasks = batches[0] + batches[1];
   out.stats.tasks = tasks;
   std::vector<std::vector<Photon>> lists(tasks);
+  // Per PE, for the run record: photons emitted and stored, by map (each PE writes its own row).
+  std::vector<std::array<std::uint64_t, 4>> perPe(std::size_t(runtime.pes()), std::array<std::uint64_t, 4>{});
   if (tasks > 0) {
-    runtime.runStage("photon trace", par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId t) {
+    runtime.runStage("photon trace", par::TaskSet::uniform(tasks), [&](par::Pe& pe, par::TaskId t) {
       const std::size_t task = std::size_t(t);
       const int map = task < batches[0] ? kGlobalStream : kCausticStream;
       const std::size_t b = map == kGlobalStream ? task : task - batches[0];
@@ -519,8 +522,22 @@ PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, cons
         EmittedPhoton photon;
         if (emit(s, map, e, i, photon)) trace(s, map, std::uint32_t(i), photon, store);
       }
+      std::array<std::uint64_t, 4>& row = perPe[std::size_t(pe.id())];
+      row[map == kGlobalStream ? 0 : 1] += end - begin;
+      row[map == kGlobalStream ? 2 : 3] += store.size();
     });
   }
+  // The figures leave the tracer as run-record counters (STYLE.md section 4). Photons not traced
+  // at all are the controller's decision: booked on PE 0.
+  for (int p = 0; p < runtime.pes(); ++p) {
+    const std::array<std::uint64_t, 4>& row = perPe[std::size_t(p)];
+    runtime.addCounter("Photons/global_emitted", p, double(row[0]));
+    runtime.addCounter("Photons/caustic_emitted", p, double(row[1]));
+    runtime.addCounter("Photons/global_stored", p, double(row[2]));
+    runtime.addCounter("Photons/caustic_stored", p, double(row[3]));
+  }
+  runtime.addCounter("Photons/global_skipped", 0, double(out.stats.globalSkipped));
+  runtime.addCounter("Photons/caustic_skipped", 0, double(out.stats.causticSkipped));
   for (std::size_t t = 0; t < tasks; ++t) {
     std::vector<Photon>& dst = t < batches[0] ? out.global : out.caustic;
     dst.insert(dst.end(), lists[t].begin(), lists[t].end());

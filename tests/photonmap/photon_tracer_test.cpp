@@ -239,6 +239,18 @@ TEST_CASE("PhotonTracer: the maps are the same photons in the same order for eve
     const pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
     CHECK(sameBytes(lists.global, reference.global));
     CHECK(sameBytes(lists.caustic, reference.caustic));
+    // The run record's per-PE counters add up to the maps' figures.
+    auto total = [&](const char* name) {
+      double sum = 0.0;
+      for (const par::CounterRecord& c : runtime.record().counters)
+        if (c.name == name)
+          for (double v : c.perPe) sum += v;
+      return sum;
+    };
+    CHECK(total("Photons/global_emitted") == double(lists.stats.globalEmitted));
+    CHECK(total("Photons/caustic_emitted") == double(lists.stats.causticEmitted));
+    CHECK(total("Photons/global_stored") == double(lists.global.size()));
+    CHECK(total("Photons/caustic_stored") == double(lists.caustic.size()));
   }
   // The kd-trees built from them agree too.
   par::Runtime two(2, "spiral");
