@@ -29,21 +29,6 @@ namespace EmitDim {
 constexpr std::uint32_t kPick = 0, kPosU = 1, kPosV = 2, kDirU = 3, kDirV = 4, kTarget = 5;
 }
 
-// glTF KHR_lights_punctual range window and spot falloff, as raytrace/integrators/
-// light_sampler.cpp applies them to direct light (the photons must carry the same light).
-float rangeWindow(float distance, float range) {
-  if (!std::isfinite(range) || range <= 0.0f) return 1.0f;
-  const float r = distance / range;
-  const float w = std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
-  return w * w;
-}
-float spotFactor(const scene::PunctualLight& light, const glm::vec3& dir) {
-  const float cosOuter = std::cos(light.outerConeAngle);
-  const float cosInner = std::cos(light.innerConeAngle);
-  const float scale = 1.0f / std::max(1.0e-3f, cosInner - cosOuter);
-  const float t = std::clamp((glm::dot(light.direction, dir) - cosOuter) * scale, 0.0f, 1.0f);
-  return t * t;
-}
 // int over the sphere of spotFactor: the factor t^2 with t = (c - cosOuter) s, s the scale
 // above, clamped to 1 at c >= cosOuter + 1/s, so 2 pi [ (1 - c1) + (c1 - cosOuter) / 3 ].
 double spotSolidAngle(const scene::PunctualLight& light) {
@@ -288,7 +273,7 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
       solidAngle = 4.0f * kPi;
     }
     float factor = 1.0f;
-    if (light.type == scene::LightType::Spot) factor = spotFactor(light, dir);
+    if (light.type == scene::LightType::Spot) factor = scene::spotFactor(light, dir);
     out.ray = rt::Ray{light.position, 0.0f, dir, rt::kInfinity};
     out.power = colour * (factor * solidAngle / float(n));  // I(w) / (N pdf(w)), pdf = 1 / solidAngle
     return factor > 0.0f;
@@ -356,7 +341,7 @@ void trace(const Setup& s, int map, std::uint32_t index, EmittedPhoton photon, s
     rt::Hit hit;
     if (!s.bvh->intersect(ray, hit)) return;
     const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
-    if (bounce == 0 && photon.light) power *= rangeWindow(hit.t * glm::length(ray.direction), photon.light->range);
+    if (bounce == 0 && photon.light) power *= scene::rangeWindow(hit.t * glm::length(ray.direction), photon.light->range);
     const rt::ShadingMaterial m = rt::evalMaterial(scene, si, s.options->textures);
     const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 

@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 
 namespace pr::test {
@@ -33,6 +34,15 @@ inline std::filesystem::path scratchDir(const std::string& name) {
   std::filesystem::create_directories(dir);
   return dir;
 }
+
+// Concatenates with append: GCC 12 warns (-Wrestrict, falsely) on chains of literal + std::string.
+inline std::string join(std::initializer_list<std::string> parts) {
+  std::string out;
+  for (const std::string& p : parts) out.append(p);
+  return out;
+}
+// A path in double quotes, for a runParrender command line.
+inline std::string quoted(const std::filesystem::path& p) { return join({"\"", p.string(), "\""}); }
 
 struct CommandResult {
   int exitStatus = -1;

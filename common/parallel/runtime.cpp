@@ -90,8 +90,7 @@ void Runtime::runStage(std::string_view name, const TaskSet& tasks, const TaskFn
 
 void Runtime::runPinned(std::string_view name, const TaskSet& tasks, std::vector<int> owner, const TaskFn& work) {
   const std::unique_ptr<Scheduler> pinned = makeOwnerPinnedScheduler(owner);
-  pinnedOwners_ = std::move(owner);
-  runStage(name, tasks, *pinned, work);
+  runStage(name, tasks, *pinned, work, std::move(owner));
 }
 
 void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work) {
@@ -297,7 +296,12 @@ void Runtime::peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage,
   }
 }
 
-void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work) {
+void Runtime::runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work) {
+  runStage(name, tasks, scheduler, work, {});
+}
+
+void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work,
+                       std::vector<int> owners) {
   PR_CHECK(!inStage_, "runStage is called by the controlling thread, not from inside a stage");
   const int pes = options_.pes;
   const std::string name(nameView);
@@ -319,8 +323,6 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   error_ = nullptr;
   outstanding_.reset(static_cast<std::int64_t>(tasks.size()));
   scheduler.reset(tasks, pes, options_.params);
-  std::vector<int> owners = std::move(pinnedOwners_);
-  pinnedOwners_.clear();
 
   if (workers_.empty()) startWorkers();
   inStage_ = true;

@@ -159,6 +159,9 @@ class Runtime {
     const std::string* name = nullptr;
   };
 
+  // owners: the PE of each task of an owner-pinned stage (kept in the record), else empty.
+  void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work,
+                std::vector<int> owners);
   void startWorkers();
   void workerMain(int p);
   void peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name);
@@ -195,7 +198,6 @@ class Runtime {
   std::atomic<int> running_{0};
   bool shutdown_ = false;
   StageJob job_;
-  std::vector<int> pinnedOwners_;  // owners of the next stage's tasks, when runPinned runs it
 
   std::mutex counterMutex_;
   std::mutex errorMutex_;

@@ -5,6 +5,8 @@
 // nits (cd/m^2). Irradiance from a point light is intensity / d^2 lux.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <string>
@@ -28,6 +30,26 @@ struct PunctualLight {
   float innerConeAngle = 0.0f;         // radians (spot)
   float outerConeAngle = 0.7853982f;   // radians, pi/4 default (spot)
 };
+
+// KHR_lights_punctual's recommended range window: clamp(1 - (d / range)^4, 0, 1)^2, smooth to
+// zero at `range`; 1 for an infinite or unset range. Multiplies the inverse-square falloff.
+// The one definition both families and the photon tracer light with.
+inline float rangeWindow(float distance, float range) {
+  if (!std::isfinite(range) || range <= 0.0f) return 1.0f;
+  const float r = distance / range;
+  const float w = std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
+  return w * w;
+}
+
+// KHR_lights_punctual spot attenuation along the unit direction `towardsPoint` (from the light):
+// t^2 with t rising linearly in the cosine from the outer cone (0) to the inner one (1).
+inline float spotFactor(const PunctualLight& light, const glm::vec3& towardsPoint) {
+  const float cosOuter = std::cos(light.outerConeAngle);
+  const float cosInner = std::cos(light.innerConeAngle);
+  const float scale = 1.0f / std::max(1.0e-3f, cosInner - cosOuter);
+  const float t = std::clamp((glm::dot(light.direction, towardsPoint) - cosOuter) * scale, 0.0f, 1.0f);
+  return t * t;
+}
 
 // An emissive triangle used as an area light (its emission comes from its material).
 struct AreaLight {

@@ -55,20 +55,9 @@ bool incidentLight(const scene::PunctualLight& light, glm::vec3 p, glm::vec3& L,
   if (!(d2 > 0.0f)) return false;
   float d = std::sqrt(d2);
   L = toLight / d;
-  // Inverse-square falloff with the extension's recommended range window.
-  float attenuation = 1.0f / d2;
-  if (std::isfinite(light.range) && light.range > 0.0f) {
-    float r = d / light.range;
-    attenuation *= std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
-  }
-  if (light.type == scene::LightType::Spot) {
-    // Smooth falloff between the cones (the extension's reference implementation).
-    float cosOuter = std::cos(light.outerConeAngle);
-    float cosInner = std::cos(light.innerConeAngle);
-    float scale = 1.0f / std::max(0.001f, cosInner - cosOuter);
-    float t = std::clamp((glm::dot(-L, light.direction) - cosOuter) * scale, 0.0f, 1.0f);
-    attenuation *= t * t;
-  }
+  // Inverse-square falloff with the extension's range window and spot cone (common/scene/light.h).
+  float attenuation = scene::rangeWindow(d, light.range) / d2;
+  if (light.type == scene::LightType::Spot) attenuation *= scene::spotFactor(light, -L);
   E = light.color * (light.intensity * attenuation);
   return attenuation > 0.0f;
 }

@@ -13,22 +13,6 @@ namespace pr::rt {
 namespace {
 constexpr uint32_t kNotALight = ~0u;
 
-// glTF KHR_lights_punctual recommended range window: smooth to zero at `range`.
-float rangeWindow(float distance, float range) {
-  if (!std::isfinite(range) || range <= 0.0f) return 1.0f;
-  const float r = distance / range;
-  const float w = std::clamp(1.0f - r * r * r * r, 0.0f, 1.0f);
-  return w * w;
-}
-
-// glTF KHR_lights_punctual spot attenuation: smooth between the outer and inner cone.
-float spotFactor(const scene::PunctualLight& light, const glm::vec3& towardsPoint) {
-  const float cosOuter = std::cos(light.outerConeAngle);
-  const float cosInner = std::cos(light.innerConeAngle);
-  const float scale = 1.0f / std::max(1.0e-3f, cosInner - cosOuter);
-  const float t = std::clamp((glm::dot(light.direction, towardsPoint) - cosOuter) * scale, 0.0f, 1.0f);
-  return t * t;
-}
 }  // namespace
 
 LightSampler::LightSampler(const scene::Scene& scene, bool textures)
@@ -71,8 +55,8 @@ bool LightSampler::samplePunctual(const scene::PunctualLight& light, const Surfa
   if (!(d2 > 0.0f) || !std::isfinite(d2)) return false;  // the point sits on the light
   const float d = std::sqrt(d2);
   out.wi = toLight / d;
-  float factor = rangeWindow(d, light.range) / d2;  // inverse-square law, I / d^2
-  if (light.type == scene::LightType::Spot) factor *= spotFactor(light, -out.wi);
+  float factor = scene::rangeWindow(d, light.range) / d2;  // inverse-square law, I / d^2
+  if (light.type == scene::LightType::Spot) factor *= scene::spotFactor(light, -out.wi);
   if (!(factor > 0.0f) || !std::isfinite(factor)) return false;
   out.radiance = colour * factor;
   out.pdf = 0.0f;

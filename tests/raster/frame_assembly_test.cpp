@@ -83,32 +83,13 @@ TEST_CASE("FrameAssembly: static tiles send every tile PE 1 owns, one message ea
   }
 }
 
-struct CornellRow {
-  const char* method;
-  RegionStrategy regions;
-  const char* compositor;
-  bool sparse;
-};
-constexpr CornellRow kCornellRows[] = {
-    {"sort-first", RegionStrategy::StaticStrips, "direct-send", false},
-    {"sort-first", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-first", RegionStrategy::Dynamic, "direct-send", false},
-    {"sort-middle", RegionStrategy::StaticStrips, "direct-send", false},
-    {"sort-middle", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-middle", RegionStrategy::Dynamic, "direct-send", false},
-    {"sort-last", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-last", RegionStrategy::StaticTiles, "direct-send", true},
-    {"sort-last", RegionStrategy::StaticTiles, "binary-swap", false},
-    {"sort-last", RegionStrategy::StaticTiles, "binary-swap", true},
-};
-
 TEST_CASE("FrameAssembly: the Cornell box at P = 2 sends results for every sort point; P = 1 moves no bytes") {
   setQuiet(true);
   const scene::Scene s = scene::loadGltf(test::sourceDir() / "scenes" / "cornell.gltf");
   const int w = 64, h = 48;
   const FrameView view = makeFrameView(scene::selectCamera(s, "", float(w) / h), w, h);
   const RegionFramebuffer reference = renderSequential(s, view);
-  for (const CornellRow& row : kCornellRows) {
+  for (const test::SortRow& row : test::kSortRows) {
     CAPTURE(row.method);
     CAPTURE(regionStrategyName(row.regions));
     CAPTURE(row.compositor);

@@ -13,15 +13,11 @@
 
 #include "test_support.h"
 
+using pr::test::join;
+using pr::test::quoted;
 using pr::test::runParrender;
 
 namespace {
-std::string join(std::initializer_list<std::string> parts) {
-  std::string out;
-  for (const std::string& p : parts) out.append(p);
-  return out;
-}
-std::string quoted(const std::filesystem::path& p) { return join({"\"", p.string(), "\""}); }
 std::string bundled(const char* file) { return quoted(pr::test::sourceDir() / "scenes" / file); }
 bool contains(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
 }  // namespace

@@ -11,16 +11,11 @@
 #include "raytrace/integrators/integrator.h"
 #include "test_support.h"
 
+using pr::test::join;
+using pr::test::quoted;
 using pr::test::runParrender;
 
 namespace {
-// Joins with append: GCC 12 warns (-Wrestrict, falsely) on chains of literal + std::string.
-std::string join(std::initializer_list<std::string> parts) {
-  std::string out;
-  for (const std::string& p : parts) out.append(p);
-  return out;
-}
-std::string quoted(const std::filesystem::path& p) { return join({"\"", p.string(), "\""}); }
 std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 }  // namespace
 

@@ -23,27 +23,9 @@ namespace {
 
 constexpr int kW = 64, kH = 48;
 
-struct Row {
-  const char* method;
-  RegionStrategy regions;
-  const char* compositor;
-  bool sparse;
-};
-
-// Bit-identical rows: the depth key decides every pixel from the set of its fragments alone
-// (depth_resolve.h), and shading depends only on (triangle, pixel), so no row has a tolerance.
-const Row kRows[] = {
-    {"sort-first", RegionStrategy::StaticStrips, "direct-send", false},
-    {"sort-first", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-first", RegionStrategy::Dynamic, "direct-send", false},
-    {"sort-middle", RegionStrategy::StaticStrips, "direct-send", false},
-    {"sort-middle", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-middle", RegionStrategy::Dynamic, "direct-send", false},
-    {"sort-last", RegionStrategy::StaticTiles, "direct-send", false},
-    {"sort-last", RegionStrategy::StaticTiles, "direct-send", true},
-    {"sort-last", RegionStrategy::StaticTiles, "binary-swap", false},  // P a power of two only
-    {"sort-last", RegionStrategy::StaticTiles, "binary-swap", true},
-};
+// Bit-identical rows (test::kSortRows): the depth key decides every pixel from the set of its
+// fragments alone (depth_resolve.h), and shading depends only on (triangle, pixel), so no row
+// has a tolerance.
 
 // only / strategy: run the rows of this method and region assignment alone (empty: all), to
 // keep big scenes under a second per test case.
@@ -52,7 +34,7 @@ void checkScene(const scene::Scene& s, const FrameView& view, const std::string&
   for (int pes : {1, 2, 3, 4, 7, 8}) {
     // Small batches and tiles so that every PE gets primitives and regions.
     const uint32_t batch = std::max<uint32_t>(1, uint32_t(s.triangles.size() / (2 * pes) + 1));
-    for (const Row& row : kRows) {
+    for (const test::SortRow& row : test::kSortRows) {
       if (!only.empty() && only != row.method) continue;
       if (strategy && row.regions != *strategy) continue;
       if (std::string(row.compositor) == "binary-swap" && !std::has_single_bit(unsigned(pes))) continue;

@@ -1,5 +1,6 @@
-// Helpers for the sort-point tests: the hand-checked three-triangle scene and sums over the
-// runtime's run record (stage traffic, channel traffic by kind or name, named counters).
+// Helpers for the sort-point tests: the table of sort-point configurations, the hand-checked
+// three-triangle scene and sums over the runtime's run record (stage traffic, channel traffic
+// by kind or name, named counters).
 #pragma once
 
 #include <cstdint>
@@ -8,9 +9,31 @@
 
 #include "common/parallel/runtime.h"
 #include "raster/raster_test_scenes.h"
+#include "raster/sort/region_assignment.h"
 #include "raster/stages/geometry.h"
 
 namespace pr::test {
+
+// Every sort point with every region assignment or compositor it takes: the rows of the
+// equivalence table and of the result-traffic checks.
+struct SortRow {
+  const char* method;
+  raster::RegionStrategy regions;
+  const char* compositor;
+  bool sparse;
+};
+inline constexpr SortRow kSortRows[] = {
+    {"sort-first", raster::RegionStrategy::StaticStrips, "direct-send", false},
+    {"sort-first", raster::RegionStrategy::StaticTiles, "direct-send", false},
+    {"sort-first", raster::RegionStrategy::Dynamic, "direct-send", false},
+    {"sort-middle", raster::RegionStrategy::StaticStrips, "direct-send", false},
+    {"sort-middle", raster::RegionStrategy::StaticTiles, "direct-send", false},
+    {"sort-middle", raster::RegionStrategy::Dynamic, "direct-send", false},
+    {"sort-last", raster::RegionStrategy::StaticTiles, "direct-send", false},
+    {"sort-last", raster::RegionStrategy::StaticTiles, "direct-send", true},
+    {"sort-last", raster::RegionStrategy::StaticTiles, "binary-swap", false},  // P a power of two only
+    {"sort-last", raster::RegionStrategy::StaticTiles, "binary-swap", true},
+};
 
 // 16 x 16 pixels through pixelOrthoCamera (pixel row j has its sample at world y = 7.5 - j).
 // Triangle 0 covers rows 2..5 only (top strip), triangle 1 rows 10..13 only (bottom strip),

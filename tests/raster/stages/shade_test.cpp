@@ -129,11 +129,12 @@ TEST_CASE("Shade: point lights fall off with the inverse square and the range wi
   // Same directions (V = L = N), so the ratio is exactly the inverse square law.
   CHECK(near(at1, 4.0f * at2, 1e-5f));
   CHECK(near(at1, 10.0f * evalBrdf(glm::vec3(1.0f), 0.0f, 1.0f, sp.normal, sp.normal, sp.normal), 1e-5f));
-  // Beyond its range a light contributes nothing; at half range the window is 1 - (1/2)^4.
+  // Beyond its range a light contributes nothing; at half range the window is (1 - (1/2)^4)^2,
+  // the same window the ray tracers apply.
   ctx.lights[0].range = 1.5f;
   CHECK(shadeSurface(ctx, sp) == glm::vec3(0.0f));
   ctx.lights[0].range = 4.0f;
-  CHECK(near(shadeSurface(ctx, sp), at2 * (1.0f - 1.0f / 16.0f), 1e-5f));
+  CHECK(near(shadeSurface(ctx, sp), at2 * (1.0f - 1.0f / 16.0f) * (1.0f - 1.0f / 16.0f), 1e-5f));
 }
 
 TEST_CASE("Shade: double-sided back faces are lit on the viewer's side, emission adds") {
