@@ -462,10 +462,8 @@ Setup makeSetup(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptio
     }
     causticPower.push_back(e.power * std::min(fraction, 1.0));
   }
-  if (options.plan) {
-    s.simulate[kGlobalStream] = options.plan->on(scene::Effect::IndirectDiffuse);
-    s.simulate[kCausticStream] = options.plan->on(scene::Effect::Caustics);
-  }
+  s.simulate[kGlobalStream] = options.effects.has(scene::Effect::IndirectDiffuse);
+  s.simulate[kCausticStream] = options.effects.has(scene::Effect::Caustics);
   if (s.targets.empty()) s.simulate[kCausticStream] = false;
   s.firstPhoton[kGlobalStream] = splitPhotons(power, s.simulate[kGlobalStream] ? options.globalPhotons : 0);
   s.firstPhoton[kCausticStream] = splitPhotons(causticPower, s.simulate[kCausticStream] ? options.causticPhotons : 0);

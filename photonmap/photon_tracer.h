@@ -32,10 +32,10 @@ struct PhotonOptions {
   std::size_t batchSize = 4096;         // photons per task (the task granularity)
   int maxBounces = 64;                  // safety cap on a path; roulette ends paths long before
   bool textures = true;                 // emissive and surface textures (the plan's textures)
-  // The effects to simulate; null = everything. Caustics off: no caustic photon is traced.
+  // The effects to simulate (the RenderPlan's). Caustics off: no caustic photon is traced.
   // Indirect off: no global photon is traced (pass 2 reads the global map only for indirect
   // diffuse light).
-  const scene::RenderPlan* plan = nullptr;
+  scene::EffectSet effects = scene::EffectSet::all();
 };
 
 // What pass 1 did, for the run record and the tests.

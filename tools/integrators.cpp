@@ -6,16 +6,18 @@
 namespace pr::cli {
 
 namespace {
-rt::IntegratorRegistry assemble() {
+rt::IntegratorRegistry assemble(const pm::PhotonMapSettings& photonmap) {
   rt::IntegratorRegistry registry = rt::builtinIntegrators();
-  // Integrators of photonmap are added here, e.g. registry.add(pm::photonMapIntegrator()).
+  registry.add(pm::photonMapIntegratorEntry(photonmap));
   return registry;
 }
 }  // namespace
 
 const rt::IntegratorRegistry& integrators() {
-  static const rt::IntegratorRegistry kIntegrators = assemble();
+  static const rt::IntegratorRegistry kIntegrators = assemble({});
   return kIntegrators;
 }
+
+rt::IntegratorRegistry integrators(const pm::PhotonMapSettings& photonmap) { return assemble(photonmap); }
 
 }  // namespace pr::cli

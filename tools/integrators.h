@@ -4,10 +4,14 @@
 // libraries further down the link order (photonmap), one add() line each in integrators.cpp.
 #pragma once
 
+#include "photonmap/photon_map_integrator.h"
 #include "raytrace/integrators/integrator.h"
 
 namespace pr::cli {
 
+// With the photon map's default settings: what --integrator validates against and --help lists.
 const rt::IntegratorRegistry& integrators();
+// The same integrators, the photon map's factory built with `photonmap` (one render's options).
+rt::IntegratorRegistry integrators(const pm::PhotonMapSettings& photonmap);
 
 }  // namespace pr::cli

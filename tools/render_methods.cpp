@@ -32,7 +32,13 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   options.adaptive = r.settings.ray.adaptive;
   options.progress = r.progress;
   rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
-  job.integrator = integrators().find(r.settings.ray.integrator).make(
+  const bool photonmap = r.settings.ray.integrator == "photonmap";
+  for (const CLI::Option* o : r.settings.ray.photonOptions)
+    if (o->count() > 0 && !photonmap)
+      throw InputError(o->get_name() + " applies to --integrator photonmap, not " + r.settings.ray.integrator);
+  pm::PhotonMapSettings photonSettings = r.settings.ray.photonmap;
+  photonSettings.view = pm::parsePhotonView(r.settings.ray.view);
+  job.integrator = integrators(photonSettings).find(r.settings.ray.integrator).make(
       rt::IntegratorSetup{r.scene, r.camera, r.width, r.height, options.integrator});
   rt::TraceResult result = rt::renderRays(job, name, r.runtime);
   RenderOutcome out;
@@ -45,7 +51,9 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
     return uint64_t{0};
   };
   const uint64_t camera = total("Rays/camera"), continuation = total("Rays/continuation"), shadow = total("Rays/shadow");
-  out.rays = camera + continuation + shadow;
+  // Rays traced by an integrator's pre-pass (final gathering for the irradiance cache).
+  const uint64_t gather = total("Gather/rays");
+  out.rays = camera + continuation + shadow + gather;
   // The work the plan skipped, from the Plan/ counters of the run record.
   std::string skipped;
   for (const par::CounterSummary& c : summary.counters)
@@ -59,6 +67,12 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
                 ", max depth " + std::to_string(options.integrator.maxDepth) + "; rays: camera " +
                 std::to_string(camera) + ", continuation " + std::to_string(continuation) + ", shadow " +
                 std::to_string(shadow) + "; tasks " + std::to_string(result.tasks);
+  if (photonmap)
+    out.details += "; photons stored: global " + std::to_string(total("Photons/global_stored")) + ", caustic " +
+                   std::to_string(total("Photons/caustic_stored")) + "; irradiance-cache records " +
+                   std::to_string(total("IrradianceCache/records")) + " from " +
+                   std::to_string(total("IrradianceCache/probes")) + " probes, gather rays " + std::to_string(gather) +
+                   (photonSettings.view != pm::PhotonView::Full ? "; view " + r.settings.ray.view : "");
   return out;
 }
 
@@ -183,6 +197,28 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
                       MethodFamily::Ray);
   family.emplace_back(command.add_flag("--adaptive", ray.adaptive, "image-space: split tiles estimated at over twice the mean cost"),
                       MethodFamily::Ray);
+  // The photon map's own settings (photonmap/photon_map_integrator.h PhotonMapSettings).
+  pm::PhotonMapSettings& pm = ray.photonmap;
+  auto photon = [&](CLI::Option* o) {
+    ray.photonOptions.push_back(o);
+    family.emplace_back(o, MethodFamily::Ray);
+  };
+  photon(command.add_option("--photons", pm.globalPhotons, "photonmap: photons emitted for the global map")
+             ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))->capture_default_str());
+  photon(command.add_option("--caustic-photons", pm.causticPhotons, "photonmap: photons emitted towards specular objects for the caustic map")
+             ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))->capture_default_str());
+  photon(command.add_option("--k", pm.globalK, "photonmap: photons per global-map estimate")->check(CLI::Range(1, 10000))->capture_default_str());
+  photon(command.add_option("--caustic-k", pm.causticK, "photonmap: photons per caustic-map estimate")->check(CLI::Range(1, 10000))->capture_default_str());
+  photon(command.add_option("--radius", pm.globalRadius, "photonmap: global-map search radius in scene units (0 = 5% of the scene's diagonal)")
+             ->check(CLI::NonNegativeNumber)->capture_default_str());
+  photon(command.add_option("--caustic-radius", pm.causticRadius, "photonmap: caustic-map search radius (0 = 1.5% of the scene's diagonal)")
+             ->check(CLI::NonNegativeNumber)->capture_default_str());
+  photon(command.add_option("--gather", pm.gatherRays, "photonmap: final-gather rays per irradiance-cache record")
+             ->check(CLI::Range(1, 65536))->capture_default_str());
+  photon(command.add_option("--cache-accuracy", pm.cacheAccuracy, "photonmap: irradiance-cache accuracy a (smaller = more records)")
+             ->check(CLI::Range(0.001f, 1.0f))->capture_default_str());
+  photon(command.add_option("--view", ray.view, "photonmap: full | global-map | caustic-map (a map's estimate at the first hit)")
+             ->check(CLI::IsMember({"full", "global-map", "caustic-map"}))->capture_default_str());
 }
 
 void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family) {

@@ -21,6 +21,7 @@
 #include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
 #include "common/util/registry.h"
+#include "photonmap/photon_map_integrator.h"
 
 namespace pr::cli {
 
@@ -35,6 +36,11 @@ struct RayOptions {
   uint64_t seed = 1;
   int tileSizePx = 16;
   bool adaptive = false;
+  // --integrator photonmap's settings (--photons, --gather, --view, ...), and the options
+  // that set them: giving one with another integrator is an input error.
+  pm::PhotonMapSettings photonmap;
+  std::string view = "full";
+  std::vector<const CLI::Option*> photonOptions;
 };
 
 // Options of the rasterization family (raster/sort/sort_point.h SortOptions, plus frames).

@@ -35,6 +35,18 @@ float ggxPdf(float alpha, const glm::vec3& wo, const glm::vec3& wi) {
   return ggxD(alpha, h.z) * h.z / (4.0f * oh);
 }
 
+// wo reflected about a GGX half vector: cos^2(theta_h) = (1 - u) / (1 + (alpha^2 - 1) u)
+// (Walter et al. eq. 35), phi_h = 2 pi v.
+glm::vec3 ggxReflection(float alpha, const glm::vec3& wo, float u, float v) {
+  const float a2 = alpha * alpha;
+  const float cos2 = (1.0f - u) / (1.0f + (a2 - 1.0f) * u);
+  const float cosH = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
+  const float sinH = std::sqrt(std::max(0.0f, 1.0f - cosH * cosH));
+  const float phi = 2.0f * kPi * v;
+  const glm::vec3 h(sinH * std::cos(phi), sinH * std::sin(phi), cosH);
+  return 2.0f * glm::dot(wo, h) * h - wo;
+}
+
 glm::vec4 textureLookup(const scene::Scene& scene, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
   if (!ref.present() || size_t(ref.texture) >= scene.textures.size()) return glm::vec4(1.0f);
   return scene.textures[size_t(ref.texture)].sample(ref.transformUv(uv), srgb);
@@ -104,17 +116,29 @@ float specularProbability(const ShadingMaterial& m, float cosO) {
   return ws + wd > 0.0f ? ws / (ws + wd) : 0.0f;
 }
 
+glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f || !m.hasSpecular() || m.deltaSpecular()) return glm::vec3(0.0f);
+  const glm::vec3 h = glm::normalize(wo + wi);
+  const float d = ggxD(m.alpha, h.z);
+  const float g = ggxG1(m.alpha, wo.z) * ggxG1(m.alpha, wi.z);
+  return fresnelSchlick(m.specularF0(), glm::dot(wo, h)) * (d * g / (4.0f * wo.z * wi.z));
+}
+
+BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v) {
+  BsdfSample s;
+  if (wo.z <= 0.0f || !m.hasSpecular() || m.deltaSpecular()) return s;
+  s.wi = ggxReflection(m.alpha, wo, u, v);
+  if (s.wi.z <= 0.0f) return s;
+  s.pdf = ggxPdf(m.alpha, wo, s.wi);
+  if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return s;
+  s.weight = evalGlossy(m, wo, s.wi) * (s.wi.z / s.pdf);
+  s.valid = isFinite(s.weight);
+  return s;
+}
+
 glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
-  glm::vec3 f = m.diffuseColor() * kInvPi;
-  if (m.hasSpecular() && !m.deltaSpecular()) {
-    const glm::vec3 h = glm::normalize(wo + wi);
-    const float oh = glm::dot(wo, h);
-    const float d = ggxD(m.alpha, h.z);
-    const float g = ggxG1(m.alpha, wo.z) * ggxG1(m.alpha, wi.z);
-    f += fresnelSchlick(m.specularF0(), oh) * (d * g / (4.0f * wo.z * wi.z));
-  }
-  return f;
+  return m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi);
 }
 
 float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
@@ -138,14 +162,7 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
       s.valid = true;
       return s;
     }
-    // GGX half vector: cos^2(theta_h) = (1 - u) / (1 + (alpha^2 - 1) u) (Walter et al. eq. 35).
-    const float a2 = m.alpha * m.alpha;
-    const float cos2 = (1.0f - u) / (1.0f + (a2 - 1.0f) * u);
-    const float cosH = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
-    const float sinH = std::sqrt(std::max(0.0f, 1.0f - cosH * cosH));
-    const float phi = 2.0f * kPi * v;
-    const glm::vec3 h(sinH * std::cos(phi), sinH * std::sin(phi), cosH);
-    s.wi = 2.0f * glm::dot(wo, h) * h - wo;
+    s.wi = ggxReflection(m.alpha, wo, u, v);
   } else {
     s.wi = cosineHemisphere(u, v);
   }

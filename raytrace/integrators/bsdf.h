@@ -81,6 +81,12 @@ struct BsdfSample {
   bool valid = false;
 };
 BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// The rough specular (GGX) lobe alone, for integrators that treat it apart from the diffuse
+// part (the photon map: glossy reflection by Monte Carlo, diffuse by density estimation):
+// f_s(wo, wi) without cos (zero without a rough specular lobe), and a sample of wi from the
+// GGX half-vector distribution with weight = f_s cos / pdf and its pdf.
+glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi);
+BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v);
 // Probability that sampleOpaque picks the specular lobe (from Fresnel and diffuse luminance).
 float specularProbability(const ShadingMaterial& m, float cosO);
 

@@ -3,6 +3,7 @@
 // a message; reads the Scene and light sampler only, writes the Film through Emit.
 #include "raytrace/integrators/integrator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -51,18 +52,18 @@ glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInte
 
 void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
                                     const glm::vec3& woLocal, const RayMessage& msg, float opaqueWeight, bool mis,
-                                    Emit& out) const {
+                                    Emit& out, int areaSamples) const {
   if (!(opaqueWeight > 0.0f)) return;
   const bool area = lights_.hasAreaLights();
   if (!simulates(scene::Effect::DirectLight)) {
-    out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? 1u : 0u);
+    out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? uint64_t(std::max(1, areaSamples)) : 0u);
     return;
   }
   const bool shadows = simulates(scene::Effect::Shadows);
   // Light from behind the geometric surface cannot reach an opaque side (no leaks through
   // thin walls whose interpolated normal leans towards the light).
   const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
-  auto addSample = [&](const LightSample& ls) {
+  auto addSample = [&](const LightSample& ls, float scale) {
     if (glm::dot(ls.wi, ng) <= 0.0f) return;
     const glm::vec3 wiLocal = frame.toLocal(ls.wi);
     if (wiLocal.z <= 0.0f) return;
@@ -73,7 +74,7 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
       const float pb = opaqueWeight * pdfOpaque(m, woLocal, wiLocal);
       weight = ls.pdf * ls.pdf / (ls.pdf * ls.pdf + pb * pb);
     }
-    const glm::vec3 c = msg.throughput * f * ls.radiance * (wiLocal.z * weight);
+    const glm::vec3 c = msg.throughput * f * ls.radiance * (wiLocal.z * weight * scale);
     if (!(maxComponent(c) > 0.0f) || !isFinite(c)) return;
     RayMessage shadow;
     shadow.ray = ls.shadowRay;
@@ -91,12 +92,18 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
   };
   LightSample ls;
   for (const scene::PunctualLight& light : scene_->lights)
-    if (lights_.samplePunctual(light, si, ls)) addSample(ls);
-  if (area && !simulates(scene::Effect::Emission))
-    ++out.stats().lightSamplesSkipped;
-  else if (area &&
-           lights_.sampleArea(si, sample(msg, Dim::kLightPick), sample(msg, Dim::kLightU), sample(msg, Dim::kLightV), ls))
-    addSample(ls);
+    if (lights_.samplePunctual(light, si, ls)) addSample(ls, 1.0f);
+  if (!area) return;
+  const int n = std::max(1, areaSamples);
+  if (!simulates(scene::Effect::Emission)) {
+    out.stats().lightSamplesSkipped += uint64_t(n);
+    return;
+  }
+  for (int i = 0; i < n; ++i) {
+    const uint32_t d = i == 0 ? Dim::kLightPick : Dim::kLightExtra + 3u * uint32_t(i - 1);
+    const uint32_t du = i == 0 ? Dim::kLightU : d + 1u, dv = i == 0 ? Dim::kLightV : d + 2u;
+    if (lights_.sampleArea(si, sample(msg, d), sample(msg, du), sample(msg, dv), ls)) addSample(ls, 1.0f / float(n));
+  }
 }
 
 RayMessage IntegratorContext::continuation(const SurfaceInteraction& si, const RayMessage& msg, const glm::vec3& wi,

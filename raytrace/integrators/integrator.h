@@ -26,6 +26,10 @@
 #include "raytrace/integrators/sampling.h"
 #include "raytrace/integrators/trace_stats.h"
 
+namespace pr::par {
+class Runtime;
+}
+
 namespace pr::rt {
 
 // The built-in integrators, for library callers and tests that pick one without a registry
@@ -87,11 +91,13 @@ class IntegratorContext {
   glm::vec3 emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const;
   // Next-event estimation at a hit: one shadow ray per punctual light and one area-light
   // sample, each carrying throughput * f * L * cos / pdf (times the MIS weight against BSDF
-  // sampling when mis is set). opaqueWeight scales the diffuse + glossy part. Plan: nothing
+  // sampling when mis is set). opaqueWeight scales the diffuse + glossy part. areaSamples > 1
+  // takes that many area-light samples, each weighted 1 / areaSamples (sample 0 on the Dim::
+  // kLight* dimensions, sample i on Dim::kLightExtra + 3 (i - 1) ...). Plan: nothing
   // with direct light off, no area sample with emission off, and with shadows off the
   // contribution goes straight to the film (what an unoccluded shadow ray adds on its miss).
   void directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame, const glm::vec3& woLocal,
-                   const RayMessage& msg, float opaqueWeight, bool mis, Emit& out) const;
+                   const RayMessage& msg, float opaqueWeight, bool mis, Emit& out, int areaSamples = 1) const;
   // Pushes ray when the plan simulates `effect`, else counts it in TraceStats::*skipped.
   void spawn(scene::Effect effect, uint64_t TraceStats::*skipped, const RayMessage& ray, Emit& out) const {
     if (simulates(effect))
@@ -153,6 +159,16 @@ class Integrator {
   // The same with spp samples per pixel (image-space's one-sample cost pre-pass): sample s of
   // a pixel is the same ray whatever spp, for s < spp, only when spp matches the render's.
   void cameraRays(const PixelRect& rect, int spp, std::vector<RayMessage>& out) const;
+  // A pre-pass over the whole scene before the trace stage (the photon map's photon tracing and
+  // irradiance cache), run by the world-model tracers (sequential, image-space) on the
+  // controlling thread between stages, its stages recorded in rt's run record; afterwards the
+  // integrator is read-only again. The message-passing tracers hold no world BVH and refuse an
+  // integrator that needs one (an InputError naming the tracers that can run it).
+  virtual bool needsWorldPrePass() const { return false; }
+  virtual void prePass(const Bvh& world, par::Runtime& rt) const {
+    (void)world;
+    (void)rt;
+  }
   // A camera or continuation ray hit si (made by makeInteraction from msg.ray's closest hit).
   virtual void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const = 0;
   // A ray found nothing: a shadow ray adds its contribution (unoccluded); any other ray sees

@@ -17,6 +17,8 @@ enum class RayKind : uint8_t {
   Camera,        // primary ray from the eye
   Continuation,  // reflection, refraction or path bounce: shaded where it hits
   Shadow,        // visibility test: adds `throughput` to the pixel iff unoccluded
+  Gather,        // final-gathering ray: shaded where it hits, by the integrator's gather rule
+                 // (photon map: the global map's estimate); traced and counted as a continuation
 };
 
 struct RayMessage {

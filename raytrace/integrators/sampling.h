@@ -31,6 +31,10 @@ inline constexpr uint32_t kPixelX = 0, kPixelY = 1;
 inline constexpr uint32_t kLightPick = 2, kLightU = 3, kLightV = 4;
 inline constexpr uint32_t kLobe = 5, kBsdfU = 6, kBsdfV = 7;
 inline constexpr uint32_t kRoulette = 8;
+// Further area-light samples at one vertex (IntegratorContext::directLight), three each.
+inline constexpr uint32_t kLightExtra = 16;
+// First dimension free for an integrator's own draws (photonmap: glossy rays).
+inline constexpr uint32_t kIntegratorOwn = 128;
 }  // namespace Dim
 
 // A uniform number in [0, 1) for one (seed, pixel, sample, depth, dimension).

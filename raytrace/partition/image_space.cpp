@@ -33,6 +33,7 @@ struct TileTask {
 class ImageSpacePartition final : public Partition {
  public:
   std::string_view name() const override { return "image-space"; }
+  bool holdsWorldModel() const override { return true; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
     // The world BVH is built once, on the assembler's PE in a stage of its own (so its time is
@@ -49,6 +50,9 @@ class ImageSpacePartition final : public Partition {
     const Integrator& integrator = *shared;
     std::vector<TileTask> tiles = makeTiles(job);
     rt.recordBroadcast(job.scene.memoryBytes() + bvh.stats().memoryBytes);
+    // The integrator's pre-pass (photon maps, irradiance cache) records the broadcast of what
+    // it replicates itself.
+    integrator.prePass(bvh, rt);
     if (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, integrator, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 

@@ -96,6 +96,9 @@ class Partition {
  public:
   virtual ~Partition() = default;
   virtual std::string_view name() const = 0;
+  // Whether every PE reads the whole scene and one BVH over it (world model, DESIGN.md rule
+  // 1): such a tracer runs an integrator's world pre-pass (Integrator::prePass).
+  virtual bool holdsWorldModel() const { return false; }
   // Runs the render on rt's PEs (stages recorded in rt.record()). Called from the
   // controlling thread.
   virtual TraceResult render(const TraceJob& job, par::Runtime& rt) = 0;

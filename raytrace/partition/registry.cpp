@@ -60,6 +60,13 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
     throw InputError("scene " + job.scene.source.string() + " has no triangles to ray trace");
   checkBvhLimit("scene " + job.scene.source.string(), job.scene.triangles.size());
   std::unique_ptr<Partition> p = makePartition(partition);
+  if (job.integrator && job.integrator->needsWorldPrePass() && !p->holdsWorldModel()) {
+    std::string world;
+    for (const PartitionInfo& info : partitions())
+      if (info.make()->holdsWorldModel()) world += (world.empty() ? "" : ", ") + info.name;
+    throw InputError("integrator " + std::string(job.integrator->name()) + " needs a pre-pass over the whole scene, which " +
+                     std::string(partition) + " does not hold on any PE; it runs with " + world);
+  }
   return p->render(job, rt);
 }
 

@@ -25,6 +25,7 @@ namespace {
 class SequentialPartition final : public Partition {
  public:
   std::string_view name() const override { return "sequential"; }
+  bool holdsWorldModel() const override { return true; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
     // The BVH build is a stage of its own, timed like every tracer's build (Ts includes it).
@@ -36,6 +37,7 @@ class SequentialPartition final : public Partition {
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
+    integrator.prePass(bvh, rt);
     Film film(job.width, job.height, integrator.options().spp);
     PerPeTraceStats counters(rt.pes());
     rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {

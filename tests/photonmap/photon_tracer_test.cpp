@@ -202,7 +202,7 @@ TEST_CASE("PhotonTracer: the plan's caustics off and indirect off skip those pho
   pm::PhotonOptions options;
   options.globalPhotons = 2000;
   options.causticPhotons = 3000;
-  options.plan = &plan;
+  options.effects = plan.enabled();
   par::Runtime runtime(1);
   pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
   CHECK(lists.caustic.empty());
@@ -210,6 +210,7 @@ TEST_CASE("PhotonTracer: the plan's caustics off and indirect off skip those pho
   CHECK(lists.global.size() > 0);
   plan[scene::Effect::Caustics].on = true;
   plan[scene::Effect::IndirectDiffuse].on = false;
+  options.effects = plan.enabled();
   lists = pm::tracePhotonLists(s, bvh, options, runtime);
   CHECK(lists.global.empty());
   CHECK(lists.stats.globalSkipped == 2000);

@@ -72,6 +72,17 @@ RENDER_BAD_INPUT("a zero width", join({"render ", cornell(), " --width 0", out})
 RENDER_BAD_INPUT("an unknown camera", join({"render ", cornell(), " --camera 7", out}), "7")
 RENDER_BAD_INPUT("an unsupported output extension", join({"render ", cornell(), " -o \"", (dir / "x.jpg").string(), "\""}), ".jpg")
 
+TEST_CASE("Render: --integrator photonmap renders and reports its maps and cache") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_photonmap");
+  const auto r = runParrender(join({"render ", cornell(), " --integrator photonmap --threads 2 --width 24 --height 18 --spp 1",
+                                    " --photons 4000 --caustic-photons 2000 --gather 32 -o \"", (dir / "pm.png").string(), "\""}));
+  INFO(r.output);
+  CHECK(r.exitStatus == 0);
+  CHECK(std::filesystem::exists(dir / "pm.png"));
+  CHECK(r.output.find("photons stored: global ") != std::string::npos);
+  CHECK(r.output.find("irradiance-cache records ") != std::string::npos);
+}
+
 TEST_CASE("Render: --help lists every integrator and compositor of their registries") {
   const auto r = runParrender("render --help");
   INFO(r.output);
@@ -87,7 +98,12 @@ TEST_CASE("Render: --help lists every integrator and compositor of their registr
 }
 
 RENDER_BAD_INPUT("an unknown integrator, listing the registry's", join({"render ", cornell(), " --integrator foo", out}),
-                 "unknown integrator 'foo' (expected one of: whitted, path)")
+                 "unknown integrator 'foo' (expected one of: whitted, path, photonmap)")
+RENDER_BAD_INPUT("a photon-map option with another integrator", join({"render ", cornell(), " --integrator path --photons 1000", out}),
+                 "--photons applies to --integrator photonmap, not path")
+RENDER_BAD_INPUT("the photon map on a tracer without a world model", join({"render ", cornell(), " -m object-space --integrator photonmap", out}),
+                 "runs with sequential, image-space")
+RENDER_BAD_INPUT("an unknown photon-map view", join({"render ", cornell(), " --integrator photonmap --view photons", out}), "--view")
 RENDER_BAD_INPUT("an unknown compositor, listing the registry's",
                  join({"render ", cornell(), " -m sort-last --compositor foo", out}),
                  "unknown compositor 'foo' (expected one of: direct-send, binary-swap)")

@@ -1,0 +1,367 @@
+// The photon-map integrator (see photon_map_integrator.h): the pre-pass that traces the maps
+// and places the irradiance-cache records, and the shading of one hit.
+//
+// Record placement is deterministic: the image is probed on grids of stride 16, 8, 4, 2 and 1
+// pixels; at each level the probe points that no record of the earlier levels covers gather a
+// new record, in parallel (one task per band of rows), and the new records are inserted in
+// pixel order on the controlling thread. A record's placement therefore depends only on the
+// records of coarser levels, never on which PE finished first.
+#include "photonmap/photon_map_integrator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <optional>
+#include <vector>
+
+#include "common/parallel/runtime.h"
+#include "common/util/error.h"
+#include "photonmap/final_gather.h"
+#include "raytrace/core/bvh.h"
+
+namespace pr::pm {
+
+namespace {
+
+using rt::kPi;
+using rt::RayKind;
+using rt::RayMessage;
+
+// Rays weaker than this add nothing visible (below 1/4096 of a camera ray's weight).
+constexpr float kMinThroughput = 1.0f / 4096.0f;
+// Cache levels: probe grids of stride 16 down to 1 pixel.
+constexpr int kCoarsestStride = 16;
+// A record's reach a R_i in pixels at its distance: at least 1.5 (so a stride-1 grid is
+// covered between records), at most 24 (so large flat walls still get a record every few
+// dozen pixels, bounding the extrapolation by gradients).
+constexpr float kMinReachPixels = 1.5f;
+constexpr float kMaxReachPixels = 24.0f;
+// Rows of the image per task of a cache level.
+constexpr int kRowsPerTask = 4;
+// Random dimensions of this integrator at a vertex: fallback gather rays, then glossy rays.
+constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
+constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
+constexpr int kMaxRaysPerVertex = 256;
+
+float sceneDiagonal(const scene::Scene& scene) {
+  scene::Bounds b = scene.bounds;
+  if (b.empty())
+    for (const glm::vec3& p : scene.positions) b.extend(p);
+  return std::max(glm::length(b.extent()), 1.0e-6f);
+}
+
+}  // namespace
+
+std::string_view toString(PhotonView view) {
+  switch (view) {
+    case PhotonView::GlobalMap: return "global-map";
+    case PhotonView::CausticMap: return "caustic-map";
+    default: return "full";
+  }
+}
+
+PhotonView parsePhotonView(std::string_view text) {
+  for (PhotonView v : {PhotonView::Full, PhotonView::GlobalMap, PhotonView::CausticMap})
+    if (text == toString(v)) return v;
+  throw InputError("unknown --view '" + std::string(text) + "'; expected full, global-map or caustic-map");
+}
+
+PhotonMapIntegrator::PhotonMapIntegrator(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                                         const rt::IntegratorOptions& options, const PhotonMapSettings& settings)
+    : IntegratorBase(scene, camera, width, height, options),
+      settings_(settings),
+      camera_(camera),
+      state_(std::make_unique<State>()) {
+  auto check = [](bool ok, const std::string& what) {
+    if (!ok) throw InputError("photonmap: " + what);
+  };
+  check(settings.globalK >= 1 && settings.globalK <= 10000, "--k must be in [1, 10000]");
+  check(settings.causticK >= 1 && settings.causticK <= 10000, "--caustic-k must be in [1, 10000]");
+  check(settings.globalRadius >= 0.0f && std::isfinite(settings.globalRadius), "--radius must be >= 0 (0 = automatic)");
+  check(settings.causticRadius >= 0.0f && std::isfinite(settings.causticRadius), "--caustic-radius must be >= 0 (0 = automatic)");
+  check(settings.gatherRays >= 1 && settings.gatherRays <= 65536, "--gather must be in [1, 65536]");
+  check(settings.cacheAccuracy > 0.0f && settings.cacheAccuracy <= 1.0f, "--cache-accuracy must be in (0, 1]");
+  check(settings.fallbackGatherRays >= 1 && settings.fallbackGatherRays <= kMaxRaysPerVertex, "fallback gather rays out of range");
+  check(settings.maxGlossyRays >= 1 && settings.maxGlossyRays <= kMaxRaysPerVertex, "glossy rays out of range");
+  check(settings.areaLightSamples >= 1 && settings.areaLightSamples <= 64, "area-light samples must be in [1, 64]");
+  const float diagonal = sceneDiagonal(scene);
+  globalDensity_.k = settings.globalK;
+  globalDensity_.maxRadius = settings.globalRadius > 0.0f ? settings.globalRadius : kAutoGlobalRadius * diagonal;
+  globalDensity_.filter = DensityFilter::Box;
+  causticDensity_.k = settings.causticK;
+  causticDensity_.maxRadius = settings.causticRadius > 0.0f ? settings.causticRadius : kAutoCausticRadius * diagonal;
+  causticDensity_.filter = DensityFilter::Cone;
+  state_->cache = IrradianceCache(scene.bounds, settings.cacheAccuracy);
+}
+
+glm::vec3 PhotonMapIntegrator::mapRadiance(const KdTree& map, const DensityOptions& density,
+                                           const rt::SurfaceInteraction& si, const rt::ShadingMaterial& m) const {
+  const glm::vec3 diffuse = (1.0f - m.dielectricWeight()) * m.diffuseColor();
+  if (!(rt::maxComponent(diffuse) > 0.0f) || map.empty()) return glm::vec3(0.0f);
+  thread_local NearestPhotons scratch;
+  const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
+  return lambertianRadiance(diffuse, estimateIrradiance(map, si.position, ng, density, scratch).irradiance);
+}
+
+// ---- pre-pass ---------------------------------------------------------------------------------
+
+void PhotonMapIntegrator::prePass(const rt::Bvh& world, par::Runtime& rt) const {
+  const rt::IntegratorContext& ctx = context();
+  PhotonOptions photons;
+  photons.seed = options().seed;
+  photons.globalPhotons = settings_.globalPhotons;
+  photons.causticPhotons = settings_.causticPhotons;
+  photons.batchSize = settings_.photonBatch;
+  photons.textures = ctx.simulates(scene::Effect::Textures);
+  photons.effects = options().effects;
+  // A view traces only the map it shows, whatever the plan says of its effect.
+  if (settings_.view != PhotonView::Full) {
+    photons.effects.set(scene::Effect::IndirectDiffuse, settings_.view == PhotonView::GlobalMap);
+    photons.effects.set(scene::Effect::Caustics, settings_.view == PhotonView::CausticMap);
+  }
+  state_->maps = tracePhotons(ctx.scene(), world, photons, rt);
+  // Every PE reads both maps: replicated data, one broadcast of their bytes.
+  if (!state_->maps.global.empty() || !state_->maps.caustic.empty())
+    rt.recordBroadcast(state_->maps.global.bytes() + state_->maps.caustic.bytes());
+  state_->cache = IrradianceCache(ctx.scene().bounds, settings_.cacheAccuracy);
+  if (settings_.view == PhotonView::Full && ctx.simulates(scene::Effect::IndirectDiffuse) && !state_->maps.global.empty()) {
+    buildCache(world, rt);
+    if (state_->cache.size() > 0) rt.recordBroadcast(state_->cache.bytes());
+  }
+}
+
+void PhotonMapIntegrator::buildCache(const rt::Bvh& world, par::Runtime& rt) const {
+  const rt::IntegratorContext& ctx = context();
+  const scene::Scene& scene = ctx.scene();
+  const int width = ctx.width(), height = ctx.height();
+  const bool textures = ctx.simulates(scene::Effect::Textures);
+  GatherOptions gather;
+  gather.rays = settings_.gatherRays;
+  gather.global = globalDensity_;
+  gather.textures = textures;
+  gather.seed = options().seed;
+  const float pixelAngle = camera_.projection == scene::Projection::Orthographic
+                               ? 0.0f
+                               : 2.0f * std::tan(0.5f * camera_.yfov) / float(height);
+  const float orthoPixel = 2.0f * camera_.ymag / float(height);
+  const float a = settings_.cacheAccuracy;
+  IrradianceCache& cache = state_->cache;
+
+  // The first surface with a diffuse part that pixel p's camera ray reaches through ideal
+  // mirrors and glass (the dominant branch at each dielectric), and the world size of a pixel
+  // there; nullopt when the path leaves the scene or ends on a purely glossy surface.
+  struct Probe {
+    rt::SurfaceInteraction si;
+    float footprint = 0.0f;
+  };
+  auto probe = [&](int x, int y) -> std::optional<Probe> {
+    std::vector<RayMessage> rays;
+    cameraRays(rt::PixelRect{x, y, x + 1, y + 1}, 1, rays);
+    rt::Ray ray = rays.front().ray;
+    float travelled = 0.0f;
+    for (int depth = 0; depth < options().maxDepth; ++depth) {
+      rt::Hit hit;
+      if (!world.intersect(ray, hit)) return std::nullopt;
+      const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
+      travelled += hit.t * glm::length(ray.direction);
+      const rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures);
+      const rt::ShadingFrame sf(si);
+      if (rt::maxComponent((1.0f - m.dielectricWeight()) * m.diffuseColor()) > 0.0f)
+        return Probe{si, pixelAngle > 0.0f ? travelled * pixelAngle : orthoPixel};
+      glm::vec3 wi;
+      if (m.dielectricWeight() >= 0.5f) {
+        const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+        const float cosI = glm::dot(sf.ns, si.wo);
+        glm::vec3 wt;
+        if (rt::fresnelDielectric(cosI, eta) < 0.5f && rt::refractDirection(si.wo, sf.ns, eta, wt))
+          wi = wt;
+        else
+          wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+      } else if (m.hasSpecular() && m.deltaSpecular()) {
+        wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
+      } else {
+        return std::nullopt;
+      }
+      ray = rt::spawnRay(si, wi);
+    }
+    return std::nullopt;
+  };
+
+  std::vector<std::uint64_t> raysPerPe(std::size_t(rt.pes()), 0), recordsPerPe(std::size_t(rt.pes()), 0),
+      probesPerPe(std::size_t(rt.pes()), 0);
+  for (int stride = kCoarsestStride; stride >= 1; stride /= 2) {
+    // This level's probe pixels: on the stride grid, not on the previous (coarser) one.
+    auto onLevel = [&](int x, int y) {
+      if (x % stride != 0 || y % stride != 0) return false;
+      return stride == kCoarsestStride || x % (2 * stride) != 0 || y % (2 * stride) != 0;
+    };
+    const int rows = (height + stride - 1) / stride;
+    const int tasks = (rows + kRowsPerTask - 1) / kRowsPerTask;
+    std::vector<std::vector<std::pair<std::uint32_t, IrradianceRecord>>> found(static_cast<std::size_t>(tasks));
+    rt.runStage("irradiance-cache gather 1/" + std::to_string(stride), par::TaskSet::uniform(std::size_t(tasks)),
+                [&](par::Pe& pe, par::TaskId task) {
+                  NearestPhotons scratch;
+                  std::uint64_t rays = 0;
+                  for (int row = int(task) * kRowsPerTask; row < std::min(rows, int(task + 1) * kRowsPerTask); ++row) {
+                    const int y = row * stride;
+                    for (int x = 0; x < width; x += stride) {
+                      if (!onLevel(x, y)) continue;
+                      ++probesPerPe[std::size_t(pe.id())];
+                      const std::optional<Probe> p = probe(x, y);
+                      if (!p) continue;
+                      const rt::ShadingFrame sf(p->si);
+                      if (cache.covers(p->si.position, sf.ns)) continue;
+                      const std::uint32_t pixel = std::uint32_t(y) * std::uint32_t(width) + std::uint32_t(x);
+                      IrradianceRecord r = gatherIrradiance(scene, world, state_->maps.global, p->si, pixel, gather, scratch, rays);
+                      // The translation-gradient limit (Krivanek et al. 2006): the extrapolation by
+                      // the gradient may not halve the irradiance within the radius.
+                      const glm::vec3 w(0.2126f, 0.7152f, 0.0722f);
+                      const glm::vec3 g = w.x * r.translationGradient[0] + w.y * r.translationGradient[1] +
+                                          w.z * r.translationGradient[2];
+                      const float e = rt::luminance(r.irradiance), gl = glm::length(g);
+                      if (gl > 0.0f && e > 0.0f) r.radius = std::min(r.radius, e / gl);
+                      r.radius = std::clamp(r.radius, kMinReachPixels * p->footprint / a, kMaxReachPixels * p->footprint / a);
+                      found[std::size_t(task)].push_back({pixel, r});
+                      ++recordsPerPe[std::size_t(pe.id())];
+                    }
+                  }
+                  raysPerPe[std::size_t(pe.id())] += rays;
+                });
+    // In pixel order: tasks are bands of rows in order, each band's records in scan order.
+    for (auto& band : found)
+      for (auto& [pixel, record] : band) cache.insert(record);
+  }
+  for (int p = 0; p < rt.pes(); ++p) {
+    rt.addCounter("IrradianceCache/probes", p, double(probesPerPe[std::size_t(p)]));
+    rt.addCounter("IrradianceCache/records", p, double(recordsPerPe[std::size_t(p)]));
+    rt.addCounter("Gather/rays", p, double(raysPerPe[std::size_t(p)]));
+  }
+}
+
+// ---- shading ----------------------------------------------------------------------------------
+
+void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const {
+  const rt::IntegratorContext& ctx = context();
+  const State& state = *state_;
+  const rt::ShadingMaterial m = ctx.material(si, out);
+
+  if (settings_.view != PhotonView::Full) {
+    const bool global = settings_.view == PhotonView::GlobalMap;
+    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(global ? state.maps.global : state.maps.caustic,
+                                                            global ? globalDensity_ : causticDensity_, si, m));
+    return;
+  }
+
+  const rt::ShadingFrame sf(si);
+  const float dielectric = m.dielectricWeight();
+  const float opaque = 1.0f - dielectric;
+  auto spawn = [&](scene::Effect effect, std::uint64_t rt::TraceStats::*skipped, RayMessage ray) {
+    if (rt::maxComponent(ray.throughput) > kMinThroughput && rt::isFinite(ray.throughput)) ctx.spawn(effect, skipped, ray, out);
+  };
+  auto mirror = [&]() { return sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z)); };
+
+  // A gathering or glossy ray's hit: all of its light from the global map (no emission, which
+  // light sampling at the ray's origin already counted); gathering rays go on through ideal
+  // specular surfaces to the diffuse surface behind them, as in the cache's gathering.
+  const bool secondary = msg.kind == RayKind::Gather || (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f);
+  if (secondary) {
+    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(state.maps.global, globalDensity_, si, m));
+    if (msg.kind != RayKind::Gather || msg.depth >= options().maxDepth) return;
+    const float u = ctx.sample(msg, rt::Dim::kLobe);
+    RayMessage next;
+    if (u < dielectric) {
+      const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+      const float cosI = glm::dot(sf.ns, si.wo);
+      glm::vec3 wt;
+      if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt))
+        next = ctx.continuation(si, msg, glm::normalize(2.0f * cosI * sf.ns - si.wo), msg.throughput, 0.0f);
+      else
+        next = ctx.continuation(si, msg, wt, msg.throughput * m.baseColor, 0.0f);
+    } else if (m.hasSpecular() && m.deltaSpecular() && glm::dot(mirror(), sf.ng) > 0.0f) {
+      next = ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z), 0.0f);
+    } else {
+      return;
+    }
+    next.kind = RayKind::Gather;
+    spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, next);
+    return;
+  }
+
+  // An eye path (camera ray, or ideal specular and refraction rays from one): emission in full.
+  const glm::vec3 le = ctx.emitted(m, si, out);
+  if (rt::maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
+  if (msg.depth >= options().maxDepth) return;
+  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, settings_.areaLightSamples);
+
+  // The diffuse part: caustics from the caustic map, indirect light from the cache.
+  const glm::vec3 diffuse = opaque * m.diffuseColor();
+  if (rt::maxComponent(diffuse) > 0.0f) {
+    if (!ctx.simulates(scene::Effect::Caustics))
+      ++out.stats().causticRaysSkipped;
+    else if (!state.maps.caustic.empty())
+      out.addRadiance(msg.pixel, msg.throughput * mapRadiance(state.maps.caustic, causticDensity_, si, m));
+    glm::vec3 irradiance;
+    if (!ctx.simulates(scene::Effect::IndirectDiffuse)) {
+      ++out.stats().indirectRaysSkipped;
+    } else if (state.cache.lookup(si.position, sf.ns, irradiance)) {
+      out.addRadiance(msg.pixel, msg.throughput * lambertianRadiance(diffuse, irradiance));
+    } else if (!state.maps.global.empty()) {
+      // No record here (a point seen only through a mirror, or between the probes): gather
+      // with rays that travel as messages, cosine-distributed so each carries diffuse / n.
+      const int n = settings_.fallbackGatherRays;
+      for (int i = 0; i < n; ++i) {
+        const glm::vec3 wi = sf.frame.toWorld(rt::cosineHemisphere(ctx.sample(msg, kGatherDim + 2u * std::uint32_t(i)),
+                                                                    ctx.sample(msg, kGatherDim + 2u * std::uint32_t(i) + 1u)));
+        if (glm::dot(wi, sf.ng) <= 0.0f) continue;
+        RayMessage g = ctx.continuation(si, msg, wi, msg.throughput * diffuse / float(n), 0.0f);
+        g.kind = RayKind::Gather;
+        spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, g);
+      }
+    }
+  }
+
+  // The opaque specular lobe: one ideal mirror ray, or Monte Carlo glossy rays (more the
+  // rougher the lobe, one below the first hit), whose hits read the global map.
+  if (opaque > 0.0f && m.hasSpecular()) {
+    if (m.deltaSpecular()) {
+      if (glm::dot(mirror(), sf.ng) > 0.0f)
+        spawn(scene::Effect::IdealSpecular, &rt::TraceStats::specularRaysSkipped,
+              ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z) * opaque, 0.0f));
+    } else {
+      const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
+      for (int i = 0; i < n; ++i) {
+        const rt::BsdfSample s = rt::sampleGlossy(m, sf.woLocal, ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)),
+                                                  ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u));
+        if (!s.valid) continue;
+        const glm::vec3 wi = sf.frame.toWorld(s.wi);
+        if (glm::dot(wi, sf.ng) <= 0.0f) continue;
+        // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
+        spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,
+              ctx.continuation(si, msg, wi, msg.throughput * s.weight * (opaque / float(n)), std::max(s.pdf, 1.0e-30f)));
+      }
+    }
+  }
+
+  // The smooth dielectric: Fresnel reflection and refraction, one ray each (as Whitted).
+  if (dielectric > 0.0f) {
+    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+    const float cosI = glm::dot(sf.ns, si.wo);
+    const float fr = rt::fresnelDielectric(cosI, eta);
+    spawn(scene::Effect::Transmission, &rt::TraceStats::transmissionRaysSkipped,
+          ctx.continuation(si, msg, glm::normalize(2.0f * cosI * sf.ns - si.wo), msg.throughput * (dielectric * fr), 0.0f));
+    glm::vec3 wt;
+    if (fr < 1.0f && rt::refractDirection(si.wo, sf.ns, eta, wt))
+      spawn(scene::Effect::Transmission, &rt::TraceStats::transmissionRaysSkipped,
+            ctx.continuation(si, msg, wt, msg.throughput * m.baseColor * (dielectric * (1.0f - fr)), 0.0f));
+  }
+}
+
+rt::IntegratorInfo photonMapIntegratorEntry(const PhotonMapSettings& settings) {
+  return {"photonmap",
+          "Jensen's two-pass photon map: direct light by shadow rays, caustics from the caustic map, indirect "
+          "diffuse by final gathering over the global map through an irradiance cache",
+          [settings](const rt::IntegratorSetup& s) -> std::shared_ptr<const rt::Integrator> {
+            return std::make_shared<const PhotonMapIntegrator>(s.scene, s.camera, s.width, s.height, s.options, settings);
+          }};
+}
+
+}  // namespace pr::pm

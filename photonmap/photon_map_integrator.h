@@ -1,0 +1,107 @@
+// Pass 2 of Jensen's two-pass method, `--integrator photonmap` (seed chapter "Global
+// Illumination in Complex Scenes using Photon Maps", section 2.4): the radiance at a surface
+// seen from the eye split into
+//   - emission and direct light, by next-event estimation (shadow rays; several on area lights),
+//   - ideal specular reflection and refraction, by one ray each (Fresnel-weighted),
+//   - glossy reflection, by Monte Carlo rays from the GGX lobe, as many as the roughness asks,
+//   - caustics, straight from the caustic map (cone filter),
+//   - indirect diffuse light, by final gathering whose hits read the global map, through an
+//     irradiance cache with Ward-Heckbert gradients built in a pre-pass over the image.
+// Hits of glossy and gathering rays read the global map for all their light (Jensen's rule
+// for paths after a diffuse or glossy bounce). The pre-pass (prePass: photon tracing, both
+// kd-trees, cache records) runs on the world model before the trace stage; every shade call
+// after it only reads the maps and the cache, so shading is the same ray-message state
+// machine as the other integrators and gives the same image for every P and schedule.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "photonmap/density_estimate.h"
+#include "photonmap/irradiance_cache.h"
+#include "photonmap/kd_tree.h"
+#include "photonmap/photon_tracer.h"
+#include "raytrace/integrators/trace_loop.h"
+
+namespace pr::pm {
+
+// What the image shows: the full solution, or one map's radiance estimate at the first
+// surface seen (the seed's figure 3, for inspecting a map).
+enum class PhotonView : std::uint8_t { Full, GlobalMap, CausticMap };
+std::string_view toString(PhotonView view);
+// "full" | "global-map" | "caustic-map"; throws pr::InputError listing them otherwise.
+PhotonView parsePhotonView(std::string_view text);
+
+struct PhotonMapSettings {
+  std::size_t globalPhotons = 200000;   // --photons: emitted for the global map
+  std::size_t causticPhotons = 100000;  // --caustic-photons
+  int globalK = 100;                    // --k: photons per global-map estimate
+  int causticK = 60;                    // --caustic-k
+  // Maximum search radii in scene units; 0 = a fraction of the scene's bounding diagonal
+  // (kAutoGlobalRadius, kAutoCausticRadius).
+  float globalRadius = 0.0f;            // --radius
+  float causticRadius = 0.0f;           // --caustic-radius
+  int gatherRays = 256;                 // --gather: rays per irradiance-cache record
+  float cacheAccuracy = 0.25f;          // --cache-accuracy: Ward's a
+  int fallbackGatherRays = 64;          // gather rays as messages where no record covers a point
+  int areaLightSamples = 4;             // shadow rays per area-light evaluation
+  int maxGlossyRays = 16;               // glossy rays at a first hit of roughness 1 (fewer when smoother)
+  PhotonView view = PhotonView::Full;   // --view
+  std::size_t photonBatch = 4096;       // photons per task of pass 1
+};
+
+inline constexpr float kAutoGlobalRadius = 0.05f;    // x the scene's bounding diagonal
+inline constexpr float kAutoCausticRadius = 0.015f;  // x the scene's bounding diagonal
+
+class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator> {
+ public:
+  PhotonMapIntegrator(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                      const rt::IntegratorOptions& options, const PhotonMapSettings& settings);
+
+  std::string_view name() const override { return "photonmap"; }
+  // Everything but anisotropy: the glossy lobe is isotropic GGX.
+  scene::EffectSet simulated() const override {
+    scene::EffectSet s = scene::EffectSet::all();
+    s.set(scene::Effect::Anisotropy, false);
+    return s;
+  }
+  bool needsWorldPrePass() const override { return true; }
+  // Pass 1 (stages "photon trace", "photon-kd-build"), the maps' broadcast, and the cache
+  // (stages "irradiance-cache probe", "irradiance-cache gather 1/16" ... "1/1"), with its
+  // records' broadcast; counters Photons/... and IrradianceCache/records, Gather/rays.
+  void prePass(const rt::Bvh& world, par::Runtime& rt) const override;
+  void shade(const rt::SurfaceInteraction& si, const rt::RayMessage& msg, rt::Emit& out) const override;
+
+  const PhotonMapSettings& settings() const { return settings_; }
+  // What the pre-pass built (valid after prePass).
+  const PhotonMaps& maps() const { return state_->maps; }
+  const IrradianceCache& cache() const { return state_->cache; }
+  const DensityOptions& globalDensity() const { return globalDensity_; }
+  const DensityOptions& causticDensity() const { return causticDensity_; }
+
+ private:
+  // The maps and the cache: written once by prePass on the controlling thread before the trace
+  // stage, read-only by every PE afterwards (the integrator itself is shared as const).
+  struct State {
+    PhotonMaps maps;
+    IrradianceCache cache;
+  };
+  void buildCache(const rt::Bvh& world, par::Runtime& rt) const;
+  // The map's Lambertian radiance at si: opaque weight x diffuse colour / pi x E.
+  glm::vec3 mapRadiance(const KdTree& map, const DensityOptions& density, const rt::SurfaceInteraction& si,
+                        const rt::ShadingMaterial& m) const;
+
+  PhotonMapSettings settings_;
+  scene::Camera camera_;
+  DensityOptions globalDensity_, causticDensity_;
+  std::unique_ptr<State> state_;
+};
+
+// The registry entry ("photonmap" -> a factory building the integrator with `settings`), added
+// to the program's registry by tools/integrators.cpp.
+rt::IntegratorInfo photonMapIntegratorEntry(const PhotonMapSettings& settings = {});
+
+}  // namespace pr::pm
