@@ -43,7 +43,7 @@ GatherSample traceGatherRay(const scene::Scene& scene, const rt::Bvh& bvh, const
     if (!bvh.intersect(ray, hit)) return out;
     const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
     if (bounce == 0) out.distance = hit.t * glm::length(ray.direction);
-    out.radiance += throughput * globalMapRadiance(scene, global, si, options.global, options.textures, scratch);
+    out.radiance += throughput * globalMapRadiance(scene, global, options.precomputed, si, options.global, options.textures, scratch);
     const rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
     const rt::ShadingFrame sf(si);
     const float dielectric = m.dielectricWeight();
@@ -75,12 +75,15 @@ GatherSample traceGatherRay(const scene::Scene& scene, const rt::Bvh& bvh, const
 
 }  // namespace
 
-glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const rt::SurfaceInteraction& si,
-                            const DensityOptions& density, bool textures, NearestPhotons& scratch) {
+glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
+                            const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
+                            NearestPhotons& scratch) {
   const rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures);
   const glm::vec3 diffuse = (1.0f - m.dielectricWeight()) * m.diffuseColor();
   if (!(rt::maxComponent(diffuse) > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
+  if (precomputed && !precomputed->empty())
+    return lambertianRadiance(diffuse, precomputed->irradiance(si.position, ng, density.maxRadius, scratch));
   return lambertianRadiance(diffuse, estimateIrradiance(global, si.position, ng, density, scratch).irradiance);
 }
 

@@ -41,6 +41,9 @@ constexpr int kRowsPerTask = 4;
 constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
 constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
 constexpr int kMaxRaysPerVertex = 256;
+// The caustic and indirect estimates are read on a kSmoothGrid x kSmoothGrid sub-grid of a
+// pixel's sample strata (when its strata allow): 4 of 64 samples, weighted 16 each.
+constexpr int kSmoothGrid = 2;
 
 float sceneDiagonal(const scene::Scene& scene) {
   scene::Bounds b = scene.bounds;
@@ -91,6 +94,24 @@ PhotonMapIntegrator::PhotonMapIntegrator(const scene::Scene& scene, const scene:
   causticDensity_.maxRadius = settings.causticRadius > 0.0f ? settings.causticRadius : kAutoCausticRadius * diagonal;
   causticDensity_.filter = DensityFilter::Cone;
   state_->cache = IrradianceCache(scene.bounds, settings.cacheAccuracy);
+  // Shadow rays per pixel: at least areaLightSamples in all, spread over the pixel's samples.
+  areaSamples_ = std::max(1, (settings.areaLightSamples + options.spp - 1) / options.spp);
+  // The smooth terms' samples: a regular sub-grid of the pixel's strata, about
+  // kSmoothSamplesPerPixel of them, each the centre stratum of its block of strata.
+  const glm::ivec2 strata = rt::strataFor(options.spp);
+  auto divisorUpTo = [](int n, int cap) {
+    int d = std::min(n, cap);
+    while (d > 1 && n % d != 0) --d;
+    return std::max(1, d);
+  };
+  smoothBlock_ = glm::ivec2(strata.x / divisorUpTo(strata.x, kSmoothGrid), strata.y / divisorUpTo(strata.y, kSmoothGrid));
+  smoothStrataX_ = strata.x;
+}
+
+float PhotonMapIntegrator::smoothWeight(std::uint16_t sample) const {
+  const int sx = int(sample) % smoothStrataX_, sy = int(sample) / smoothStrataX_;
+  if (sx % smoothBlock_.x != smoothBlock_.x / 2 || sy % smoothBlock_.y != smoothBlock_.y / 2) return 0.0f;
+  return float(smoothBlock_.x * smoothBlock_.y);
 }
 
 glm::vec3 PhotonMapIntegrator::mapRadiance(const KdTree& map, const DensityOptions& density,
@@ -119,9 +140,13 @@ void PhotonMapIntegrator::prePass(const rt::Bvh& world, par::Runtime& rt) const 
     photons.effects.set(scene::Effect::Caustics, settings_.view == PhotonView::CausticMap);
   }
   state_->maps = tracePhotons(ctx.scene(), world, photons, rt);
-  // Every PE reads both maps: replicated data, one broadcast of their bytes.
-  if (!state_->maps.global.empty() || !state_->maps.caustic.empty())
-    rt.recordBroadcast(state_->maps.global.bytes() + state_->maps.caustic.bytes());
+  state_->irradiance = PrecomputedIrradiance();
+  if (settings_.view == PhotonView::Full && settings_.irradianceStride > 0 && !state_->maps.global.empty())
+    state_->irradiance = PrecomputedIrradiance::build(ctx.scene(), world, state_->maps.global, globalDensity_,
+                                                      settings_.irradianceStride, rt);
+  // Every PE reads both maps and the precomputed points: replicated data, one broadcast.
+  const std::size_t replicated = state_->maps.global.bytes() + state_->maps.caustic.bytes() + state_->irradiance.bytes();
+  if (replicated > 0) rt.recordBroadcast(replicated);
   state_->cache = IrradianceCache(ctx.scene().bounds, settings_.cacheAccuracy);
   if (settings_.view == PhotonView::Full && ctx.simulates(scene::Effect::IndirectDiffuse) && !state_->maps.global.empty()) {
     buildCache(world, rt);
@@ -137,6 +162,7 @@ void PhotonMapIntegrator::buildCache(const rt::Bvh& world, par::Runtime& rt) con
   GatherOptions gather;
   gather.rays = settings_.gatherRays;
   gather.global = globalDensity_;
+  gather.precomputed = &state_->irradiance;
   gather.textures = textures;
   gather.seed = options().seed;
   const float pixelAngle = camera_.projection == scene::Projection::Orthographic
@@ -264,7 +290,9 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   // specular surfaces to the diffuse surface behind them, as in the cache's gathering.
   const bool secondary = msg.kind == RayKind::Gather || (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f);
   if (secondary) {
-    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(state.maps.global, globalDensity_, si, m));
+    thread_local NearestPhotons scratch;
+    out.addRadiance(msg.pixel, msg.throughput * globalMapRadiance(ctx.scene(), state.maps.global, &state.irradiance, si,
+                                                                  globalDensity_, ctx.simulates(scene::Effect::Textures), scratch));
     if (msg.kind != RayKind::Gather || msg.depth >= options().maxDepth) return;
     const float u = ctx.sample(msg, rt::Dim::kLobe);
     RayMessage next;
@@ -290,15 +318,17 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (rt::maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= options().maxDepth) return;
-  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, settings_.areaLightSamples);
+  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_);
 
-  // The diffuse part: caustics from the caustic map, indirect light from the cache.
-  const glm::vec3 diffuse = opaque * m.diffuseColor();
+  // The diffuse part: caustics from the caustic map, indirect light from the cache, both
+  // smooth over many pixels, so read by a stratified subset of the pixel's samples only.
+  const float smooth = smoothWeight(msg.sample);
+  const glm::vec3 diffuse = opaque * m.diffuseColor() * smooth;
   if (rt::maxComponent(diffuse) > 0.0f) {
     if (!ctx.simulates(scene::Effect::Caustics))
       ++out.stats().causticRaysSkipped;
     else if (!state.maps.caustic.empty())
-      out.addRadiance(msg.pixel, msg.throughput * mapRadiance(state.maps.caustic, causticDensity_, si, m));
+      out.addRadiance(msg.pixel, msg.throughput * smooth * mapRadiance(state.maps.caustic, causticDensity_, si, m));
     glm::vec3 irradiance;
     if (!ctx.simulates(scene::Effect::IndirectDiffuse)) {
       ++out.stats().indirectRaysSkipped;

@@ -24,6 +24,7 @@
 #include "photonmap/irradiance_cache.h"
 #include "photonmap/kd_tree.h"
 #include "photonmap/photon_tracer.h"
+#include "photonmap/precomputed_irradiance.h"
 #include "raytrace/integrators/trace_loop.h"
 
 namespace pr::pm {
@@ -38,7 +39,7 @@ PhotonView parsePhotonView(std::string_view text);
 struct PhotonMapSettings {
   std::size_t globalPhotons = 200000;   // --photons: emitted for the global map
   std::size_t causticPhotons = 100000;  // --caustic-photons
-  int globalK = 100;                    // --k: photons per global-map estimate
+  int globalK = 50;                     // --k: photons per global-map estimate
   int causticK = 60;                    // --caustic-k
   // Maximum search radii in scene units; 0 = a fraction of the scene's bounding diagonal
   // (kAutoGlobalRadius, kAutoCausticRadius).
@@ -47,10 +48,13 @@ struct PhotonMapSettings {
   int gatherRays = 256;                 // --gather: rays per irradiance-cache record
   float cacheAccuracy = 0.25f;          // --cache-accuracy: Ward's a
   int fallbackGatherRays = 64;          // gather rays as messages where no record covers a point
-  int areaLightSamples = 4;             // shadow rays per area-light evaluation
+  int areaLightSamples = 4;             // area-light shadow rays per pixel, at least one per sample
   int maxGlossyRays = 16;               // glossy rays at a first hit of roughness 1 (fewer when smoother)
   PhotonView view = PhotonView::Full;   // --view
   std::size_t photonBatch = 4096;       // photons per task of pass 1
+  // Every n-th global photon carries a precomputed irradiance estimate that gathering reads
+  // (Christensen 1999); 0 = none, every gather hit makes its own density estimate.
+  int irradianceStride = 4;
 };
 
 inline constexpr float kAutoGlobalRadius = 0.05f;    // x the scene's bounding diagonal
@@ -69,7 +73,8 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
     return s;
   }
   bool needsWorldPrePass() const override { return true; }
-  // Pass 1 (stages "photon trace", "photon-kd-build"), the maps' broadcast, and the cache
+  // Pass 1 (stages "photon trace", "photon-kd-build"), the precomputed irradiance (stage
+  // "precompute irradiance"), the maps' broadcast, and the cache
   // (stages "irradiance-cache probe", "irradiance-cache gather 1/16" ... "1/1"), with its
   // records' broadcast; counters Photons/... and IrradianceCache/records, Gather/rays.
   void prePass(const rt::Bvh& world, par::Runtime& rt) const override;
@@ -79,6 +84,7 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
   // What the pre-pass built (valid after prePass).
   const PhotonMaps& maps() const { return state_->maps; }
   const IrradianceCache& cache() const { return state_->cache; }
+  const PrecomputedIrradiance& precomputedIrradiance() const { return state_->irradiance; }
   const DensityOptions& globalDensity() const { return globalDensity_; }
   const DensityOptions& causticDensity() const { return causticDensity_; }
 
@@ -87,6 +93,7 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
   // stage, read-only by every PE afterwards (the integrator itself is shared as const).
   struct State {
     PhotonMaps maps;
+    PrecomputedIrradiance irradiance;
     IrradianceCache cache;
   };
   void buildCache(const rt::Bvh& world, par::Runtime& rt) const;
@@ -94,8 +101,15 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
   glm::vec3 mapRadiance(const KdTree& map, const DensityOptions& density, const rt::SurfaceInteraction& si,
                         const rt::ShadingMaterial& m) const;
 
+  // The weight of sample `sample`'s caustic and indirect estimates: 0 outside the stratified
+  // subset of the pixel's samples that reads them, the subset's inverse share inside it.
+  float smoothWeight(std::uint16_t sample) const;
+
   PhotonMapSettings settings_;
   scene::Camera camera_;
+  int areaSamples_ = 1;            // area-light samples per shading point
+  glm::ivec2 smoothBlock_{1, 1};   // strata per block of the smooth terms' sub-grid
+  int smoothStrataX_ = 1;
   DensityOptions globalDensity_, causticDensity_;
   std::unique_ptr<State> state_;
 };

@@ -11,5 +11,6 @@ void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
+void addSweepCommand(CLI::App& app);
 
 }  // namespace pr::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   pr::cli::addInfoCommand(app);
   pr::cli::addRenderCommand(app);
   pr::cli::addSimulateCommand(app);
+  pr::cli::addSweepCommand(app);
 
   try {
     app.parse(argc, argv);
