@@ -1,16 +1,14 @@
 // Final gathering into an irradiance-cache record (see final_gather.h). The gradient formulas
-// are Ward and Heckbert, "Irradiance Gradients" (1992), eqs. for the rotation gradient and the
-// translation gradient over the cells of the (theta, phi) stratification.
+// are Ward and Heckbert, "Irradiance Gradients" (1992): the rotation gradient from each cell's
+// direction, the translation gradient from the walls between neighbouring cells.
 #include "photonmap/final_gather.h"
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 #include <vector>
 
 #include "raytrace/core/bvh.h"
 #include "raytrace/integrators/bsdf.h"
-#include "raytrace/integrators/integrator.h"
 #include "raytrace/integrators/sampling.h"
 
 namespace pr::pm {
@@ -23,54 +21,13 @@ using rt::kPi;
 // paths' (seed, pixel, sample, depth, dim).
 constexpr std::uint64_t kGatherSalt = 0x6761746865720000ull;  // "gather"
 constexpr std::uint32_t kThetaDim = 0, kPhiDim = 1, kBranchDim = 2;
+constexpr std::uint32_t kDirectionDepth = 255;
 
-struct GatherSample {
-  glm::vec3 radiance{0.0f};
-  float distance = std::numeric_limits<float>::infinity();  // to the first hit
-};
-
-// One gather ray: the global map's radiance at the first surface with a diffuse part, through
-// up to options.specularBounces ideal mirror or glass bounces (a dielectric's reflection or
-// refraction chosen by its Fresnel term, which cancels the choice's weight).
-GatherSample traceGatherRay(const scene::Scene& scene, const rt::Bvh& bvh, const KdTree& global, rt::Ray ray,
-                            std::uint32_t id, std::uint32_t index, const GatherOptions& options, NearestPhotons& scratch,
-                            std::uint64_t& rays) {
-  GatherSample out;
-  glm::vec3 throughput(1.0f);
-  for (int bounce = 0; bounce <= options.specularBounces; ++bounce) {
-    rt::Hit hit;
-    ++rays;
-    if (!bvh.intersect(ray, hit)) return out;
-    const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
-    if (bounce == 0) out.distance = hit.t * glm::length(ray.direction);
-    out.radiance += throughput * globalMapRadiance(scene, global, options.precomputed, si, options.global, options.textures, scratch);
-    const rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
-    const rt::ShadingFrame sf(si);
-    const float dielectric = m.dielectricWeight();
-    const float u = rt::sample1D(options.seed ^ kGatherSalt, id, index, std::uint32_t(bounce), kBranchDim);
-    glm::vec3 wi;
-    if (u < dielectric) {
-      const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-      const float cosI = glm::dot(sf.ns, si.wo);
-      glm::vec3 wt;
-      if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
-        wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
-      } else {
-        wi = wt;
-        throughput *= m.baseColor;
-      }
-    } else if (m.hasSpecular() && m.deltaSpecular()) {
-      // The opaque part's mirror (its selection probability 1 - dielectric cancels its weight).
-      throughput *= rt::fresnelSchlick(m.specularF0(), sf.woLocal.z);
-      wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-      if (glm::dot(wi, sf.ng) <= 0.0f) return out;
-    } else {
-      return out;
-    }
-    if (!(rt::maxComponent(throughput) > 0.0f)) return out;
-    ray = rt::spawnRay(si, wi);
-  }
-  return out;
+// The jittered (sin^2 theta, phi) of ray j.
+void cellAngles(GatherStrata strata, std::uint32_t id, std::uint32_t j, std::uint64_t seed, float& sin2, float& phi) {
+  const int jj = int(j) / strata.n, k = int(j) % strata.n;
+  sin2 = (float(jj) + rt::sample1D(seed ^ kGatherSalt, id, j, kDirectionDepth, kThetaDim)) / float(strata.m);
+  phi = 2.0f * kPi * (float(k) + rt::sample1D(seed ^ kGatherSalt, id, j, kDirectionDepth, kPhiDim)) / float(strata.n);
 }
 
 }  // namespace
@@ -87,41 +44,87 @@ glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, con
   return lambertianRadiance(diffuse, estimateIrradiance(global, si.position, ng, density, scratch).irradiance);
 }
 
-IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh, const KdTree& global,
-                                  const rt::SurfaceInteraction& si, std::uint32_t id, const GatherOptions& options,
-                                  NearestPhotons& scratch, std::uint64_t& rays) {
+GatherStrata gatherStrata(int rays) {
+  GatherStrata s;
+  s.m = std::max(1, int(std::lround(std::sqrt(double(std::max(1, rays)) / double(kPi)))));
+  s.n = std::max(1, int(std::lround(double(std::max(1, rays)) / double(s.m))));
+  return s;
+}
+
+bool gatherRay(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata, std::uint32_t id,
+               std::uint32_t j, const GatherOptions& options, rt::Ray& ray) {
+  float sin2, phi;
+  cellAngles(strata, id, j, options.seed, sin2, phi);
+  const float sinTheta = std::sqrt(std::min(sin2, rt::kOneMinusEpsilon));
+  const float cosTheta = std::sqrt(std::max(0.0f, 1.0f - sin2));
+  const glm::vec3 wi = sf.frame.toWorld(glm::vec3(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta));
+  if (glm::dot(wi, sf.ng) <= 0.0f) return false;
+  ray = rt::spawnRay(si, wi);
+  return true;
+}
+
+GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& global, const rt::SurfaceInteraction& si,
+                                    const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
+                                    const GatherOptions& options, NearestPhotons& scratch) {
+  GatherInteraction out;
+  out.radiance = throughput * globalMapRadiance(scene, global, options.precomputed, si, options.global, options.textures, scratch);
+  if (bounce >= options.specularBounces) return out;
+  // On through an ideal mirror or glass: a dielectric's reflection or refraction chosen by its
+  // Fresnel term (which cancels the choice's weight), an opaque mirror's reflection (its
+  // selection probability 1 - dielectric cancels its weight).
+  const rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
   const rt::ShadingFrame sf(si);
-  const int m = std::max(1, int(std::lround(std::sqrt(double(std::max(1, options.rays)) / double(kPi)))));
-  const int n = std::max(1, int(std::lround(double(std::max(1, options.rays)) / double(m))));
-  std::vector<GatherSample> cells(std::size_t(m) * std::size_t(n));
-  const std::uint64_t seed = options.seed ^ kGatherSalt;
+  const float dielectric = m.dielectricWeight();
+  const float u = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kBranchDim);
+  glm::vec3 wi;
+  out.throughput = throughput;
+  if (u < dielectric) {
+    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+    const float cosI = glm::dot(sf.ns, si.wo);
+    glm::vec3 wt;
+    if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
+      wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+    } else {
+      wi = wt;
+      out.throughput *= m.baseColor;
+    }
+  } else if (m.hasSpecular() && m.deltaSpecular()) {
+    out.throughput *= rt::fresnelSchlick(m.specularF0(), sf.woLocal.z);
+    wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
+    if (glm::dot(wi, sf.ng) <= 0.0f) return out;
+  } else {
+    return out;
+  }
+  if (!(rt::maxComponent(out.throughput) > 0.0f)) return out;
+  out.continues = true;
+  out.next = rt::spawnRay(si, wi);
+  return out;
+}
+
+IrradianceRecord combineGather(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata,
+                               std::uint32_t id, const GatherOptions& options, std::span<const GatherCell> cells) {
+  const int m = strata.m, n = strata.n;
   IrradianceRecord record;
   record.position = si.position;
   record.normal = sf.ns;
   glm::vec3 rotation[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};  // local frame
   float inverseDistances = 0.0f;
-  for (int j = 0; j < m; ++j)
-    for (int k = 0; k < n; ++k) {
-      const std::uint32_t index = std::uint32_t(j * n + k);
-      const float sin2 = (float(j) + rt::sample1D(seed, id, index, 255, kThetaDim)) / float(m);
-      const float phi = 2.0f * kPi * (float(k) + rt::sample1D(seed, id, index, 255, kPhiDim)) / float(n);
-      const float sinTheta = std::sqrt(std::min(sin2, rt::kOneMinusEpsilon));
-      const float cosTheta = std::sqrt(std::max(0.0f, 1.0f - sin2));
-      const glm::vec3 local(sinTheta * std::cos(phi), sinTheta * std::sin(phi), cosTheta);
-      const glm::vec3 wi = sf.frame.toWorld(local);
-      GatherSample& cell = cells[index];
-      if (glm::dot(wi, sf.ng) > 0.0f)
-        cell = traceGatherRay(scene, bvh, global, rt::spawnRay(si, wi), id, index, options, scratch, rays);
-      record.irradiance += cell.radiance;
-      if (std::isfinite(cell.distance) && cell.distance > 0.0f) inverseDistances += 1.0f / cell.distance;
-      // Rotation gradient: turning n by delta about an axis A changes cos(theta) of direction w
-      // by delta A . (n x w), so grad_r = int L (n x w) dw = int L sin(theta) v(phi) dw, with
-      // v the base-plane direction a quarter turn from phi; over cosine-distributed cells of
-      // solid angle pi / (MN cos(theta)) each: pi/(MN) sum tan(theta) L v.
-      const float tanTheta = sinTheta / std::max(cosTheta, 1.0e-4f);
-      const glm::vec3 v(-std::sin(phi), std::cos(phi), 0.0f);
-      for (int c = 0; c < 3; ++c) rotation[c] += (tanTheta * cell.radiance[c]) * v;
-    }
+  for (int j = 0; j < m * n; ++j) {
+    const GatherCell& cell = cells[std::size_t(j)];
+    record.irradiance += cell.radiance;
+    if (std::isfinite(cell.distance) && cell.distance > 0.0f) inverseDistances += 1.0f / cell.distance;
+    // Rotation gradient: turning n by delta about an axis A changes cos(theta) of direction w
+    // by delta A . (n x w), so grad_r = int L (n x w) dw = int L sin(theta) v(phi) dw, with
+    // v the base-plane direction a quarter turn from phi; over cosine-distributed cells of
+    // solid angle pi / (MN cos(theta)) each: pi/(MN) sum tan(theta) L v.
+    float sin2, phi;
+    cellAngles(strata, id, std::uint32_t(j), options.seed, sin2, phi);
+    const float sinTheta = std::sqrt(std::min(sin2, rt::kOneMinusEpsilon));
+    const float cosTheta = std::sqrt(std::max(0.0f, 1.0f - sin2));
+    const float tanTheta = sinTheta / std::max(cosTheta, 1.0e-4f);
+    const glm::vec3 v(-std::sin(phi), std::cos(phi), 0.0f);
+    for (int c = 0; c < 3; ++c) rotation[c] += (tanTheta * cell.radiance[c]) * v;
+  }
   const float cellWeight = kPi / float(m * n);
   record.irradiance *= cellWeight;
   record.radius = inverseDistances > 0.0f ? float(m * n) / inverseDistances : std::numeric_limits<float>::infinity();
@@ -129,7 +132,7 @@ IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh,
   // Translation gradient: the change of each cell's solid angle as the centre moves, from the
   // differences across the walls between neighbouring cells, each over the nearer wall distance.
   glm::vec3 translation[3] = {glm::vec3(0.0f), glm::vec3(0.0f), glm::vec3(0.0f)};
-  auto cell = [&](int j, int k) -> const GatherSample& { return cells[std::size_t(j * n + ((k % n) + n) % n)]; };
+  auto cell = [&](int j, int k) -> const GatherCell& { return cells[std::size_t(j * n + ((k % n) + n) % n)]; };
   auto inverseMin = [](float a, float b) {
     const float d = std::min(a, b);
     return std::isfinite(d) && d > 0.0f ? 1.0f / d : 0.0f;
@@ -158,6 +161,33 @@ IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh,
     record.translationGradient[c] = sf.frame.toWorld(translation[c]);
   }
   return record;
+}
+
+IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh, const KdTree& global,
+                                  const rt::SurfaceInteraction& si, std::uint32_t id, const GatherOptions& options,
+                                  NearestPhotons& scratch, std::uint64_t& rays) {
+  const rt::ShadingFrame sf(si);
+  const GatherStrata strata = gatherStrata(options.rays);
+  std::vector<GatherCell> cells(std::size_t(strata.cells()));
+  for (int j = 0; j < strata.cells(); ++j) {
+    rt::Ray ray;
+    if (!gatherRay(si, sf, strata, id, std::uint32_t(j), options, ray)) continue;
+    GatherCell& cell = cells[std::size_t(j)];
+    glm::vec3 throughput(1.0f);
+    for (int bounce = 0;; ++bounce) {
+      rt::Hit hit;
+      ++rays;
+      if (!bvh.intersect(ray, hit)) break;
+      const rt::SurfaceInteraction h = rt::makeInteraction(scene, ray, hit);
+      if (bounce == 0) cell.distance = hit.t * glm::length(ray.direction);
+      const GatherInteraction step = gatherInteraction(scene, global, h, throughput, id, std::uint32_t(j), bounce, options, scratch);
+      cell.radiance += step.radiance;
+      if (!step.continues) break;
+      ray = step.next;
+      throughput = step.throughput;
+    }
+  }
+  return combineGather(si, sf, strata, id, options, cells);
 }
 
 }  // namespace pr::pm

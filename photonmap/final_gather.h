@@ -1,11 +1,15 @@
 // Final gathering (seed chapter "Global Illumination in Complex Scenes using Photon Maps",
 // section 2.4; Jensen 1996): the indirect irradiance at a diffuse point from a stratified
 // hemisphere of rays whose hits are read from the global photon map, as one irradiance-cache
-// record with its Ward-Heckbert gradients and the harmonic mean distance that sizes it. Runs
-// in the photon-map integrator's pre-pass on a world-model PE (the scene and its BVH).
+// record with its Ward-Heckbert gradients and the harmonic mean distance that sizes it. The
+// pieces - the ray directions, one interaction of a gather ray, the record from the cells -
+// are run by the irradiance cache's pre-pass program through any tracer; gatherIrradiance runs
+// them in one go over a world BVH.
 #pragma once
 
 #include <cstdint>
+#include <limits>
+#include <span>
 
 #include <glm/glm.hpp>
 
@@ -15,6 +19,7 @@
 #include "photonmap/kd_tree.h"
 #include "photonmap/precomputed_irradiance.h"
 #include "raytrace/core/interaction.h"
+#include "raytrace/integrators/integrator.h"
 
 namespace pr::rt {
 class Bvh;
@@ -40,10 +45,44 @@ glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, con
                             const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
                             NearestPhotons& scratch);
 
-// Gathers the irradiance at si on the side of si.wo (shading normal) with options.rays rays
-// stratified in (theta, phi) over the cosine-weighted hemisphere, Ward's E = pi/(MN) sum L_jk;
-// radius is the harmonic mean distance of the hits (infinite when every ray escapes) before any
-// clamping. id selects the random stream (the record's pixel). Adds the rays traced to rays.
+// The M x N (theta, phi) strata of a record's rays: M = round(sqrt(rays / pi)), N = round(rays / M).
+struct GatherStrata {
+  int m = 1, n = 1;
+  int cells() const { return m * n; }
+};
+GatherStrata gatherStrata(int rays);
+
+// Ray j of record `id` leaving si (its shading frame sf): cell (j / N, j % N), cosine-weighted
+// and jittered; false when it points below the geometric surface (the cell stays dark).
+bool gatherRay(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata, std::uint32_t id,
+               std::uint32_t j, const GatherOptions& options, rt::Ray& ray);
+
+// One hit of a gather ray (its bounce-th, through ideal mirrors and glass): the global map's
+// radiance there times the ray's throughput, and the ray it goes on as, if any.
+struct GatherInteraction {
+  glm::vec3 radiance{0.0f};
+  bool continues = false;
+  rt::Ray next;
+  glm::vec3 throughput{0.0f};
+};
+GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& global, const rt::SurfaceInteraction& si,
+                                    const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
+                                    const GatherOptions& options, NearestPhotons& scratch);
+
+// What a record's ray j brought back: its radiance (summed over its hits in bounce order) and
+// the distance to its first hit (infinite when it left the scene).
+struct GatherCell {
+  glm::vec3 radiance{0.0f};
+  float distance = std::numeric_limits<float>::infinity();
+};
+
+// The record from its cells (strata.cells() of them, in ray order): E = pi/(MN) sum L, the
+// rotation and translation gradients, and the harmonic mean distance as radius (unclamped).
+IrradianceRecord combineGather(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata,
+                               std::uint32_t id, const GatherOptions& options, std::span<const GatherCell> cells);
+
+// All of it over a world BVH on the calling thread: the record at si on the side of si.wo.
+// id selects the random stream (the record's pixel). Adds the rays traced to rays.
 IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh, const KdTree& global,
                                   const rt::SurfaceInteraction& si, std::uint32_t id, const GatherOptions& options,
                                   NearestPhotons& scratch, std::uint64_t& rays);

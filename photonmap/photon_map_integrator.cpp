@@ -16,6 +16,8 @@
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "photonmap/final_gather.h"
+#include "photonmap/irradiance_cache_pass.h"
+#include "photonmap/photon_pass.h"
 #include "raytrace/core/bvh.h"
 
 namespace pr::pm {
@@ -28,15 +30,6 @@ using rt::RayMessage;
 
 // Rays weaker than this add nothing visible (below 1/4096 of a camera ray's weight).
 constexpr float kMinThroughput = 1.0f / 4096.0f;
-// Cache levels: probe grids of stride 16 down to 1 pixel.
-constexpr int kCoarsestStride = 16;
-// A record's reach a R_i in pixels at its distance: at least 1.5 (so a stride-1 grid is
-// covered between records), at most 24 (so large flat walls still get a record every few
-// dozen pixels, bounding the extrapolation by gradients).
-constexpr float kMinReachPixels = 1.5f;
-constexpr float kMaxReachPixels = 24.0f;
-// Rows of the image per task of a cache level.
-constexpr int kRowsPerTask = 4;
 // Random dimensions of this integrator at a vertex: fallback gather rays, then glossy rays.
 constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
 constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
@@ -125,7 +118,7 @@ glm::vec3 PhotonMapIntegrator::mapRadiance(const KdTree& map, const DensityOptio
 
 // ---- pre-pass ---------------------------------------------------------------------------------
 
-void PhotonMapIntegrator::prePass(const rt::Bvh& world, par::Runtime& rt) const {
+void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) const {
   const rt::IntegratorContext& ctx = context();
   PhotonOptions photons;
   photons.seed = options().seed;
@@ -139,127 +132,32 @@ void PhotonMapIntegrator::prePass(const rt::Bvh& world, par::Runtime& rt) const 
     photons.effects.set(scene::Effect::IndirectDiffuse, settings_.view == PhotonView::GlobalMap);
     photons.effects.set(scene::Effect::Caustics, settings_.view == PhotonView::CausticMap);
   }
-  state_->maps = tracePhotons(ctx.scene(), world, photons, rt);
+  // Pass 1 through the render's tracer; the maps are built from the merged photons.
+  PhotonLists lists = tracePhotonMessages(ctx.scene(), camera_, photons, tracer, rt);
+  state_->maps.stats = lists.stats;
+  state_->maps.global = KdTree::build(lists.global, rt);
+  state_->maps.caustic = KdTree::build(std::move(lists.caustic), rt);
   state_->irradiance = PrecomputedIrradiance();
   if (settings_.view == PhotonView::Full && settings_.irradianceStride > 0 && !state_->maps.global.empty())
-    state_->irradiance = PrecomputedIrradiance::build(ctx.scene(), world, state_->maps.global, globalDensity_,
-                                                      settings_.irradianceStride, rt);
+    state_->irradiance = PrecomputedIrradiance::build(lists.global, lists.globalNormals, state_->maps.global,
+                                                      globalDensity_, settings_.irradianceStride, rt);
   // Every PE reads both maps and the precomputed points: replicated data, one broadcast.
   const std::size_t replicated = state_->maps.global.bytes() + state_->maps.caustic.bytes() + state_->irradiance.bytes();
   if (replicated > 0) rt.recordBroadcast(replicated);
+
   state_->cache = IrradianceCache(ctx.scene().bounds, settings_.cacheAccuracy);
   if (settings_.view == PhotonView::Full && ctx.simulates(scene::Effect::IndirectDiffuse) && !state_->maps.global.empty()) {
-    buildCache(world, rt);
+    CachePassOptions cache;
+    cache.gather.rays = settings_.gatherRays;
+    cache.gather.global = globalDensity_;
+    cache.gather.precomputed = &state_->irradiance;
+    cache.gather.textures = ctx.simulates(scene::Effect::Textures);
+    cache.gather.seed = options().seed;
+    cache.accuracy = settings_.cacheAccuracy;
+    cache.maxDepth = options().maxDepth;
+    cache.camera = options();
+    state_->cache = buildIrradianceCache(ctx.scene(), camera_, ctx.width(), ctx.height(), state_->maps.global, cache, tracer, rt);
     if (state_->cache.size() > 0) rt.recordBroadcast(state_->cache.bytes());
-  }
-}
-
-void PhotonMapIntegrator::buildCache(const rt::Bvh& world, par::Runtime& rt) const {
-  const rt::IntegratorContext& ctx = context();
-  const scene::Scene& scene = ctx.scene();
-  const int width = ctx.width(), height = ctx.height();
-  const bool textures = ctx.simulates(scene::Effect::Textures);
-  GatherOptions gather;
-  gather.rays = settings_.gatherRays;
-  gather.global = globalDensity_;
-  gather.precomputed = &state_->irradiance;
-  gather.textures = textures;
-  gather.seed = options().seed;
-  const float pixelAngle = camera_.projection == scene::Projection::Orthographic
-                               ? 0.0f
-                               : 2.0f * std::tan(0.5f * camera_.yfov) / float(height);
-  const float orthoPixel = 2.0f * camera_.ymag / float(height);
-  const float a = settings_.cacheAccuracy;
-  IrradianceCache& cache = state_->cache;
-
-  // The first surface with a diffuse part that pixel p's camera ray reaches through ideal
-  // mirrors and glass (the dominant branch at each dielectric), and the world size of a pixel
-  // there; nullopt when the path leaves the scene or ends on a purely glossy surface.
-  struct Probe {
-    rt::SurfaceInteraction si;
-    float footprint = 0.0f;
-  };
-  auto probe = [&](int x, int y) -> std::optional<Probe> {
-    std::vector<RayMessage> rays;
-    cameraRays(rt::PixelRect{x, y, x + 1, y + 1}, 1, rays);
-    rt::Ray ray = rays.front().ray;
-    float travelled = 0.0f;
-    for (int depth = 0; depth < options().maxDepth; ++depth) {
-      rt::Hit hit;
-      if (!world.intersect(ray, hit)) return std::nullopt;
-      const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
-      travelled += hit.t * glm::length(ray.direction);
-      const rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures);
-      const rt::ShadingFrame sf(si);
-      if (rt::maxComponent((1.0f - m.dielectricWeight()) * m.diffuseColor()) > 0.0f)
-        return Probe{si, pixelAngle > 0.0f ? travelled * pixelAngle : orthoPixel};
-      glm::vec3 wi;
-      if (m.dielectricWeight() >= 0.5f) {
-        const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-        const float cosI = glm::dot(sf.ns, si.wo);
-        glm::vec3 wt;
-        if (rt::fresnelDielectric(cosI, eta) < 0.5f && rt::refractDirection(si.wo, sf.ns, eta, wt))
-          wi = wt;
-        else
-          wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
-      } else if (m.hasSpecular() && m.deltaSpecular()) {
-        wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-      } else {
-        return std::nullopt;
-      }
-      ray = rt::spawnRay(si, wi);
-    }
-    return std::nullopt;
-  };
-
-  std::vector<std::uint64_t> raysPerPe(std::size_t(rt.pes()), 0), recordsPerPe(std::size_t(rt.pes()), 0),
-      probesPerPe(std::size_t(rt.pes()), 0);
-  for (int stride = kCoarsestStride; stride >= 1; stride /= 2) {
-    // This level's probe pixels: on the stride grid, not on the previous (coarser) one.
-    auto onLevel = [&](int x, int y) {
-      if (x % stride != 0 || y % stride != 0) return false;
-      return stride == kCoarsestStride || x % (2 * stride) != 0 || y % (2 * stride) != 0;
-    };
-    const int rows = (height + stride - 1) / stride;
-    const int tasks = (rows + kRowsPerTask - 1) / kRowsPerTask;
-    std::vector<std::vector<std::pair<std::uint32_t, IrradianceRecord>>> found(static_cast<std::size_t>(tasks));
-    rt.runStage("irradiance-cache gather 1/" + std::to_string(stride), par::TaskSet::uniform(std::size_t(tasks)),
-                [&](par::Pe& pe, par::TaskId task) {
-                  NearestPhotons scratch;
-                  std::uint64_t rays = 0;
-                  for (int row = int(task) * kRowsPerTask; row < std::min(rows, int(task + 1) * kRowsPerTask); ++row) {
-                    const int y = row * stride;
-                    for (int x = 0; x < width; x += stride) {
-                      if (!onLevel(x, y)) continue;
-                      ++probesPerPe[std::size_t(pe.id())];
-                      const std::optional<Probe> p = probe(x, y);
-                      if (!p) continue;
-                      const rt::ShadingFrame sf(p->si);
-                      if (cache.covers(p->si.position, sf.ns)) continue;
-                      const std::uint32_t pixel = std::uint32_t(y) * std::uint32_t(width) + std::uint32_t(x);
-                      IrradianceRecord r = gatherIrradiance(scene, world, state_->maps.global, p->si, pixel, gather, scratch, rays);
-                      // The translation-gradient limit (Krivanek et al. 2006): the extrapolation by
-                      // the gradient may not halve the irradiance within the radius.
-                      const glm::vec3 w(0.2126f, 0.7152f, 0.0722f);
-                      const glm::vec3 g = w.x * r.translationGradient[0] + w.y * r.translationGradient[1] +
-                                          w.z * r.translationGradient[2];
-                      const float e = rt::luminance(r.irradiance), gl = glm::length(g);
-                      if (gl > 0.0f && e > 0.0f) r.radius = std::min(r.radius, e / gl);
-                      r.radius = std::clamp(r.radius, kMinReachPixels * p->footprint / a, kMaxReachPixels * p->footprint / a);
-                      found[std::size_t(task)].push_back({pixel, r});
-                      ++recordsPerPe[std::size_t(pe.id())];
-                    }
-                  }
-                  raysPerPe[std::size_t(pe.id())] += rays;
-                });
-    // In pixel order: tasks are bands of rows in order, each band's records in scan order.
-    for (auto& band : found)
-      for (auto& [pixel, record] : band) cache.insert(record);
-  }
-  for (int p = 0; p < rt.pes(); ++p) {
-    rt.addCounter("IrradianceCache/probes", p, double(probesPerPe[std::size_t(p)]));
-    rt.addCounter("IrradianceCache/records", p, double(recordsPerPe[std::size_t(p)]));
-    rt.addCounter("Gather/rays", p, double(raysPerPe[std::size_t(p)]));
   }
 }
 

@@ -72,12 +72,11 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
     s.set(scene::Effect::Anisotropy, false);
     return s;
   }
-  bool needsWorldPrePass() const override { return true; }
-  // Pass 1 (stages "photon trace", "photon-kd-build"), the precomputed irradiance (stage
-  // "precompute irradiance"), the maps' broadcast, and the cache
-  // (stages "irradiance-cache probe", "irradiance-cache gather 1/16" ... "1/1"), with its
-  // records' broadcast; counters Photons/... and IrradianceCache/records, Gather/rays.
-  void prePass(const rt::Bvh& world, par::Runtime& rt) const override;
+  bool hasPrePass() const override { return true; }
+  // Through the render's tracer: pass 1 (photon_pass.h, stage "photon merge" and the photon
+  // program's), the kd-trees, the precomputed irradiance, the maps' broadcast, and the
+  // irradiance cache (irradiance_cache_pass.h) with its records' broadcast.
+  void prePass(rt::PrePassTracer& tracer, par::Runtime& rt) const override;
   void shade(const rt::SurfaceInteraction& si, const rt::RayMessage& msg, rt::Emit& out) const override;
 
   const PhotonMapSettings& settings() const { return settings_; }
@@ -96,7 +95,6 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
     PrecomputedIrradiance irradiance;
     IrradianceCache cache;
   };
-  void buildCache(const rt::Bvh& world, par::Runtime& rt) const;
   // The map's Lambertian radiance at si: opaque weight x diffuse colour / pi x E.
   glm::vec3 mapRadiance(const KdTree& map, const DensityOptions& density, const rt::SurfaceInteraction& si,
                         const rt::ShadingMaterial& m) const;

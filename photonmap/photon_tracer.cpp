@@ -114,7 +114,7 @@ struct Emitter {
 
 struct Setup {
   const scene::Scene* scene;
-  const rt::Bvh* bvh;
+  PhotonOptions options_;
   const PhotonOptions* options;
   std::vector<Emitter> emitters;
   std::vector<std::size_t> firstPhoton[2];  // per map: emitter e owns photons [first[e], first[e+1])
@@ -198,12 +198,6 @@ glm::vec2 stratified(std::size_t j, std::size_t n, float u, float v) {
           std::min((float(cell / m) + v) / float(m), rt::kOneMinusEpsilon)};
 }
 
-struct EmittedPhoton {
-  rt::Ray ray;
-  glm::vec3 power{0.0f};
-  const scene::PunctualLight* light = nullptr;  // for the range window at the first hit
-};
-
 // Photon `index` (global within its map) of emitter e, which owns n photons from `first` on.
 bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhoton& out) {
   const std::uint64_t seed = s.options->seed;
@@ -217,7 +211,7 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
   if (em.light >= 0) {
     const scene::PunctualLight& light = scene.lights[std::size_t(em.light)];
     const glm::vec3 colour = light.color * light.intensity;
-    out.light = &light;
+    out.range = light.range;
     if (light.type == scene::LightType::Directional) {
       // A disc of the scene's bounding sphere, perpendicular to the light, upstream of it:
       // flux E pi R^2 (E in lux at normal incidence).
@@ -256,7 +250,7 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
       }
       out.ray = rt::Ray{origin, 0.0f, light.direction, rt::kInfinity};
       out.power = colour * area / float(n);
-      out.light = nullptr;
+      out.range = 0.0f;
       return true;
     }
     glm::vec3 dir;
@@ -324,83 +318,88 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
   if (!(weight > 0.0f)) return false;
   out.ray = rt::Ray{rt::spawnOrigin(si, dir), 0.0f, dir, rt::kInfinity};
   out.power = le * (weight * (sides ? 2.0f : 1.0f) / (pdfArea * float(n)));
-  out.light = nullptr;
+  out.range = 0.0f;
   return rt::maxComponent(out.power) > 0.0f && rt::isFinite(out.power);
 }
 
-// Follows one photon: stores it at every surface with a Lambertian part (global map) or at
-// the first such surface after specular bounces only (caustic map), then continues by
-// Russian roulette over the BSDF's parts until absorbed.
-void trace(const Setup& s, int map, std::uint32_t index, EmittedPhoton photon, std::vector<Photon>& store) {
-  const scene::Scene& scene = *s.scene;
+// One surface interaction of photon `index` of `map` (see photonInteraction in the header).
+PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bounce, glm::vec3 power, float range,
+                           const rt::Ray& ray, const rt::Hit& hit, const rt::SurfaceInteraction& si) {
+  PhotonInteraction out;
   const bool caustic = map == kCausticStream;
   const std::uint64_t seed = s.options->seed;
-  rt::Ray ray = photon.ray;
-  glm::vec3 power = photon.power;
-  for (int bounce = 0; bounce < s.options->maxBounces; ++bounce) {
-    rt::Hit hit;
-    if (!s.bvh->intersect(ray, hit)) return;
-    const rt::SurfaceInteraction si = rt::makeInteraction(scene, ray, hit);
-    if (bounce == 0 && photon.light) power *= scene::rangeWindow(hit.t * glm::length(ray.direction), photon.light->range);
-    const rt::ShadingMaterial m = rt::evalMaterial(scene, si, s.options->textures);
-    const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
+  if (bounce == 0) power *= scene::rangeWindow(hit.t * glm::length(ray.direction), range);
+  const rt::ShadingMaterial m = rt::evalMaterial(*s.scene, si, s.options->textures);
+  const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 
-    // Storage: the photon's incident flux wherever the surface has a diffuse part.
-    if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
-      if (caustic) {
-        if (bounce > 0) store.push_back(Photon::make(si.position, power, si.wo, PhotonMapKind::Caustic, bounce));
-        return;  // a caustic path ends at its first diffuse surface
+  // Storage: the photon's incident flux wherever the surface has a diffuse part.
+  if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
+    const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
+    if (caustic) {
+      if (bounce > 0) {
+        out.stored = true;
+        out.photon = Photon::make(si.position, power, si.wo, PhotonMapKind::Caustic, bounce);
+        out.normal = ng;
       }
-      store.push_back(Photon::make(si.position, power, si.wo, PhotonMapKind::Global, bounce));
+      return out;  // a caustic path ends at its first diffuse surface
     }
-
-    // Choose the part like the path tracer: the dielectric with probability equal to its
-    // weight, reflection against refraction by the Fresnel term, else the opaque lobes by
-    // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
-    // left, f cos / pdf, is the part's albedo along the sampled direction.
-    const rt::ShadingFrame sf(si);
-    const float dielectric = m.dielectricWeight();
-    const float opaque = 1.0f - dielectric;
-    const float lobe = sample(rt::Dim::kLobe);
-    glm::vec3 wi, factor;
-    bool specular;
-    if (lobe < dielectric) {
-      const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-      const float cosI = glm::dot(sf.ns, si.wo);
-      const float fr = rt::fresnelDielectric(cosI, eta);
-      glm::vec3 wt;
-      if (lobe / dielectric < fr || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
-        wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
-        factor = glm::vec3(1.0f);
-      } else {
-        wi = wt;
-        factor = m.baseColor;  // flux is conserved through refraction: no eta^2 (that is radiance)
-      }
-      specular = true;
-    } else {
-      const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, rt::kOneMinusEpsilon);
-      const rt::BsdfSample b = rt::sampleOpaque(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));
-      if (!b.valid) return;
-      wi = sf.frame.toWorld(b.wi);
-      if (glm::dot(wi, sf.ng) <= 0.0f) return;  // a reflection leaves on the side it arrived from
-      factor = b.weight;
-      specular = b.delta;
-    }
-    if (caustic && !specular) return;  // glossy or diffuse: no longer an L S+ D path
-
-    // Absorption by Russian roulette (Jensen): survive with q = the largest channel of the
-    // factor (capped at 1), and carry power * factor / q, so E[power'] = power * factor.
-    // For a Lambertian surface of albedo rho this is Jensen's rule: survive with rho, keep Phi.
-    const float q = std::min(1.0f, rt::maxComponent(factor));
-    if (!(q > 0.0f) || sample(rt::Dim::kRoulette) >= q) return;
-    power *= factor / q;
-    if (!(rt::maxComponent(power) > 0.0f) || !rt::isFinite(power)) return;
-    ray = rt::spawnRay(si, wi);
+    out.stored = true;
+    out.photon = Photon::make(si.position, power, si.wo, PhotonMapKind::Global, bounce);
+    out.normal = ng;
   }
+
+  // Choose the part like the path tracer: the dielectric with probability equal to its
+  // weight, reflection against refraction by the Fresnel term, else the opaque lobes by
+  // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
+  // left, f cos / pdf, is the part's albedo along the sampled direction.
+  const rt::ShadingFrame sf(si);
+  const float dielectric = m.dielectricWeight();
+  const float opaque = 1.0f - dielectric;
+  const float lobe = sample(rt::Dim::kLobe);
+  glm::vec3 wi, factor;
+  bool specular;
+  if (lobe < dielectric) {
+    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+    const float cosI = glm::dot(sf.ns, si.wo);
+    const float fr = rt::fresnelDielectric(cosI, eta);
+    glm::vec3 wt;
+    if (lobe / dielectric < fr || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
+      wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+      factor = glm::vec3(1.0f);
+    } else {
+      wi = wt;
+      factor = m.baseColor;  // flux is conserved through refraction: no eta^2 (that is radiance)
+    }
+    specular = true;
+  } else {
+    const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, rt::kOneMinusEpsilon);
+    const rt::BsdfSample b = rt::sampleOpaque(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));
+    if (!b.valid) return out;
+    wi = sf.frame.toWorld(b.wi);
+    if (glm::dot(wi, sf.ng) <= 0.0f) return out;  // a reflection leaves on the side it arrived from
+    factor = b.weight;
+    specular = b.delta;
+  }
+  if (caustic && !specular) return out;  // glossy or diffuse: no longer an L S+ D path
+
+  // Absorption by Russian roulette (Jensen): survive with q = the largest channel of the
+  // factor (capped at 1), and carry power * factor / q, so E[power'] = power * factor.
+  // For a Lambertian surface of albedo rho this is Jensen's rule: survive with rho, keep Phi.
+  const float q = std::min(1.0f, rt::maxComponent(factor));
+  if (!(q > 0.0f) || sample(rt::Dim::kRoulette) >= q) return out;
+  power *= factor / q;
+  if (!(rt::maxComponent(power) > 0.0f) || !rt::isFinite(power) || bounce + 1 >= s.options->maxBounces) return out;
+  out.continues = true;
+  out.power = power;
+  out.next = rt::spawnRay(si, wi);
+  return out;
 }
 
-Setup makeSetup(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptions& options) {
-  Setup s{&scene, &bvh, &options, {}, {}, {}, {}, {}, {}, {}, 0.0f, {true, true}};
+// Fills s (whose options_ are set) for the scene: emitters, targets, photon split.
+void makeSetup(Setup& s, const scene::Scene& scene) {
+  s.scene = &scene;
+  s.options = &s.options_;
+  const PhotonOptions& options = s.options_;
   scene::Bounds bounds = scene.bounds;
   if (bounds.empty())
     for (const glm::vec3& p : scene.positions) bounds.extend(p);
@@ -467,21 +466,88 @@ Setup makeSetup(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptio
   if (s.targets.empty()) s.simulate[kCausticStream] = false;
   s.firstPhoton[kGlobalStream] = splitPhotons(power, s.simulate[kGlobalStream] ? options.globalPhotons : 0);
   s.firstPhoton[kCausticStream] = splitPhotons(causticPower, s.simulate[kCausticStream] ? options.causticPhotons : 0);
-  return s;
 }
 
 }  // namespace
 
+struct PhotonSource::Impl {
+  Setup setup;
+};
+
+PhotonSource::PhotonSource(const scene::Scene& scene, const PhotonOptions& options) : impl_(std::make_unique<Impl>()) {
+  impl_->setup.options_ = options;
+  makeSetup(impl_->setup, scene);
+}
+
+PhotonSource::~PhotonSource() = default;
+
+std::size_t PhotonSource::emitted(PhotonMapKind map) const { return impl_->setup.firstPhoton[int(map)].back(); }
+
+PhotonStats PhotonSource::plan() const {
+  const Setup& s = impl_->setup;
+  PhotonStats stats;
+  stats.globalEmitted = emitted(PhotonMapKind::Global);
+  stats.causticEmitted = emitted(PhotonMapKind::Caustic);
+  stats.globalSkipped = s.options_.globalPhotons - stats.globalEmitted;
+  stats.causticSkipped = s.options_.causticPhotons - stats.causticEmitted;
+  stats.causticTargets = s.targets.size();
+  return stats;
+}
+
+bool PhotonSource::emit(PhotonMapKind map, std::size_t index, EmittedPhoton& out) const {
+  const Setup& s = impl_->setup;
+  const std::vector<std::size_t>& first = s.firstPhoton[int(map)];
+  if (index >= first.back()) return false;
+  const std::size_t e = std::size_t(std::upper_bound(first.begin(), first.end(), index) - first.begin()) - 1;
+  return pm::emit(s, int(map), e, index, out);
+}
+
+PhotonInteraction PhotonSource::interact(PhotonMapKind map, std::uint32_t index, int bounce, const glm::vec3& power,
+                                         float range, const rt::Ray& ray, const rt::Hit& hit,
+                                         const rt::SurfaceInteraction& si) const {
+  return pm::interact(impl_->setup, int(map), index, bounce, power, range, ray, hit, si);
+}
+
+void tracePhoton(const PhotonSource& source, const scene::Scene& scene, const rt::Bvh& bvh, PhotonMapKind map,
+                 std::uint32_t index, std::vector<Photon>& store, std::vector<glm::vec3>& normals) {
+  EmittedPhoton photon;
+  if (!source.emit(map, index, photon)) return;
+  rt::Ray ray = photon.ray;
+  glm::vec3 power = photon.power;
+  for (int bounce = 0;; ++bounce) {
+    rt::Hit hit;
+    if (!bvh.intersect(ray, hit)) return;
+    const PhotonInteraction step = source.interact(map, index, bounce, power, photon.range, ray, hit,
+                                                   rt::makeInteraction(scene, ray, hit));
+    if (step.stored) {
+      store.push_back(step.photon);
+      normals.push_back(step.normal);
+    }
+    if (!step.continues) return;
+    ray = step.next;
+    power = step.power;
+  }
+}
+
+void recordPhotonCounters(par::Runtime& runtime, const std::vector<std::array<std::uint64_t, 4>>& perPe,
+                          const PhotonStats& stats) {
+  for (int p = 0; p < runtime.pes(); ++p) {
+    const std::array<std::uint64_t, 4>& row = perPe[std::size_t(p)];
+    runtime.addCounter("Photons/global_emitted", p, double(row[0]));
+    runtime.addCounter("Photons/caustic_emitted", p, double(row[1]));
+    runtime.addCounter("Photons/global_stored", p, double(row[2]));
+    runtime.addCounter("Photons/caustic_stored", p, double(row[3]));
+  }
+  runtime.addCounter("Photons/global_skipped", 0, double(stats.globalSkipped));
+  runtime.addCounter("Photons/caustic_skipped", 0, double(stats.causticSkipped));
+}
+
 PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, const PhotonOptions& options,
                              par::Runtime& runtime) {
-  const Setup s = makeSetup(scene, bvh, options);
+  const PhotonSource source(scene, options);
   PhotonLists out;
-  const std::size_t emitted[2] = {s.firstPhoton[kGlobalStream].back(), s.firstPhoton[kCausticStream].back()};
-  out.stats.globalEmitted = emitted[kGlobalStream];
-  out.stats.causticEmitted = emitted[kCausticStream];
-  out.stats.globalSkipped = options.globalPhotons - emitted[kGlobalStream];
-  out.stats.causticSkipped = options.causticPhotons - emitted[kCausticStream];
-  out.stats.causticTargets = s.targets.size();
+  out.stats = source.plan();
+  const std::size_t emitted[2] = {out.stats.globalEmitted, out.stats.causticEmitted};
 
   // Batches: the global map's first, then the caustic map's; a batch never mixes maps.
   const std::size_t batch = std::max<std::size_t>(1, options.batchSize);
@@ -489,6 +555,7 @@ PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, cons
   const std::size_t tasks = batches[0] + batches[1];
   out.stats.tasks = tasks;
   std::vector<std::vector<Photon>> lists(tasks);
+  std::vector<std::vector<glm::vec3>> normals(tasks);
   // Per PE, for the run record: photons emitted and stored, by map (each PE writes its own row).
   std::vector<std::array<std::uint64_t, 4>> perPe(std::size_t(runtime.pes()), std::array<std::uint64_t, 4>{});
   if (tasks > 0) {
@@ -497,33 +564,22 @@ PhotonLists tracePhotonLists(const scene::Scene& scene, const rt::Bvh& bvh, cons
       const int map = task < batches[0] ? kGlobalStream : kCausticStream;
       const std::size_t b = map == kGlobalStream ? task : task - batches[0];
       const std::size_t begin = b * batch, end = std::min(emitted[map], begin + batch);
-      const std::vector<std::size_t>& first = s.firstPhoton[map];
-      std::vector<Photon>& store = lists[task];
-      std::size_t e = std::size_t(std::upper_bound(first.begin(), first.end(), begin) - first.begin()) - 1;
-      for (std::size_t i = begin; i < end; ++i) {
-        while (i >= first[e + 1]) ++e;
-        EmittedPhoton photon;
-        if (emit(s, map, e, i, photon)) trace(s, map, std::uint32_t(i), photon, store);
-      }
+      for (std::size_t i = begin; i < end; ++i)
+        tracePhoton(source, scene, bvh, PhotonMapKind(map), std::uint32_t(i), lists[task], normals[task]);
       std::array<std::uint64_t, 4>& row = perPe[std::size_t(pe.id())];
       row[map == kGlobalStream ? 0 : 1] += end - begin;
-      row[map == kGlobalStream ? 2 : 3] += store.size();
+      row[map == kGlobalStream ? 2 : 3] += lists[task].size();
     });
   }
   // The figures leave the tracer as run-record counters (STYLE.md section 4). Photons not traced
   // at all are the controller's decision: booked on PE 0.
-  for (int p = 0; p < runtime.pes(); ++p) {
-    const std::array<std::uint64_t, 4>& row = perPe[std::size_t(p)];
-    runtime.addCounter("Photons/global_emitted", p, double(row[0]));
-    runtime.addCounter("Photons/caustic_emitted", p, double(row[1]));
-    runtime.addCounter("Photons/global_stored", p, double(row[2]));
-    runtime.addCounter("Photons/caustic_stored", p, double(row[3]));
-  }
-  runtime.addCounter("Photons/global_skipped", 0, double(out.stats.globalSkipped));
-  runtime.addCounter("Photons/caustic_skipped", 0, double(out.stats.causticSkipped));
+  recordPhotonCounters(runtime, perPe, out.stats);
   for (std::size_t t = 0; t < tasks; ++t) {
-    std::vector<Photon>& dst = t < batches[0] ? out.global : out.caustic;
+    const bool global = t < batches[0];
+    std::vector<Photon>& dst = global ? out.global : out.caustic;
+    std::vector<glm::vec3>& dstNormals = global ? out.globalNormals : out.causticNormals;
     dst.insert(dst.end(), lists[t].begin(), lists[t].end());
+    dstNormals.insert(dstNormals.end(), normals[t].begin(), normals[t].end());
   }
   out.stats.globalStored = out.global.size();
   out.stats.causticStored = out.caustic.size();

@@ -7,14 +7,18 @@
 // Maps", sections 2.1-2.2; Jensen, "Realistic Image Synthesis Using Photon Mapping", ch. 5.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
 #include "photonmap/kd_tree.h"
 #include "photonmap/photon.h"
+#include "raytrace/core/interaction.h"
+#include "raytrace/core/ray.h"
 
 namespace pr::par {
 class Runtime;
@@ -50,13 +54,67 @@ struct PhotonStats {
   std::size_t tasks = 0;
 };
 
-// The stored photons in merge order (batch by batch, photon by photon): what the kd-trees are
-// built from. Exposed so that tests can compare runs photon for photon.
+// The stored photons in merge order (photon by photon in index order, each photon's stores in
+// bounce order): what the kd-trees are built from, with the geometric normal of the surface
+// each was stored on (facing the side it arrived from; precomputed irradiance reads them).
+// Exposed so that tests can compare runs photon for photon.
 struct PhotonLists {
   std::vector<Photon> global;
   std::vector<Photon> caustic;
+  std::vector<glm::vec3> globalNormals;
+  std::vector<glm::vec3> causticNormals;
   PhotonStats stats;
 };
+
+// A photon as it leaves its light: first ray, power, and the range of its punctual light (the
+// range window applies at the first hit; 0 = none).
+struct EmittedPhoton {
+  rt::Ray ray;
+  glm::vec3 power{0.0f};
+  float range = 0.0f;
+};
+
+// What one surface interaction does with a photon: stores it (on the surface with normal
+// `normal`), and continues it along `next` with `power`, or ends it.
+struct PhotonInteraction {
+  bool stored = false;
+  Photon photon;
+  glm::vec3 normal{0.0f};
+  bool continues = false;
+  rt::Ray next;
+  glm::vec3 power{0.0f};
+};
+
+// The emitters, projection map and photon split of one pass 1, built once by the controlling
+// thread, read-only by every PE: the two steps of a photon's path as functions of (map, photon
+// index, bounce), which both the batch tracer below and the message-passing photon pass of the
+// photon-map integrator run, so that they store the same photons.
+class PhotonSource {
+ public:
+  PhotonSource(const scene::Scene& scene, const PhotonOptions& options);
+  ~PhotonSource();
+  PhotonSource(const PhotonSource&) = delete;
+  PhotonSource& operator=(const PhotonSource&) = delete;
+
+  // Photons to emit for a map after the plan's skips; the emitted, skipped and target figures.
+  std::size_t emitted(PhotonMapKind map) const;
+  PhotonStats plan() const;
+  // Photon `index` of `map` leaving its light; false when it carries no power (or index is out of range).
+  bool emit(PhotonMapKind map, std::size_t index, EmittedPhoton& out) const;
+  // Its interaction number `bounce` (0 = the first surface hit) at si, reached along ray with power.
+  PhotonInteraction interact(PhotonMapKind map, std::uint32_t index, int bounce, const glm::vec3& power, float range,
+                             const rt::Ray& ray, const rt::Hit& hit, const rt::SurfaceInteraction& si) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// Puts pass 1's figures in the run record: per PE photons emitted and stored by map
+// (perPe rows: global emitted, caustic emitted, global stored, caustic stored), and the
+// photons the plan skipped (on PE 0). Called between stages.
+void recordPhotonCounters(par::Runtime& runtime, const std::vector<std::array<std::uint64_t, 4>>& perPe,
+                          const PhotonStats& stats);
 
 struct PhotonMaps {
   KdTree global;

@@ -7,18 +7,15 @@
 #pragma once
 
 #include <cstddef>
+#include <vector>
 
 #include <glm/glm.hpp>
 
-#include "common/scene/scene.h"
 #include "photonmap/density_estimate.h"
 #include "photonmap/kd_tree.h"
 
 namespace pr::par {
 class Runtime;
-}
-namespace pr::rt {
-class Bvh;
 }
 
 namespace pr::pm {
@@ -26,13 +23,14 @@ namespace pr::pm {
 class PrecomputedIrradiance {
  public:
   PrecomputedIrradiance() = default;
-  // Every stride-th photon of `global` (heap order) becomes a point: its surface normal found
-  // by a short ray back along the photon's incoming direction (a photon whose surface the ray
-  // misses is skipped), its irradiance estimated over `global` with `density`. One task per
-  // chunk of photons on the runtime (stage "precompute irradiance"); the points are kept in
-  // photon order, so the structure is the same for every P and schedule.
-  static PrecomputedIrradiance build(const scene::Scene& scene, const rt::Bvh& bvh, const KdTree& global,
-                                     const DensityOptions& density, int stride, par::Runtime& runtime);
+  // Every stride-th photon of `photons` (the global map's photons in merge order, with the
+  // normals of the surfaces they were stored on) becomes a point, its irradiance estimated over
+  // `global` (the kd-tree built from them) with `density`. One task per chunk of points on the
+  // runtime (stage "precompute irradiance"); the points keep the photons' order, so the
+  // structure is the same for every tracer, P and schedule.
+  static PrecomputedIrradiance build(const std::vector<Photon>& photons, const std::vector<glm::vec3>& normals,
+                                     const KdTree& global, const DensityOptions& density, int stride,
+                                     par::Runtime& runtime);
 
   bool empty() const { return points_.empty(); }
   std::size_t size() const { return points_.size(); }

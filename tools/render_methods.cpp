@@ -51,9 +51,9 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
     return uint64_t{0};
   };
   const uint64_t camera = total("Rays/camera"), continuation = total("Rays/continuation"), shadow = total("Rays/shadow");
-  // Rays traced by an integrator's pre-pass (final gathering for the irradiance cache).
-  const uint64_t gather = total("Gather/rays");
-  out.rays = camera + continuation + shadow + gather;
+  // The pre-pass's rays (photons, probes, gather rays) are in these counts too: the pre-pass
+  // runs through the same tracer.
+  out.rays = camera + continuation + shadow;
   // The work the plan skipped, from the Plan/ counters of the run record.
   std::string skipped;
   for (const par::CounterSummary& c : summary.counters)
@@ -71,7 +71,8 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
     out.details += "; photons stored: global " + std::to_string(total("Photons/global_stored")) + ", caustic " +
                    std::to_string(total("Photons/caustic_stored")) + "; irradiance-cache records " +
                    std::to_string(total("IrradianceCache/records")) + " from " +
-                   std::to_string(total("IrradianceCache/probes")) + " probes, gather rays " + std::to_string(gather) +
+                   std::to_string(total("IrradianceCache/probes")) + " probes, gather hits " +
+                   std::to_string(total("IrradianceCache/gather_hits")) +
                    (photonSettings.view != pm::PhotonView::Full ? "; view " + r.settings.ray.view : "");
   return out;
 }

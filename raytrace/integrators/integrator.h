@@ -54,18 +54,22 @@ struct IntegratorOptions {
 
 // Where shading results go: radiance into the Film, spawned rays into the caller's queue,
 // skipped work into the PE's TraceStats. A tracer that routes rays to other PEs takes them
-// from the queue after the call.
+// from the queue after the call. pe: the PE shading, for an integrator that keeps results of
+// its own per PE (a pre-pass program's deposits, see PrePassTracer).
 class Emit {
  public:
-  Emit(Film& film, std::vector<RayMessage>& rays, TraceStats& stats) : film_(&film), rays_(&rays), stats_(&stats) {}
+  Emit(Film& film, std::vector<RayMessage>& rays, TraceStats& stats, int pe)
+      : film_(&film), rays_(&rays), stats_(&stats), pe_(pe) {}
   void addRadiance(uint32_t pixel, const glm::vec3& radiance) { film_->add(pixel, radiance); }
   void push(const RayMessage& message) { rays_->push_back(message); }
   TraceStats& stats() { return *stats_; }
+  int pe() const { return pe_; }
 
  private:
   Film* film_;
   std::vector<RayMessage>* rays_;
   TraceStats* stats_;
+  int pe_;
 };
 
 
@@ -128,6 +132,22 @@ struct ShadingFrame {
 
 struct TraceStats;  // trace_stats.h
 class Bvh;          // raytrace/core/bvh.h
+class Integrator;
+
+// What an integrator's pre-pass traces with: the render's own tracer. A pre-pass is a series
+// of programs, each an Integrator over a virtual image of its own (one pixel per photon, per
+// irradiance-cache record, ...) whose cameraRays start its paths and whose shade keeps its
+// results per PE (Emit::pe) instead of adding radiance; the tracer runs a program as it runs a
+// render - tiles as tasks in image-space, rays as messages between owners in object-space and
+// object partitioning - but assembles no image. So every tracer runs the same pre-pass, with
+// the same results, and every transfer it makes is counted in the run record.
+class PrePassTracer {
+ public:
+  virtual ~PrePassTracer() = default;
+  // Runs the program's paths to completion on the render's PEs (stages in the run record).
+  // tileSizePx: the task granularity in the program's pixels (image-space).
+  virtual void trace(const std::shared_ptr<const Integrator>& program, int tileSizePx) = 0;
+};
 
 // An integrator: how a hit becomes radiance and new rays. The interface every tracer drives;
 // concrete integrators derive from IntegratorBase<Self> (trace_loop.h) and are listed in an
@@ -157,16 +177,15 @@ class Integrator {
   // out in pixel order then sample order.
   void cameraRays(const PixelRect& rect, std::vector<RayMessage>& out) const { cameraRays(rect, options().spp, out); }
   // The same with spp samples per pixel (image-space's one-sample cost pre-pass): sample s of
-  // a pixel is the same ray whatever spp, for s < spp, only when spp matches the render's.
-  void cameraRays(const PixelRect& rect, int spp, std::vector<RayMessage>& out) const;
-  // A pre-pass over the whole scene before the trace stage (the photon map's photon tracing and
-  // irradiance cache), run by the world-model tracers (sequential, image-space) on the
-  // controlling thread between stages, its stages recorded in rt's run record; afterwards the
-  // integrator is read-only again. The message-passing tracers hold no world BVH and refuse an
-  // integrator that needs one (an InputError naming the tracers that can run it).
-  virtual bool needsWorldPrePass() const { return false; }
-  virtual void prePass(const Bvh& world, par::Runtime& rt) const {
-    (void)world;
+  // a pixel is the same ray whatever spp, for s < spp, only when spp matches the render's. A
+  // pre-pass program overrides it to start its own paths (photons, gather rays).
+  virtual void cameraRays(const PixelRect& rect, int spp, std::vector<RayMessage>& out) const;
+  // A pre-pass before the render (the photon map's photon tracing and irradiance cache), run
+  // by renderRays on the controlling thread through the render's own tracer (PrePassTracer),
+  // its stages recorded in rt's run record; afterwards the integrator is read-only again.
+  virtual bool hasPrePass() const { return false; }
+  virtual void prePass(PrePassTracer& tracer, par::Runtime& rt) const {
+    (void)tracer;
     (void)rt;
   }
   // A camera or continuation ray hit si (made by makeInteraction from msg.ray's closest hit).
@@ -180,7 +199,7 @@ class Integrator {
   // every message shading spawns until none is left, against bvh (over context().scene()).
   // One call per task; implemented by IntegratorBase (trace_loop.h).
   virtual void traceToCompletion(const Bvh& bvh, std::vector<RayMessage>& queue, Film& film,
-                                 TraceStats& stats) const = 0;
+                                 TraceStats& stats, int pe) const = 0;
 
  private:
   IntegratorContext ctx_;

@@ -22,8 +22,8 @@ namespace pr::rt {
 // (fixed-point film). Shader: a concrete integrator (shade, miss).
 template <class Shader>
 void traceLoop(const Shader& integrator, const scene::Scene& scene, const Bvh& bvh, std::vector<RayMessage>& queue,
-               Film& film, TraceStats& stats) {
-  Emit emit(film, queue, stats);
+               Film& film, TraceStats& stats, int pe) {
+  Emit emit(film, queue, stats, pe);
   while (!queue.empty()) {
     const RayMessage msg = queue.back();
     queue.pop_back();
@@ -49,9 +49,10 @@ class IntegratorBase : public Integrator {
  public:
   using Integrator::Integrator;
 
-  void traceToCompletion(const Bvh& bvh, std::vector<RayMessage>& queue, Film& film, TraceStats& stats) const final {
+  void traceToCompletion(const Bvh& bvh, std::vector<RayMessage>& queue, Film& film, TraceStats& stats,
+                         int pe) const final {
     static_assert(std::is_final_v<Derived>, "a concrete integrator must be final (direct shade calls in the loop)");
-    traceLoop(static_cast<const Derived&>(*this), context().scene(), bvh, queue, film, stats);
+    traceLoop(static_cast<const Derived&>(*this), context().scene(), bvh, queue, film, stats, pe);
   }
 };
 

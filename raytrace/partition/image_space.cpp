@@ -49,11 +49,10 @@ class ImageSpacePartition final : public Partition {
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
     std::vector<TileTask> tiles = makeTiles(job);
-    rt.recordBroadcast(job.scene.memoryBytes() + bvh.stats().memoryBytes);
-    // The integrator's pre-pass (photon maps, irradiance cache) records the broadcast of what
-    // it replicates itself.
-    integrator.prePass(bvh, rt);
-    if (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive) estimateCosts(job, integrator, bvh, tiles, rt);
+    if (!job.sceneResident) rt.recordBroadcast(job.scene.memoryBytes() + bvh.stats().memoryBytes);
+    // A pre-pass program gets no cost pre-pass: it would run the program's side effects twice.
+    if (job.assembleImage && (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive))
+      estimateCosts(job, integrator, bvh, tiles, rt);
     if (job.options.adaptive) tiles = subdivide(tiles);
 
     par::TaskSet set;
@@ -72,8 +71,8 @@ class ImageSpacePartition final : public Partition {
       TraceStats stats;
       std::vector<RayMessage> queue;
       integrator.cameraRays(rect, queue);
-      integrator.traceToCompletion(bvh, queue, tile, stats);
-      assembly.deliver(pe, tile, rect, false);
+      integrator.traceToCompletion(bvh, queue, tile, stats, pe.id());
+      if (job.assembleImage) assembly.deliver(pe, tile, rect, false);
       counters.of(pe.id()) += stats;
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job.options.progress) job.options.progress(n, total);
@@ -110,7 +109,7 @@ class ImageSpacePartition final : public Partition {
       for (int y = t.rect.y0; y < t.rect.y1; y += kPrePassStride)
         for (int x = t.rect.x0; x < t.rect.x1; x += kPrePassStride) {
           integrator.cameraRays(PixelRect{x, y, x + 1, y + 1}, 1, queue);
-          integrator.traceToCompletion(bvh, queue, scratch, stats);
+          integrator.traceToCompletion(bvh, queue, scratch, stats, 0);
           ++sampled;
         }
       t.cost = sampled > 0 ? double(stats.total()) * double(t.rect.pixels()) / double(sampled) : 1.0;

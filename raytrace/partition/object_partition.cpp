@@ -77,7 +77,7 @@ class ObjectFrame {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
       integrator_->cameraRays(tiles[size_t(id)], st.start);
-      st.stats.cameraRays += st.start.size() - before;
+      countStartRays(st.stats, std::span<const RayMessage>(st.start).subspan(before));
       drain(pe);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
@@ -90,7 +90,7 @@ class ObjectFrame {
       std::vector<Film*> films;
       for (const std::unique_ptr<Film>& f : films_) films.push_back(f.get());
       FilmAssembly assembly(rt_, *films_[kAssemblerPe]);
-      assembly.deliverFilms(rt_, films, tiles);
+      if (job_.assembleImage) assembly.deliverFilms(rt_, films, tiles);
     }
 
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
@@ -145,7 +145,7 @@ class ObjectFrame {
   void launch(par::Pe& pe, PeState& st, const RayMessage& m) {
     assignment_.ownersAlong(m.ray, st.owners);
     if (st.owners.empty()) {
-      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
+      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
       integrator_->miss(m, emit);  // reaches no object: nothing to ask
       return;
     }
@@ -206,7 +206,7 @@ class ObjectFrame {
     const Pending done = p;
     st.freeSlots.push_back(r.slot);
     --st.live;
-    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
+    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     if (done.message.kind == RayKind::Shadow) {
       if (!done.best.found) integrator_->miss(done.message, emit);
       return;

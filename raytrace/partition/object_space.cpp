@@ -73,7 +73,7 @@ class ObjectSpaceFrame {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
       integrator_->cameraRays(tiles[size_t(id)], camera);
-      st.stats.cameraRays += camera.size();
+      countStartRays(st.stats, camera);
       for (const RayMessage& m : camera) trace(pe, TravellingRay{m, 0});
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
@@ -85,7 +85,7 @@ class ObjectSpaceFrame {
       std::vector<Film*> films;
       for (const std::unique_ptr<Film>& f : films_) films.push_back(f.get());
       FilmAssembly assembly(rt_, *films_[kAssemblerPe]);
-      assembly.deliverFilms(rt_, films, tiles);
+      if (job_.assembleImage) assembly.deliverFilms(rt_, films, tiles);
     }
 
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
@@ -136,7 +136,7 @@ class ObjectSpaceFrame {
       st.spans.push_back(s);
       return true;
     });
-    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats);
+    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     for (size_t k = item.span; k < st.spans.size(); ++k) {
       const uint32_t v = st.spans[k].voxel;
       if (split_.triangles(v).empty()) continue;  // nothing to hit: no owner needs the ray

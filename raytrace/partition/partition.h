@@ -86,6 +86,12 @@ struct TraceJob {
   // render's, options.integrator is then unused. nullptr: the built-in integrator that
   // options.integrator.kind names, built by the partition.
   std::shared_ptr<const Integrator> integrator = nullptr;
+  // False for a pre-pass program (PrePassTracer): its film is not assembled on PE 0 and gets no
+  // cost pre-pass (which would run the program's side effects twice); the image is then empty.
+  bool assembleImage = true;
+  // The PEs hold the scene (and the world BVH handed in) already: a world-model tracer does not
+  // count its broadcast again (the second and later jobs of one render: pre-pass and render).
+  bool sceneResident = false;
 };
 
 // The integrator a partition renders job with: job.integrator, or the built-in default.
@@ -96,8 +102,8 @@ class Partition {
  public:
   virtual ~Partition() = default;
   virtual std::string_view name() const = 0;
-  // Whether every PE reads the whole scene and one BVH over it (world model, DESIGN.md rule
-  // 1): such a tracer runs an integrator's world pre-pass (Integrator::prePass).
+  // Whether every PE reads the whole scene and one BVH over it (world model, DESIGN.md rule 1):
+  // such a tracer shares one BVH between an integrator's pre-pass and its render.
   virtual bool holdsWorldModel() const { return false; }
   // Runs the render on rt's PEs (stages recorded in rt.record()). Called from the
   // controlling thread.

@@ -73,6 +73,14 @@ inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const 
   rt.recordBroadcast(shadingDataBytes(s) + emitters + directoryBytes);
 }
 
+// Counts the rays a camera-ray task starts by kind, as the world-model loop counts the rays it
+// traces: camera rays, or a pre-pass program's own start rays (photons, gather rays) as
+// continuations.
+inline void countStartRays(TraceStats& stats, std::span<const RayMessage> rays) {
+  for (const RayMessage& m : rays)
+    ++(m.kind == RayKind::Camera ? stats.cameraRays : m.kind == RayKind::Shadow ? stats.shadowRays : stats.continuationRays);
+}
+
 // The scene a PE shades from: the shared one, or its poisoned view when the check is on.
 class SceneViews {
  public:

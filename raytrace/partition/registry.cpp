@@ -1,8 +1,11 @@
 // The registry of ray-tracer partitions: one line per partition (name, description, factory).
 // Feeds `parrender render -m`, its --help text, validation and the equivalence tests.
+#include <algorithm>
+#include <memory>
 #include <string>
 
 #include "common/util/error.h"
+#include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/partition.h"
 
 namespace pr::rt {
@@ -44,6 +47,38 @@ TraceStats recordRayCounters(par::Runtime& rt, const std::vector<TraceStats>& pe
   return sum;
 }
 
+namespace {
+
+// Runs an integrator's pre-pass programs through the render's partition (PrePassTracer): each
+// one a job over the program's virtual image, its film not assembled, sharing the render's
+// world BVH where the partition holds one (the partitioned tracers distribute their geometry
+// afresh for each program, and count it).
+class PartitionPrePass final : public PrePassTracer {
+ public:
+  PartitionPrePass(const TraceJob& render, std::string_view partition, par::Runtime& rt)
+      : render_(render), partition_(partition), rt_(rt) {}
+
+  void trace(const std::shared_ptr<const Integrator>& program, int tileSizePx) override {
+    const IntegratorContext& c = program->context();
+    TraceJob job{render_.scene, render_.camera, c.width(), c.height(), render_.options};
+    job.options.tileSizePx = std::max(1, tileSizePx);
+    job.options.adaptive = false;
+    job.options.progress = {};
+    job.integrator = program;
+    job.assembleImage = false;
+    // The world-model PEs hold the scene already (the render counts its broadcast once).
+    job.sceneResident = render_.options.worldBvh != nullptr;
+    makePartition(partition_)->render(job, rt_);
+  }
+
+ private:
+  const TraceJob& render_;
+  std::string partition_;
+  par::Runtime& rt_;
+};
+
+}  // namespace
+
 TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt) {
   auto range = [](const char* what, long value, long lo, long hi) {
     if (value < lo || value > hi)
@@ -60,14 +95,21 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
     throw InputError("scene " + job.scene.source.string() + " has no triangles to ray trace");
   checkBvhLimit("scene " + job.scene.source.string(), job.scene.triangles.size());
   std::unique_ptr<Partition> p = makePartition(partition);
-  if (job.integrator && job.integrator->needsWorldPrePass() && !p->holdsWorldModel()) {
-    std::string world;
-    for (const PartitionInfo& info : partitions())
-      if (info.make()->holdsWorldModel()) world += (world.empty() ? "" : ", ") + info.name;
-    throw InputError("integrator " + std::string(job.integrator->name()) + " needs a pre-pass over the whole scene, which " +
-                     std::string(partition) + " does not hold on any PE; it runs with " + world);
+  if (!job.integrator || !job.integrator->hasPrePass()) return p->render(job, rt);
+  // The integrator's pre-pass runs through this same tracer; a world-model tracer builds its
+  // BVH once for the pre-pass's programs and the render.
+  TraceJob main = job;
+  std::unique_ptr<Bvh> built;
+  if (p->holdsWorldModel() && !job.options.worldBvh) {
+    rt.runPinned("build", par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+      built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+    });
+    main.options.worldBvh = built.get();
   }
-  return p->render(job, rt);
+  PartitionPrePass tracer(main, partition, rt);
+  job.integrator->prePass(tracer, rt);
+  main.sceneResident = true;
+  return p->render(main, rt);
 }
 
 TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, int width, int height,

@@ -37,7 +37,6 @@ class SequentialPartition final : public Partition {
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
-    integrator.prePass(bvh, rt);
     Film film(job.width, job.height, integrator.options().spp);
     PerPeTraceStats counters(rt.pes());
     rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {
@@ -47,7 +46,7 @@ class SequentialPartition final : public Partition {
       // single task reports its progress in rows.
       for (int y = 0; y < job.height; ++y) {
         integrator.cameraRays(PixelRect{0, y, job.width, y + 1}, queue);
-        integrator.traceToCompletion(bvh, queue, film, stats);
+        integrator.traceToCompletion(bvh, queue, film, stats, pe.id());
         if (job.options.progress) job.options.progress(y + 1, job.height);
       }
     });

@@ -1,6 +1,6 @@
 // Tests of pass 2, the photon-map integrator (photonmap/photon_map_integrator.h): the same image
-// bit for bit from the sequential tracer and image-space for every P and schedule; refused by
-// the tracers without a world model; close to a long path-traced reference of the bundled
+// bit for bit from the sequential tracer, image-space, object-space and object partitioning for
+// every P and schedule, the pre-pass included; close to a long path-traced reference of the bundled
 // Cornell box; a render with the plan's caustics off equals one without caustic photons; the
 // map views show their maps; the pre-pass's records and rays reach the run record.
 #include <doctest/doctest.h>
@@ -102,18 +102,31 @@ TEST_CASE("PhotonMapIntegrator: sequential and image-space give the same image f
   }
 }
 
-TEST_CASE("PhotonMapIntegrator: the tracers without a world model refuse it, naming those that run it") {
+TEST_CASE("PhotonMapIntegrator: object-space and object partitioning give the sequential image, pre-pass and all") {
   const scene::Scene s = cornell();
+  const image::Image reference = render(s, smallSettings(), "sequential", 1, "demand");
+  for (const char* partition : {"object-space", "object"})
+    for (int pes : {1, 2, 3}) {
+      CAPTURE(partition);
+      CAPTURE(pes);
+      CHECK(render(s, smallSettings(), partition, pes, "demand").pixels == reference.pixels);
+    }
+}
+
+TEST_CASE("PhotonMapIntegrator: the partitioned pre-pass reads no geometry a PE does not hold") {
+  // Each PE shades from a copy of the scene whose foreign triangles are NaN: a photon, probe or
+  // gather path read anywhere but at the owner would change the image.
+  const scene::Scene s = cornell();
+  const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
+  const image::Image reference = render(s, smallSettings(), "sequential", 1, "demand");
   for (const char* partition : {"object-space", "object"}) {
     CAPTURE(partition);
-    try {
-      render(s, smallSettings(), partition, 2, "demand");
-      FAIL("expected an InputError");
-    } catch (const InputError& e) {
-      const std::string what = e.what();
-      CHECK(what.find("photonmap") != std::string::npos);
-      CHECK(what.find("sequential, image-space") != std::string::npos);
-    }
+    rt::TraceJob job{s, cam, kW, kH, {}};
+    job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kW, kH, rt::IntegratorOptions{}, smallSettings());
+    job.options.tileSizePx = 8;
+    job.options.poisonForeignGeometry = true;
+    par::Runtime runtime(3);
+    CHECK(rt::renderRays(job, partition, runtime).image.pixels == reference.pixels);
   }
 }
 
@@ -179,12 +192,14 @@ TEST_CASE("PhotonMapIntegrator: the pre-pass's photons, records and gather rays 
   const double records = counter(runtime, "IrradianceCache/records");
   CHECK(records > 0);
   CHECK(records < 0.5 * kW * kH);  // gathering at a fraction of the pixels
-  CHECK(counter(runtime, "IrradianceCache/probes") == kW * kH);
-  CHECK(counter(runtime, "Gather/rays") >= records * 60);
+  // Probes that found a diffuse surface: most pixels (not the light, the open front, glass).
+  CHECK(counter(runtime, "IrradianceCache/probes") > 0.5 * kW * kH);
+  CHECK(counter(runtime, "IrradianceCache/probes") <= kW * kH);
+  CHECK(counter(runtime, "IrradianceCache/gather_hits") >= records * 30);
   CHECK(counter(runtime, "Photons/global_stored") > 0);
   // The maps and the cache are broadcast to every PE.
   bool cacheStage = false;
-  for (const par::StageRecord& stage : runtime.record().stages) cacheStage |= stage.name == "irradiance-cache gather 1/16";
+  for (const par::StageRecord& stage : runtime.record().stages) cacheStage |= stage.name == "irradiance-cache records 1/16";
   CHECK(cacheStage);
 }
 

@@ -1,6 +1,5 @@
 // Tests of precomputed irradiance (photonmap/precomputed_irradiance.h): on a uniformly lit
-// ground plane every precomputed point lies on the plane with its normal, its irradiance is the
-// density estimate there, a query reads the nearest point of the same surface, and a query from
+// ground plane a precomputed point's irradiance is the density estimate there, a query reads the nearest point of the same surface, and a query from
 // the other side of the surface or beyond the radius gets nothing.
 #include <doctest/doctest.h>
 
@@ -9,15 +8,10 @@
 #include "common/parallel/runtime.h"
 #include "photonmap/photon_test_support.h"
 #include "photonmap/precomputed_irradiance.h"
-#include "raytrace/core/bvh.h"
-#include "raytrace/integrators/integrator_scenes.h"
 
 using namespace pr;
 
 TEST_CASE("PrecomputedIrradiance: points on a lit plane carry the density estimate and the plane's normal") {
-  scene::Scene s;
-  test::addGround(s, 1.0f, test::addMaterial(s, test::diffuse(0.5f)));
-  const rt::Bvh bvh(s);
   // 20000 photons on the ground (y = 0) from above, irradiance E = 3 everywhere.
   test::TestRng rng(5);
   const float e = 3.0f;
@@ -27,12 +21,13 @@ TEST_CASE("PrecomputedIrradiance: points on a lit plane carry the density estima
     photons.push_back(pm::Photon::make({rng.uniform(-1.0f, 1.0f), 0.0f, rng.uniform(-1.0f, 1.0f)}, glm::vec3(e * 4.0f / n),
                                        glm::normalize(glm::vec3(rng.uniform(-0.5f, 0.5f), 1.0f, rng.uniform(-0.5f, 0.5f)))));
   const pm::KdTree global = pm::KdTree::build(photons);
+  const std::vector<glm::vec3> normals(photons.size(), glm::vec3(0.0f, 1.0f, 0.0f));
   pm::DensityOptions density;
   density.k = 100;
   density.maxRadius = 0.3f;
   par::Runtime runtime(2);
-  const pm::PrecomputedIrradiance points = pm::PrecomputedIrradiance::build(s, bvh, global, density, 4, runtime);
-  CHECK(points.size() == n / 4);  // every photon's surface is found
+  const pm::PrecomputedIrradiance points = pm::PrecomputedIrradiance::build(photons, normals, global, density, 4, runtime);
+  CHECK(points.size() == n / 4);  // every 4th photon
   pm::NearestPhotons scratch;
   const glm::vec3 up(0.0f, 1.0f, 0.0f);
   for (const glm::vec3 x : {glm::vec3(0.0f), glm::vec3(0.3f, 0.0f, -0.2f), glm::vec3(-0.5f, 0.0f, 0.4f)}) {
@@ -47,7 +42,7 @@ TEST_CASE("PrecomputedIrradiance: points on a lit plane carry the density estima
   }
   // The same points for every P.
   par::Runtime serial(1);
-  const pm::PrecomputedIrradiance again = pm::PrecomputedIrradiance::build(s, bvh, global, density, 4, serial);
+  const pm::PrecomputedIrradiance again = pm::PrecomputedIrradiance::build(photons, normals, global, density, 4, serial);
   CHECK(again.size() == points.size());
   CHECK(again.irradiance(glm::vec3(0.1f, 0.0f, 0.1f), up, density.maxRadius, scratch) ==
         points.irradiance(glm::vec3(0.1f, 0.0f, 0.1f), up, density.maxRadius, scratch));

@@ -81,6 +81,12 @@ TEST_CASE("Render: --integrator photonmap renders and reports its maps and cache
   CHECK(std::filesystem::exists(dir / "pm.png"));
   CHECK(r.output.find("photons stored: global ") != std::string::npos);
   CHECK(r.output.find("irradiance-cache records ") != std::string::npos);
+  // The same through object partitioning: photon paths and gather rays travel as messages.
+  const auto o = runParrender(join({"render ", cornell(), " -m object --integrator photonmap --threads 2 --width 24 --height 18",
+                                    " --spp 1 --photons 4000 --caustic-photons 2000 --gather 32 -o \"", (dir / "pm_object.png").string(), "\""}));
+  INFO(o.output);
+  CHECK(o.exitStatus == 0);
+  CHECK(std::filesystem::exists(dir / "pm_object.png"));
 }
 
 TEST_CASE("Render: --help lists every integrator and compositor of their registries") {
@@ -101,8 +107,6 @@ RENDER_BAD_INPUT("an unknown integrator, listing the registry's", join({"render 
                  "unknown integrator 'foo' (expected one of: whitted, path, photonmap)")
 RENDER_BAD_INPUT("a photon-map option with another integrator", join({"render ", cornell(), " --integrator path --photons 1000", out}),
                  "--photons applies to --integrator photonmap, not path")
-RENDER_BAD_INPUT("the photon map on a tracer without a world model", join({"render ", cornell(), " -m object-space --integrator photonmap", out}),
-                 "runs with sequential, image-space")
 RENDER_BAD_INPUT("an unknown photon-map view", join({"render ", cornell(), " --integrator photonmap --view photons", out}), "--view")
 RENDER_BAD_INPUT("an unknown compositor, listing the registry's",
                  join({"render ", cornell(), " -m sort-last --compositor foo", out}),

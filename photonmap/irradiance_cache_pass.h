@@ -1,0 +1,42 @@
+// The irradiance cache's pre-pass, run through the render's own tracer (rt::PrePassTracer) as
+// two programs: a probe program (one pixel per image pixel: its camera ray followed through
+// ideal mirrors and glass to the first surface with a diffuse part) and, per level, a gather
+// program (one pixel per new record: its final-gather rays, final_gather.h, whose hits read the
+// global map where the tracer shades them). Record placement is deterministic: the probes are
+// taken on grids of stride 16, 8, 4, 2 and 1 pixels; at each level the probes no record of the
+// earlier levels covers gather a new record, in parallel, and the records are inserted in pixel
+// order on the controlling thread - a record's placement depends only on coarser levels.
+// Probe hits and gather samples travel to PE 0 as counted messages; the cache is then
+// broadcast to every PE.
+#pragma once
+
+#include <cstdint>
+
+#include "common/scene/camera.h"
+#include "common/scene/scene.h"
+#include "photonmap/final_gather.h"
+#include "photonmap/irradiance_cache.h"
+
+namespace pr::par {
+class Runtime;
+}
+namespace pr::rt {
+class PrePassTracer;
+}
+
+namespace pr::pm {
+
+struct CachePassOptions {
+  GatherOptions gather;      // rays per record, the global map's lookup, seed
+  float accuracy = 0.25f;    // Ward's a
+  int maxDepth = 8;          // mirror and glass bounces a probe follows
+  rt::IntegratorOptions camera;  // the render's options (seed, effects): probe rays are its sample 0
+};
+
+// The cache for the image (width x height through `camera`). Counters IrradianceCache/probes,
+// IrradianceCache/records and IrradianceCache/gather_rays (per PE that made them).
+IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
+                                     const KdTree& global, const CachePassOptions& options, rt::PrePassTracer& tracer,
+                                     par::Runtime& rt);
+
+}  // namespace pr::pm
