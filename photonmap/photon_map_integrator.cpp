@@ -18,6 +18,7 @@
 #include "photonmap/final_gather.h"
 #include "photonmap/irradiance_cache_pass.h"
 #include "photonmap/photon_pass.h"
+#include "photonmap/ward_brdf.h"
 #include "raytrace/core/bvh.h"
 
 namespace pr::pm {
@@ -216,7 +217,20 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (rt::maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= options().maxDepth) return;
-  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_);
+  // An anisotropic material's glossy lobe is Ward's, in the frame of its anisotropy direction.
+  const bool ward = m.anisotropy > 0.0f && m.hasSpecular() && !m.deltaSpecular() && ctx.simulates(scene::Effect::Anisotropy);
+  const WardLobe lobe = ward ? wardLobe(m) : WardLobe{};
+  const rt::Frame wardFrame = ward ? anisotropyFrame(ctx.scene(), si, sf.ns, m.anisotropyDirection) : sf.frame;
+  const glm::vec3 wardWo = wardFrame.toLocal(si.wo);
+  if (ward) {
+    const glm::vec3 diffuseF = m.diffuseColor() * rt::kInvPi;
+    const rt::IntegratorContext::OpaqueEval eval = [&](const glm::vec3&, const glm::vec3& wiLocal) {
+      return diffuseF + evalWard(lobe, wardWo, wardFrame.toLocal(sf.frame.toWorld(wiLocal)));
+    };
+    ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_, &eval);
+  } else {
+    ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_);
+  }
 
   // The diffuse part: caustics from the caustic map, indirect light from the cache, both
   // smooth over many pixels, so read by a stratified subset of the pixel's samples only.
@@ -257,10 +271,10 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     } else {
       const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
       for (int i = 0; i < n; ++i) {
-        const rt::BsdfSample s = rt::sampleGlossy(m, sf.woLocal, ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)),
-                                                  ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u));
+        const float u = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)), v = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u);
+        const rt::BsdfSample s = ward ? sampleWard(lobe, wardWo, u, v) : rt::sampleGlossy(m, sf.woLocal, u, v);
         if (!s.valid) continue;
-        const glm::vec3 wi = sf.frame.toWorld(s.wi);
+        const glm::vec3 wi = (ward ? wardFrame : sf.frame).toWorld(s.wi);
         if (glm::dot(wi, sf.ng) <= 0.0f) continue;
         // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
         spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,

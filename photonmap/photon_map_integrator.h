@@ -3,7 +3,8 @@
 // seen from the eye split into
 //   - emission and direct light, by next-event estimation (shadow rays; several on area lights),
 //   - ideal specular reflection and refraction, by one ray each (Fresnel-weighted),
-//   - glossy reflection, by Monte Carlo rays from the GGX lobe, as many as the roughness asks,
+//   - glossy reflection, by Monte Carlo rays from the GGX lobe (Ward's anisotropic lobe for
+//     KHR_materials_anisotropy), as many as the roughness asks,
 //   - caustics, straight from the caustic map (cone filter),
 //   - indirect diffuse light, by final gathering whose hits read the global map, through an
 //     irradiance cache with Ward-Heckbert gradients built in a pre-pass over the image.
@@ -66,12 +67,8 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
                       const rt::IntegratorOptions& options, const PhotonMapSettings& settings);
 
   std::string_view name() const override { return "photonmap"; }
-  // Everything but anisotropy: the glossy lobe is isotropic GGX.
-  scene::EffectSet simulated() const override {
-    scene::EffectSet s = scene::EffectSet::all();
-    s.set(scene::Effect::Anisotropy, false);
-    return s;
-  }
+  // Every effect: anisotropic materials get the Ward lobe (ward_brdf.h).
+  scene::EffectSet simulated() const override { return scene::EffectSet::all(); }
   bool hasPrePass() const override { return true; }
   // Through the render's tracer: pass 1 (photon_pass.h, stage "photon merge" and the photon
   // program's), the kd-trees, the precomputed irradiance, the maps' broadcast, and the

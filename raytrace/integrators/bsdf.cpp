@@ -77,6 +77,21 @@ ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction
   if (mat.isEmissive())
     m.emission = glm::max(mat.emission() * glm::vec3(textureOr(scene, mat.emissiveTexture, si.uv, true)), glm::vec3(0.0f));
   m.doubleSided = mat.doubleSided;
+  if (mat.anisotropyStrength > 0.0f) {
+    // The texture's RG is a tangent-space direction in [-1, 1]^2 and B scales the strength;
+    // the rotation turns the direction counter-clockwise (KHR_materials_anisotropy).
+    glm::vec2 dir(1.0f, 0.0f);
+    float strength = mat.anisotropyStrength;
+    if (mat.anisotropyTexture.present()) {
+      const glm::vec4 t = textureOr(scene, mat.anisotropyTexture, si.uv, false);
+      const glm::vec2 d = glm::vec2(t) * 2.0f - 1.0f;
+      if (glm::dot(d, d) > 1.0e-8f) dir = glm::normalize(d);
+      strength *= t.z;
+    }
+    const float c = std::cos(mat.anisotropyRotation), s = std::sin(mat.anisotropyRotation);
+    m.anisotropyDirection = glm::vec2(c * dir.x - s * dir.y, s * dir.x + c * dir.y);
+    m.anisotropy = std::clamp(strength, 0.0f, 1.0f);
+  }
   return m;
 }
 

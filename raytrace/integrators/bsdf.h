@@ -26,6 +26,11 @@ struct ShadingMaterial {
   float ior = 1.5f;
   glm::vec3 emission{0.0f};   // radiance (nits) leaving the emitting side
   bool doubleSided = false;
+  // KHR_materials_anisotropy: strength in [0, 1] and the direction in the tangent plane, as
+  // (cos, sin) of its angle from the uv tangent (rotation and texture applied). The path tracer
+  // ignores them; the photon map's Ward lobe reads them.
+  float anisotropy = 0.0f;
+  glm::vec2 anisotropyDirection{1.0f, 0.0f};
 
   // Weight of the Lambertian part: the non-metallic, non-transmissive share of baseColor.
   glm::vec3 diffuseColor() const { return (1.0f - metallic) * (1.0f - transmission) * baseColor; }

@@ -52,7 +52,7 @@ glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInte
 
 void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
                                     const glm::vec3& woLocal, const RayMessage& msg, float opaqueWeight, bool mis,
-                                    Emit& out, int areaSamples) const {
+                                    Emit& out, int areaSamples, const OpaqueEval* eval) const {
   if (!(opaqueWeight > 0.0f)) return;
   const bool area = lights_.hasAreaLights();
   if (!simulates(scene::Effect::DirectLight)) {
@@ -67,9 +67,9 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
     if (glm::dot(ls.wi, ng) <= 0.0f) return;
     const glm::vec3 wiLocal = frame.toLocal(ls.wi);
     if (wiLocal.z <= 0.0f) return;
-    const glm::vec3 f = evalOpaque(m, woLocal, wiLocal) * opaqueWeight;
+    const glm::vec3 f = (eval ? (*eval)(woLocal, wiLocal) : evalOpaque(m, woLocal, wiLocal)) * opaqueWeight;
     float weight = 1.0f;
-    if (mis && ls.pdf > 0.0f) {
+    if (mis && !eval && ls.pdf > 0.0f) {
       // Power heuristic (Veach 1997, eq. 9.13) against the BSDF sample that could hit this light.
       const float pb = opaqueWeight * pdfOpaque(m, woLocal, wiLocal);
       weight = ls.pdf * ls.pdf / (ls.pdf * ls.pdf + pb * pb);

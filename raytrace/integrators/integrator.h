@@ -100,8 +100,12 @@ class IntegratorContext {
   // kLight* dimensions, sample i on Dim::kLightExtra + 3 (i - 1) ...). Plan: nothing
   // with direct light off, no area sample with emission off, and with shadows off the
   // contribution goes straight to the film (what an unoccluded shadow ray adds on its miss).
+  // eval, when given, replaces the opaque BSDF's evaluation f(wo, wi) (local vectors of frame,
+  // without cos): an integrator's own lobe (the photon map's anisotropic Ward). MIS is then off.
+  using OpaqueEval = std::function<glm::vec3(const glm::vec3& woLocal, const glm::vec3& wiLocal)>;
   void directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame, const glm::vec3& woLocal,
-                   const RayMessage& msg, float opaqueWeight, bool mis, Emit& out, int areaSamples = 1) const;
+                   const RayMessage& msg, float opaqueWeight, bool mis, Emit& out, int areaSamples = 1,
+                   const OpaqueEval* eval = nullptr) const;
   // Pushes ray when the plan simulates `effect`, else counts it in TraceStats::*skipped.
   void spawn(scene::Effect effect, uint64_t TraceStats::*skipped, const RayMessage& ray, Emit& out) const {
     if (simulates(effect))

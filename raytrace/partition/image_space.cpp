@@ -42,7 +42,7 @@ class ImageSpacePartition final : public Partition {
     // caller (TraceOptions::worldBvh) is not rebuilt: its build is then outside the record.
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)
-      rt.runPinned("build", par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+      rt.runPinned(job.stage("build"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
         built = std::make_unique<Bvh>(job.scene, job.options.bvh);
       });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
@@ -65,7 +65,7 @@ class ImageSpacePartition final : public Partition {
     PerPeTraceStats counters(rt.pes());
     std::atomic<int64_t> done{0};
     const int64_t total = int64_t(tiles.size());
-    rt.runStage("trace", set, [&](par::Pe& pe, par::TaskId id) {
+    rt.runStage(job.stage("trace"), set, [&](par::Pe& pe, par::TaskId id) {
       const PixelRect& rect = tiles[size_t(id)].rect;
       Film tile(rect, job.width, job.height, integrator.options().spp);
       TraceStats stats;

@@ -53,7 +53,7 @@ class ObjectFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
-    rt_.runOnEachPe("build", [&](par::Pe& pe) {
+    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
         bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);
@@ -73,7 +73,7 @@ class ObjectFrame {
     // Materials, textures, lights and the directory of piece bounds and owners are replicated
     // on every PE, and so are the emitters (area-light sampling); other geometry is not.
     recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), assignment_.directoryBytes());
-    rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
       integrator_->cameraRays(tiles[size_t(id)], st.start);

@@ -51,7 +51,7 @@ class ObjectSpaceFrame {
   TraceResult run() {
     const int pes = rt_.pes();
     // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
-    rt_.runOnEachPe("build", [&](par::Pe& pe) {
+    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       std::vector<uint32_t> held;
       for (int v = 0; v < split_.voxels(); ++v)
         if (owners_[v] == pe.id() && !split_.triangles(v).empty()) {
@@ -69,7 +69,7 @@ class ObjectSpaceFrame {
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
     recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
-    rt_.runStage("trace", tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
       integrator_->cameraRays(tiles[size_t(id)], camera);

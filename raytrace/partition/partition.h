@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -92,6 +93,10 @@ struct TraceJob {
   // The PEs hold the scene (and the world BVH handed in) already: a world-model tracer does not
   // count its broadcast again (the second and later jobs of one render: pre-pass and render).
   bool sceneResident = false;
+  // Put before the tracer's stage names ("build", "trace"), so that a pre-pass program's
+  // stages are told apart from the render's in the run record ("photon-pass trace").
+  std::string stagePrefix;
+  std::string stage(std::string_view name) const { return stagePrefix + std::string(name); }
 };
 
 // The integrator a partition renders job with: job.integrator, or the built-in default.

@@ -66,6 +66,7 @@ class PartitionPrePass final : public PrePassTracer {
     job.options.progress = {};
     job.integrator = program;
     job.assembleImage = false;
+    job.stagePrefix = std::string(program->name()) + " ";
     // The world-model PEs hold the scene already (the render counts its broadcast once).
     job.sceneResident = render_.options.worldBvh != nullptr;
     makePartition(partition_)->render(job, rt_);

@@ -31,7 +31,7 @@ class SequentialPartition final : public Partition {
     // The BVH build is a stage of its own, timed like every tracer's build (Ts includes it).
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)
-      rt.runStage("build", par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
+      rt.runStage(job.stage("build"), par::TaskSet::uniform(1), [&](par::Pe&, par::TaskId) {
         built = std::make_unique<Bvh>(job.scene, job.options.bvh);
       });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
@@ -39,7 +39,7 @@ class SequentialPartition final : public Partition {
     const Integrator& integrator = *shared;
     Film film(job.width, job.height, integrator.options().spp);
     PerPeTraceStats counters(rt.pes());
-    rt.runStage("trace", par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {
+    rt.runStage(job.stage("trace"), par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {
       TraceStats& stats = counters.of(pe.id());
       std::vector<RayMessage> queue;
       // Row by row keeps the queue at one row of camera rays plus one path's messages; the
