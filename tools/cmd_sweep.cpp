@@ -61,6 +61,7 @@ struct SweepArgs {
   std::uint64_t seed = 1;
   int referenceSpp = 1024;
   int referenceDepth = 16;
+  bool pathSppGiven = false;
   std::string referenceDir;
   bool noCache = false;
   double targetRmse = 0.0;
@@ -227,11 +228,15 @@ void run(SweepArgs& a) {
   // The series.
   std::vector<Row> rows;
   std::size_t total = 0;
-  for (const std::string& i : a.integrators) total += (i == "photonmap" || a.vary == "spp") ? a.values.size() : a.pathSpp.size();
+  // The path tracer's series: --path-spp when given, else --values when spp is varied.
+  const std::vector<double> pathValues = (a.vary == "spp" && !a.pathSppGiven)
+                                             ? a.values
+                                             : std::vector<double>(a.pathSpp.begin(), a.pathSpp.end());
+  for (const std::string& i : a.integrators) total += i == "photonmap" ? a.values.size() : pathValues.size();
   for (const std::string& integrator : a.integrators) {
-    const bool varied = integrator == "photonmap" || a.vary == "spp";
-    const std::string setting = varied ? a.vary : "spp";
-    std::vector<double> values = varied ? a.values : std::vector<double>(a.pathSpp.begin(), a.pathSpp.end());
+    const bool photonSeries = integrator == "photonmap";
+    const std::string setting = photonSeries ? a.vary : "spp";
+    const std::vector<double>& values = photonSeries ? a.values : pathValues;
     for (double v : values) {
       RenderSettings s = baseSettings(a, integrator, a.spp, a.seed, a.maxDepth);
       if (integrator == "photonmap") applyVaried(a.vary, v, s);
@@ -325,7 +330,7 @@ void addSweepCommand(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::Validator([](std::string& v) { return integrators().problem(v); }, "INTEGRATOR"))
       ->capture_default_str();
-  cmd->add_option("--path-spp", a->pathSpp, "the path tracer's samples per pixel, comma-separated")
+  CLI::Option* pathSpp = cmd->add_option("--path-spp", a->pathSpp, "the path tracer's samples per pixel, comma-separated (default: --values with --vary spp)")
       ->delimiter(',')->check(CLI::Range(1, rt::kMaxSpp))->capture_default_str();
   cmd->add_option("-m,--method", a->method, "ray-tracing method (the image does not depend on it)")
       ->check(CLI::Validator([](std::string& v) { return renderMethods().problem(v); }, "METHOD"))
@@ -354,7 +359,10 @@ void addSweepCommand(CLI::App& app) {
   cmd->add_option("--k", p.globalK, "photonmap: photons per global-map estimate")->check(CLI::Range(1, 10000))->capture_default_str();
   cmd->add_option("--radius", p.globalRadius, "photonmap: global-map radius (0 = automatic)")->check(CLI::NonNegativeNumber)->capture_default_str();
   par::addScheduleOptions(*cmd, a->schedule);
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a, pathSpp] {
+    a->pathSppGiven = pathSpp->count() > 0;
+    run(*a);
+  });
 }
 
 }  // namespace pr::cli

@@ -35,6 +35,19 @@ if pm and path:
     ratio = path / pm
     print(f"speed-up of the photon map at equal RMSE: {ratio:.1f}x (bar 3x, goal 5x): {'PASS' if ratio >= 3 else 'FAIL'}")
 rows = j["rows"]
+def cpu_to(integrator, target):
+    pts = sorted((r["cpuSeconds"], r["rmse"]) for r in rows if r["integrator"] == integrator)
+    for (t0, e0), (t1, e1) in zip(pts, pts[1:]):
+        if e0 > target >= e1:
+            import math
+            f = (math.log(target) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0)))
+    return pts[0][0] if pts and pts[0][1] <= target else None
+path256 = next((r for r in rows if r["integrator"] == "path" and r["value"] == 256), None)
+if path256:
+    a, b = cpu_to("photonmap", path256["rmse"]), path256["cpuSeconds"]
+    if a:
+        print(f"at the path tracer's 256-spp RMSE {path256['rmse']:.5f}: photonmap {a:.2f} CPU s, path {b:.2f} CPU s, {b / a:.1f}x")
 best = max((r for r in rows if r["integrator"] == "photonmap"), key=lambda r: r["cpuSeconds"])
 near = min((r for r in rows if r["integrator"] == "path"), key=lambda r: abs(r["cpuSeconds"] - best["cpuSeconds"]))
 print(f"caustic region ({j['causticPixels']} px) at about equal time: photonmap {best['causticRmse']:.4f} "
