@@ -12,6 +12,13 @@ void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameVie
   const Rect screen{0, 0, view.width, view.height};
   if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
   sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
+  // The plan's skipped work leaves the sort point as run-record counters, per PE.
+  const std::vector<ShadeCounters> shade = sortPoint.takeShadeCounters();
+  for (size_t p = 0; p < shade.size() && int(p) < runtime.pes(); ++p) {
+    runtime.addCounter("Plan/texture_evaluations_skipped", int(p), double(shade[p].textureEvaluationsSkipped));
+    runtime.addCounter("Plan/emission_skipped", int(p), double(shade[p].emissionSkipped));
+    runtime.addCounter("Plan/light_samples_skipped", int(p), double(shade[p].lightSamplesSkipped));
+  }
 }
 
 RegionFramebuffer renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameView& view,

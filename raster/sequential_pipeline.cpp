@@ -27,7 +27,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
     processTriangles(scene, view, first, std::min(options.batchSize, total - first), tris, &st.geometry);
   }
 
-  const ShadingContext ctx = makeShadingContext(scene, view);
+  const ShadingContext ctx = makeShadingContext(scene, view, options.effects);
   st.usesHeadlight = ctx.usesHeadlight;
   auto draw = [&](std::span<const ScreenTriangle> list, const PixelWindow& pixels) {
     drawRegion(ctx, list, pixels, &st.raster, &st.shade);

@@ -23,6 +23,8 @@ struct SequentialOptions {
   std::vector<Rect> regions;
   // Triangles per geometry batch (the PDI of the parallel pipelines); no effect on the image.
   uint32_t batchSize = 4096;
+  // The RenderPlan's effects shading honours (see SortOptions::effects).
+  scene::EffectSet effects = scene::EffectSet::all();
 };
 
 struct RasterStats {

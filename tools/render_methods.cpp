@@ -98,6 +98,7 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   options.tileSizePx = o.tileSizePx;
   options.compositor = o.compositor;
   options.sparse = o.sparse;
+  options.effects = r.plan.enabled();
   std::unique_ptr<raster::SortPoint> sortPoint = raster::makeSortPoint(name);
   raster::RegionFramebuffer last;
   for (int frame = 0; frame < o.frames; ++frame) {
@@ -110,7 +111,8 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   const par::RunRecord& record = r.runtime.record();
   // The raster stages (raster/stages/shade.cpp) shade each visible pixel once: direct light
   // from punctual lights (a headlight without them) with its glossy highlight, emission and
-  // textures; no shadows, reflection or refraction rays, so there is no plan work to skip.
+  // textures, each skipped (and counted) when the plan has it off; no shadows, reflection or
+  // refraction rays.
   scene::EffectSet rasterEffects = scene::EffectSet::none();
   for (scene::Effect e : {scene::Effect::DirectLight, scene::Effect::Emission, scene::Effect::Textures})
     rasterEffects.set(e, true);
@@ -118,9 +120,13 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   const auto count = [&](std::string_view counter) { return std::to_string(counterTotal(record, counter)); };
   RenderOutcome out;
   out.image = raster::toImage(last);
+  std::string skipped;
+  for (const char* c : {"Plan/texture_evaluations_skipped", "Plan/emission_skipped", "Plan/light_samples_skipped"})
+    if (const uint64_t n = counterTotal(record, c); n > 0)
+      skipped += (skipped.empty() ? "" : ", ") + std::string(c + 5) + " " + std::to_string(n);
   out.effects = "rasterization simulates direct light (punctual lights, no shadows), emission and textures" +
                 (missing.empty() ? std::string() : "; not simulated: " + missing) +
-                "; the plan is reported, not applied (no rays to skip)";
+                "; skipped work: " + (skipped.empty() ? "none" : skipped);
   out.details = "frames " + std::to_string(o.frames) + (o.orbit ? " (orbit)" : "") + ", regions " + o.regions +
                 ", tile " + std::to_string(o.tileSizePx) + " px";
   if (name == "sort-first")

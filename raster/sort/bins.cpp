@@ -55,16 +55,16 @@ void RegionDrawer::drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<con
                            const Rect& rect, FrameAssembly& frame) {
   if (!frame.assembles(pe)) {
     RegionFramebuffer region = frame.buffer(rect);
-    drawRegion(ctx, tris, region.window());
+    drawRegion(ctx, tris, region.window(), nullptr, &shade_);
     frame.deliver(pe, std::move(region));
     return;
   }
   RegionFramebuffer& image = frame.frame(pe);
   if (rect.area() > kScratchTilePixels) {
-    drawRegion(ctx, tris, image.window(rect));
+    drawRegion(ctx, tris, image.window(rect), nullptr, &shade_);
   } else {
     scratch_.reshape(rect);
-    drawRegion(ctx, tris, scratch_.window());
+    drawRegion(ctx, tris, scratch_.window(), nullptr, &shade_);
     copyInto(scratch_, image);
   }
   frame.serve(pe);  // the regions other PEs finished meanwhile

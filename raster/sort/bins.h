@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "common/parallel/pe.h"
@@ -44,6 +45,8 @@ class RegionDrawer {
 
   // Triangles binned by the last draw (a triangle counts once per region it went to).
   size_t binned() const { return binned_; }
+  // What shading did and skipped since the last call, then reset.
+  ShadeCounters takeShadeCounters() { return std::exchange(shade_, ShadeCounters{}); }
 
  private:
   std::unique_ptr<ScreenTriangle[]> storage_;  // uninitialised beyond what draw() writes
@@ -52,6 +55,7 @@ class RegionDrawer {
   std::vector<int> slot_;       // grid region -> position in regions, or -1
   std::vector<size_t> start_;   // per position: first index in storage_
   RegionFramebuffer scratch_;
+  ShadeCounters shade_;
 };
 
 

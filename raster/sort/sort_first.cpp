@@ -96,7 +96,7 @@ class ReadableScene {
  public:
   ReadableScene(const FrameInputs& f, std::span<const uint32_t> ids)
       : shared_(f.scene), view_(f.options.poisonForeignGeometry ? scene::poisonedView(f.scene, ids) : nullptr) {
-    if (view_) shading_ = makeShadingContext(*view_, f.view);
+    if (view_) shading_ = makeShadingContext(*view_, f.view, f.options.effects);
   }
   const scene::Scene& scene() const { return view_ ? *view_ : shared_; }
   // The shading context over the same scene (deferred shading reads vertex attributes).
@@ -111,12 +111,17 @@ class ReadableScene {
 class SortFirst : public SortPoint {
  public:
   std::string_view name() const override { return "sort-first"; }
+  std::vector<ShadeCounters> takeShadeCounters() override {
+    std::vector<ShadeCounters> out;
+    for (RegionDrawer& d : drawers_) out.push_back(d.takeShadeCounters());
+    return out;
+  }
 
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
     declareSortCounters(name(), rt);
     // The first frame on a scene and runtime hands every PE its initial share; each PE keeps
     // that share, so a later loss of coherence (below) starts again from it at no cost.

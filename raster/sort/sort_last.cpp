@@ -19,13 +19,14 @@ namespace {
 class SortLast : public SortPoint {
  public:
   std::string_view name() const override { return "sort-last"; }
+  std::vector<ShadeCounters> takeShadeCounters() override { return std::exchange(shade_, {}); }
 
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     // The compositor is chosen (and a bad name rejected) before any work is done.
     std::unique_ptr<Compositor> compositor = makeCompositor(f.options.compositor);
     const Rect screen{0, 0, f.view.width, f.view.height};
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
 
@@ -54,7 +55,10 @@ class SortLast : public SortPoint {
     });
 
     // Stage 2, shading of each PE's visible pixels, in its own buffer.
-    rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) { shadeRegion(ctx, tris[pe.id()], buffers[pe.id()]); });
+    shade_.assign(size_t(pes), ShadeCounters{});
+    rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
+      shadeRegion(ctx, tris[pe.id()], buffers[pe.id()], &shade_[size_t(pe.id())]);
+    });
 
     // Stage 3, the sort: depth compositing by screen region (its counters go to the record).
     const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse);
@@ -67,6 +71,7 @@ class SortLast : public SortPoint {
 
  private:
   std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
+  std::vector<ShadeCounters> shade_;        // per PE, the last frame's
   RegionBufferPool pool_;                   // region message storage, kept between frames
   SceneDistribution distribution_;
 };

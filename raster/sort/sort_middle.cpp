@@ -35,11 +35,16 @@ void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
 class SortMiddle : public SortPoint {
  public:
   std::string_view name() const override { return "sort-middle"; }
+  std::vector<ShadeCounters> takeShadeCounters() override {
+    std::vector<ShadeCounters> out;
+    for (RegionDrawer& d : drawers_) out.push_back(d.takeShadeCounters());
+    return out;
+  }
 
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
     FrameAssembly frame(rt, image, pool_);

@@ -13,11 +13,13 @@
 #include <vector>
 
 #include "common/parallel/runtime.h"
+#include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
 #include "common/util/registry.h"
 #include "raster/framebuffer.h"
 #include "raster/sort/region_assignment.h"
 #include "raster/stages/geometry.h"
+#include "raster/stages/shade.h"
 
 namespace pr::raster {
 
@@ -30,6 +32,10 @@ struct SortOptions {
   // A check for tests (common/scene/poisoned_view.h): sort-first PEs read geometry from a scene
   // copy holding only the primitives they hold or were sent, so an uncounted read shows.
   bool poisonForeignGeometry = false;
+  // The RenderPlan's effects: shading skips textures, emission or direct light when they are
+  // off, and the work not done is put in the run record (Plan/texture_evaluations_skipped,
+  // Plan/emission_skipped, Plan/light_samples_skipped, per PE), as the ray tracers do.
+  scene::EffectSet effects = scene::EffectSet::all();
 };
 
 // The algorithm counters of the sort points, named per PE in the run record (Sort/...): the
@@ -61,6 +67,8 @@ struct FrameInputs {
 class SortPoint {
  public:
   virtual ~SortPoint() = default;
+  // The shading counters of the last frame, per PE, reset by the call (the plan's skipped work).
+  virtual std::vector<ShadeCounters> takeShadeCounters() = 0;
   virtual std::string_view name() const = 0;  // "sort-first" | "sort-middle" | "sort-last"
   // Renders one frame on the runtime's PEs into image (full screen), writing every pixel: what
   // it held before does not matter, so a caller can reuse one image from frame to frame.

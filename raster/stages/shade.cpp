@@ -96,12 +96,15 @@ SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm
   return sp;
 }
 
-ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view) {
+ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view, scene::EffectSet effects) {
   ShadingContext ctx;
   ctx.scene = &scene;
   ctx.view = view;
   ctx.lights = scene.lights;
   ctx.usesHeadlight = ctx.lights.empty();
+  ctx.textures = effects.has(scene::Effect::Textures);
+  ctx.emission = effects.has(scene::Effect::Emission);
+  ctx.direct = effects.has(scene::Effect::DirectLight);
   return ctx;
 }
 
@@ -164,19 +167,34 @@ glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N,
   return brdf(base, metallic, roughness, N, V, L);
 }
 
-glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp) {
+glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeCounters* counters) {
   const scene::Scene& scene = *ctx.scene;
   const scene::Material& m = scene.materials[sp.material];
+  // A texture lookup the plan skips is counted, and the factor alone used.
+  auto texture = [&](const scene::TextureRef& ref, bool srgb) {
+    if (ctx.textures) return sampleSlot(scene, ref, sp.uv, srgb);
+    if (counters) ++counters->textureEvaluationsSkipped;
+    return glm::vec4(1.0f);
+  };
   glm::vec4 base = m.baseColorFactor * sp.colour;
-  if (m.baseColorTexture.present()) base *= sampleSlot(scene, m.baseColorTexture, sp.uv, true);
+  if (m.baseColorTexture.present()) base *= texture(m.baseColorTexture, true);
   float metallic = m.metallicFactor, roughness = m.roughnessFactor;
   if (m.metallicRoughnessTexture.present()) {
-    glm::vec4 mr = sampleSlot(scene, m.metallicRoughnessTexture, sp.uv, false);
+    glm::vec4 mr = texture(m.metallicRoughnessTexture, false);
     roughness *= mr.y;  // G channel
     metallic *= mr.z;    // B channel
   }
-  glm::vec3 radiance = m.emission();
-  if (m.emissiveTexture.present()) radiance *= glm::vec3(sampleSlot(scene, m.emissiveTexture, sp.uv, true));
+  glm::vec3 radiance(0.0f);
+  if (ctx.emission) {
+    radiance = m.emission();
+    if (m.emissiveTexture.present()) radiance *= glm::vec3(texture(m.emissiveTexture, true));
+  } else if (counters && m.isEmissive()) {
+    ++counters->emissionSkipped;
+  }
+  if (!ctx.direct) {
+    if (counters) counters->lightSamplesSkipped += ctx.usesHeadlight ? 1 : ctx.lights.size();
+    return radiance;
+  }
 
   glm::vec3 V = ctx.view.perspective ? glm::normalize(ctx.view.eye - sp.position) : -ctx.view.forward;
   glm::vec3 albedo(base);
@@ -373,7 +391,8 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
 
   // Lanes take the headlight path with per-material constants; anything else (punctual lights,
   // textures, vertex colours) is shaded one pixel at a time by shadeSurface.
-  const bool lanes = ctx.usesHeadlight && scene.colors.empty();
+  // The plan's skips are handled (and counted) by shadeSurface.
+  const bool lanes = ctx.usesHeadlight && scene.colors.empty() && ctx.textures && ctx.emission && ctx.direct;
   std::vector<HeadlightMaterial> materials;
   if (lanes) {
     materials.reserve(scene.materials.size());
@@ -450,7 +469,7 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
       const int64_t e0 = e[0], e1 = e[1], e2 = e[2];
       ++shaded;
       if (!cachedFields) {
-        colours[i] = shadeSurface(ctx, surfaceAt(scene, tri, barycentricsFromEdges(tri, e0, e1, e2)));
+        colours[i] = shadeSurface(ctx, surfaceAt(scene, tri, barycentricsFromEdges(tri, e0, e1, e2)), counters);
         continue;
       }
       // A run of kLanes pixels of this triangle starting a batch fills it at once.

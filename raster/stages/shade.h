@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/scene/effect_analysis.h"
 #include "common/scene/light.h"
 #include "common/scene/scene.h"
 #include "raster/framebuffer.h"
@@ -46,9 +47,14 @@ struct ShadingContext {
   // still readable). usesHeadlight says so; lights is then empty.
   std::vector<scene::PunctualLight> lights;
   bool usesHeadlight = false;
+  // The RenderPlan's effects (common/scene/effect_analysis.h) this stage can skip: textures off
+  // shades from the material factors, emission off adds no emitted radiance, direct off adds
+  // no light (punctual or headlight). The work not done is counted in ShadeCounters.
+  bool textures = true, emission = true, direct = true;
 };
 
-ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view);
+ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view,
+                                  scene::EffectSet effects = scene::EffectSet::all());
 
 // BRDF value f_r(V, L) for the metallic-roughness model (glTF 2.0, Appendix B): Lambert
 // (1 - metallic) * base / pi plus the Cook-Torrance lobe D G F / (4 NdotL NdotV) with the GGX
@@ -56,13 +62,24 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
 // (F0 = mix(0.04, base, metallic)). N, V, L are unit vectors.
 glm::vec3 evalBrdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L);
 
-// Outgoing radiance towards the camera: emission + sum over lights of f_r * E * cos(theta).
-glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& point);
-
 struct ShadeCounters {
   uint64_t pixelsShaded = 0;
-  ShadeCounters& operator+=(const ShadeCounters& o) { pixelsShaded += o.pixelsShaded; return *this; }
+  // The plan's skipped work (the Plan/ counters of the run record, as the ray tracers name it).
+  uint64_t textureEvaluationsSkipped = 0;  // texture lookups not made (textures off)
+  uint64_t lightSamplesSkipped = 0;        // light evaluations not made (direct off), headlight included
+  uint64_t emissionSkipped = 0;            // emissive pixels whose emission was not added
+  ShadeCounters& operator+=(const ShadeCounters& o) {
+    pixelsShaded += o.pixelsShaded;
+    textureEvaluationsSkipped += o.textureEvaluationsSkipped;
+    lightSamplesSkipped += o.lightSamplesSkipped;
+    emissionSkipped += o.emissionSkipped;
+    return *this;
+  }
 };
+
+// Outgoing radiance towards the camera: emission + sum over lights of f_r * E * cos(theta),
+// less what the plan turned off (counted in counters when given).
+glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& point, ShadeCounters* counters = nullptr);
 
 // Shades every covered pixel of the window from tris[triangle index there] (the list it was
 // rasterized from) and writes its colour. Uncovered pixels keep the background colour 0.
