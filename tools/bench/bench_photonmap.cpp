@@ -4,7 +4,8 @@
 // libnanoflann-dev, tools/setup.sh --bench) on the same points in the same run when CMake found
 // it. Not part of ctest. The photons lie on the walls of a Cornell-like box with a bright
 // caustic-like blob on the floor (the density varies 20:1, as in a real map); queries are at
-// surface points near stored photons, as a renderer makes them.
+// surface points near stored photons, as a renderer makes them. Last, photon tracing (pass 1)
+// on the bundled Cornell box: photons emitted per second per PE at P = 1 and P = 2.
 //   bench_photonmap [--photons N] [--queries N] [--k N] [--radius R] [--repeat N]
 #include <algorithm>
 #include <chrono>
@@ -25,6 +26,9 @@
 #include "photonmap/density_estimate.h"
 #include "photonmap/kd_tree.h"
 #include "photonmap/photon.h"
+#include "photonmap/photon_tracer.h"
+#include "common/scene/gltf_loader.h"
+#include "raytrace/core/bvh.h"
 
 #ifdef PARRENDER_HAVE_NANOFLANN
 #include <nanoflann.hpp>
@@ -120,6 +124,33 @@ using NanoTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adapto
 #endif
 
 }  // namespace
+
+// Pass 1 on the bundled Cornell box (200k global + 100k caustic photons requested): photons
+// emitted per second per PE at P = 1 and P = 2 in the same run, wall time of the tracing stage
+// (best of repeat), and the speed-up; the lists are checked identical.
+void tracingSection(int repeat) {
+  const pr::scene::Scene scene = pr::scene::loadGltf(std::string(PARRENDER_SOURCE_DIR) + "/scenes/cornell.gltf");
+  const pr::rt::Bvh bvh(scene);
+  pr::pm::PhotonOptions options;
+  std::printf("\n== photon tracing, bundled Cornell box, %zu global + %zu caustic photons requested ==\n",
+              options.globalPhotons, options.causticPhotons);
+  double best[2] = {1e30, 1e30};
+  std::size_t emitted = 0, stored[2] = {0, 0};
+  for (int p = 1; p <= 2; ++p)
+    for (int r = 0; r < repeat; ++r) {
+      pr::par::Runtime runtime(p);
+      const auto start = Clock::now();
+      const pr::pm::PhotonLists lists = pr::pm::tracePhotonLists(scene, bvh, options, runtime);
+      best[p - 1] = std::min(best[p - 1], secondsSince(start));
+      emitted = lists.stats.globalEmitted + lists.stats.causticEmitted;
+      stored[p - 1] = lists.global.size() + lists.caustic.size();
+    }
+  for (int p = 1; p <= 2; ++p)
+    std::printf("P = %d: %.1f ms, %.2f M photons emitted/s per PE (%zu emitted, %zu stored)\n", p, 1e3 * best[p - 1],
+                double(emitted) / best[p - 1] / double(p) * 1e-6, emitted, stored[p - 1]);
+  std::printf("speed-up P = 2 / P = 1: %.2f (efficiency %.2f); same photons stored: %s\n", best[0] / best[1],
+              best[0] / (2.0 * best[1]), stored[0] == stored[1] ? "yes" : "NO");
+}
 
 int main(int argc, char** argv) {
   std::size_t photonCount = 1000000, queryCount = 200000;
@@ -298,5 +329,6 @@ int main(int argc, char** argv) {
 #else
   std::printf("nanoflann anchor skipped: nanoflann.hpp not found at configure time (tools/setup.sh --bench installs libnanoflann-dev)\n");
 #endif
+  tracingSection(repeat);
   return 0;
 }
