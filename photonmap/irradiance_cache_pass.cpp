@@ -64,8 +64,12 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
       : IntegratorBase(scene, camera, width, height, options), maxDepth_(maxDepth), textures_(textures), perPe_(std::size_t(pes)) {}
 
   std::string_view name() const override { return "irradiance-cache probes"; }
+  // The render's camera rays (sample 0 of one per pixel), counted as the pre-pass's own rays
+  // (continuations), not as the render's camera rays.
   void cameraRays(const rt::PixelRect& rect, int, std::vector<RayMessage>& out) const override {
+    const std::size_t first = out.size();
     Integrator::cameraRays(rect, 1, out);
+    for (std::size_t i = first; i < out.size(); ++i) out[i].kind = RayKind::Continuation;
   }
 
   void shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const override {
@@ -224,7 +228,9 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
       if (uncovered[i]) chosen.push_back(candidates[i]);
     if (chosen.empty()) continue;
 
-    // Their gather rays, traced where the tracer traces them; the samples go to PE 0.
+    // Their gather rays, traced where the tracer traces them (every PE gets the chosen probes
+    // it may start rays from: a broadcast); the samples go to PE 0.
+    rt.recordBroadcast(chosen.size() * sizeof(ProbeHit));
     const int gw = std::min<int>(kGatherWidth, int(chosen.size()));
     const int gh = int((chosen.size() + std::size_t(gw) - 1) / std::size_t(gw));
     const auto gather = std::make_shared<const GatherProgram>(scene, camera, gw, gh, chosen, global, options.gather, pes);
@@ -266,8 +272,11 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
         made[i] = r;
       }
     });
+    const std::size_t before = cache.bytes();
     for (const IrradianceRecord& r : made) cache.insert(r);
     records += double(made.size());
+    // The new records reach every PE (the next level's coverage and the render read them).
+    rt.recordBroadcast(cache.bytes() - before);
   }
   for (int p = 0; p < pes; ++p) {
     rt.addCounter("IrradianceCache/probes", p, probesPerPe[std::size_t(p)]);

@@ -6,8 +6,8 @@
 // taken on grids of stride 16, 8, 4, 2 and 1 pixels; at each level the probes no record of the
 // earlier levels covers gather a new record, in parallel, and the records are inserted in pixel
 // order on the controlling thread - a record's placement depends only on coarser levels.
-// Probe hits and gather samples travel to PE 0 as counted messages; the cache is then
-// broadcast to every PE.
+// Probe hits and gather samples travel to PE 0 as counted messages; each level's chosen probes
+// and new records are broadcast to every PE.
 #pragma once
 
 #include <cstdint>
@@ -33,8 +33,8 @@ struct CachePassOptions {
   rt::IntegratorOptions camera;  // the render's options (seed, effects): probe rays are its sample 0
 };
 
-// The cache for the image (width x height through `camera`). Counters IrradianceCache/probes,
-// IrradianceCache/records and IrradianceCache/gather_rays (per PE that made them).
+// The cache for the image (width x height through `camera`). Counters IrradianceCache/probes
+// and IrradianceCache/gather_hits (per PE that shaded them), IrradianceCache/records (PE 0).
 IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
                                      const KdTree& global, const CachePassOptions& options, rt::PrePassTracer& tracer,
                                      par::Runtime& rt);

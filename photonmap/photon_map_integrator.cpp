@@ -1,11 +1,8 @@
 // The photon-map integrator (see photon_map_integrator.h): the pre-pass that traces the maps
 // and places the irradiance-cache records, and the shading of one hit.
 //
-// Record placement is deterministic: the image is probed on grids of stride 16, 8, 4, 2 and 1
-// pixels; at each level the probe points that no record of the earlier levels covers gather a
-// new record, in parallel (one task per band of rows), and the new records are inserted in
-// pixel order on the controlling thread. A record's placement therefore depends only on the
-// records of coarser levels, never on which PE finished first.
+// The pre-pass runs as programs through the render's tracer (photon_pass.h for the maps,
+// irradiance_cache_pass.h for the cache, whose record placement is deterministic).
 #include "photonmap/photon_map_integrator.h"
 
 #include <algorithm>
@@ -35,6 +32,8 @@ constexpr float kMinThroughput = 1.0f / 4096.0f;
 constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
 constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
 constexpr int kMaxRaysPerVertex = 256;
+// Photons per map at most (CLI range; the photon program's pixel index is 32 bits).
+constexpr std::size_t kMaxPhotons = 100000000;
 // The caustic and indirect estimates are read on a kSmoothGrid x kSmoothGrid sub-grid of a
 // pixel's sample strata (when its strata allow): 4 of 64 samples, weighted 16 each.
 constexpr int kSmoothGrid = 2;
@@ -76,6 +75,8 @@ PhotonMapIntegrator::PhotonMapIntegrator(const scene::Scene& scene, const scene:
   check(settings.globalRadius >= 0.0f && std::isfinite(settings.globalRadius), "--radius must be >= 0 (0 = automatic)");
   check(settings.causticRadius >= 0.0f && std::isfinite(settings.causticRadius), "--caustic-radius must be >= 0 (0 = automatic)");
   check(settings.gatherRays >= 1 && settings.gatherRays <= 65536, "--gather must be in [1, 65536]");
+  check(settings.globalPhotons <= kMaxPhotons && settings.causticPhotons <= kMaxPhotons,
+        "--photons and --caustic-photons must be at most 100000000 each");
   check(settings.cacheAccuracy > 0.0f && settings.cacheAccuracy <= 1.0f, "--cache-accuracy must be in (0, 1]");
   check(settings.fallbackGatherRays >= 1 && settings.fallbackGatherRays <= kMaxRaysPerVertex, "fallback gather rays out of range");
   check(settings.maxGlossyRays >= 1 && settings.maxGlossyRays <= kMaxRaysPerVertex, "glossy rays out of range");
@@ -90,8 +91,8 @@ PhotonMapIntegrator::PhotonMapIntegrator(const scene::Scene& scene, const scene:
   state_->cache = IrradianceCache(scene.bounds, settings.cacheAccuracy);
   // Shadow rays per pixel: at least areaLightSamples in all, spread over the pixel's samples.
   areaSamples_ = std::max(1, (settings.areaLightSamples + options.spp - 1) / options.spp);
-  // The smooth terms' samples: a regular sub-grid of the pixel's strata, about
-  // kSmoothSamplesPerPixel of them, each the centre stratum of its block of strata.
+  // The smooth terms' samples: a regular sub-grid of the pixel's strata, up to kSmoothGrid x
+  // kSmoothGrid of them, each the centre stratum of its block of strata.
   const glm::ivec2 strata = rt::strataFor(options.spp);
   auto divisorUpTo = [](int n, int cap) {
     int d = std::min(n, cap);
@@ -157,8 +158,8 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
     cache.accuracy = settings_.cacheAccuracy;
     cache.maxDepth = options().maxDepth;
     cache.camera = options();
+    // (The cache pass broadcasts each level's records as it makes them.)
     state_->cache = buildIrradianceCache(ctx.scene(), camera_, ctx.width(), ctx.height(), state_->maps.global, cache, tracer, rt);
-    if (state_->cache.size() > 0) rt.recordBroadcast(state_->cache.bytes());
   }
 }
 
@@ -179,20 +180,24 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const rt::ShadingFrame sf(si);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
-  auto spawn = [&](scene::Effect effect, std::uint64_t rt::TraceStats::*skipped, RayMessage ray) {
-    if (rt::maxComponent(ray.throughput) > kMinThroughput && rt::isFinite(ray.throughput)) ctx.spawn(effect, skipped, ray, out);
+  // One of `of` rays that share a weight: the cut-off applies to their sum, not to each.
+  auto spawn = [&](scene::Effect effect, std::uint64_t rt::TraceStats::*skipped, RayMessage ray, int of = 1) {
+    if (rt::maxComponent(ray.throughput) * float(of) > kMinThroughput && rt::isFinite(ray.throughput))
+      ctx.spawn(effect, skipped, ray, out);
   };
   auto mirror = [&]() { return sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z)); };
 
   // A gathering or glossy ray's hit: all of its light from the global map (no emission, which
-  // light sampling at the ray's origin already counted); gathering rays go on through ideal
-  // specular surfaces to the diffuse surface behind them, as in the cache's gathering.
+  // light sampling at the ray's origin already counted); both go on through ideal specular
+  // surfaces to the diffuse surface behind them, as the cache's gathering does, keeping their
+  // kind (a glossy ray its bsdfPdf > 0 mark).
   const bool secondary = msg.kind == RayKind::Gather || (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f);
   if (secondary) {
     thread_local NearestPhotons scratch;
     out.addRadiance(msg.pixel, msg.throughput * globalMapRadiance(ctx.scene(), state.maps.global, &state.irradiance, si,
                                                                   globalDensity_, ctx.simulates(scene::Effect::Textures), scratch));
-    if (msg.kind != RayKind::Gather || msg.depth >= options().maxDepth) return;
+    if (msg.depth >= options().maxDepth) return;
+    const float mark = msg.kind == RayKind::Gather ? 0.0f : msg.bsdfPdf;
     const float u = ctx.sample(msg, rt::Dim::kLobe);
     RayMessage next;
     if (u < dielectric) {
@@ -200,16 +205,19 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
       const float cosI = glm::dot(sf.ns, si.wo);
       glm::vec3 wt;
       if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt))
-        next = ctx.continuation(si, msg, glm::normalize(2.0f * cosI * sf.ns - si.wo), msg.throughput, 0.0f);
+        next = ctx.continuation(si, msg, glm::normalize(2.0f * cosI * sf.ns - si.wo), msg.throughput, mark);
       else
-        next = ctx.continuation(si, msg, wt, msg.throughput * m.baseColor, 0.0f);
+        next = ctx.continuation(si, msg, wt, msg.throughput * m.baseColor, mark);
     } else if (m.hasSpecular() && m.deltaSpecular() && glm::dot(mirror(), sf.ng) > 0.0f) {
-      next = ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z), 0.0f);
+      next = ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z), mark);
     } else {
       return;
     }
-    next.kind = RayKind::Gather;
-    spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, next);
+    next.kind = msg.kind;
+    if (msg.kind == RayKind::Gather)
+      spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, next);
+    else
+      spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped, next);
     return;
   }
 
@@ -256,7 +264,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
         if (glm::dot(wi, sf.ng) <= 0.0f) continue;
         RayMessage g = ctx.continuation(si, msg, wi, msg.throughput * diffuse / float(n), 0.0f);
         g.kind = RayKind::Gather;
-        spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, g);
+        spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, g, n);
       }
     }
   }
@@ -278,7 +286,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
         if (glm::dot(wi, sf.ng) <= 0.0f) continue;
         // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
         spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,
-              ctx.continuation(si, msg, wi, msg.throughput * s.weight * (opaque / float(n)), std::max(s.pdf, 1.0e-30f)));
+              ctx.continuation(si, msg, wi, msg.throughput * s.weight * (opaque / float(n)), std::max(s.pdf, 1.0e-30f)), n);
       }
     }
   }

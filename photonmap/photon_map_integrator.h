@@ -10,9 +10,9 @@
 //     irradiance cache with Ward-Heckbert gradients built in a pre-pass over the image.
 // Hits of glossy and gathering rays read the global map for all their light (Jensen's rule
 // for paths after a diffuse or glossy bounce). The pre-pass (prePass: photon tracing, both
-// kd-trees, cache records) runs on the world model before the trace stage; every shade call
-// after it only reads the maps and the cache, so shading is the same ray-message state
-// machine as the other integrators and gives the same image for every P and schedule.
+// kd-trees, cache records) runs through the render's own tracer before the render; every shade
+// call after it only reads the maps and the cache, so shading is the same ray-message state
+// machine as the other integrators and gives the same image for every tracer, P and schedule.
 #pragma once
 
 #include <cstddef>
@@ -72,7 +72,7 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
   bool hasPrePass() const override { return true; }
   // Through the render's tracer: pass 1 (photon_pass.h, stage "photon merge" and the photon
   // program's), the kd-trees, the precomputed irradiance, the maps' broadcast, and the
-  // irradiance cache (irradiance_cache_pass.h) with its records' broadcast.
+  // irradiance cache (irradiance_cache_pass.h), which broadcasts its records level by level.
   void prePass(rt::PrePassTracer& tracer, par::Runtime& rt) const override;
   void shade(const rt::SurfaceInteraction& si, const rt::RayMessage& msg, rt::Emit& out) const override;
 

@@ -461,7 +461,8 @@ void makeSetup(Setup& s, const scene::Scene& scene) {
     }
     causticPower.push_back(e.power * std::min(fraction, 1.0));
   }
-  s.simulate[kGlobalStream] = options.effects.has(scene::Effect::IndirectDiffuse);
+  // The global map lights indirect diffuse light and what glossy rays see.
+  s.simulate[kGlobalStream] = options.effects.has(scene::Effect::IndirectDiffuse) || options.effects.has(scene::Effect::GlossySpecular);
   s.simulate[kCausticStream] = options.effects.has(scene::Effect::Caustics);
   if (s.targets.empty()) s.simulate[kCausticStream] = false;
   s.firstPhoton[kGlobalStream] = splitPhotons(power, s.simulate[kGlobalStream] ? options.globalPhotons : 0);

@@ -37,8 +37,8 @@ struct PhotonOptions {
   int maxBounces = 64;                  // safety cap on a path; roulette ends paths long before
   bool textures = true;                 // emissive and surface textures (the plan's textures)
   // The effects to simulate (the RenderPlan's). Caustics off: no caustic photon is traced.
-  // Indirect off: no global photon is traced (pass 2 reads the global map only for indirect
-  // diffuse light).
+  // Indirect and glossy both off: no global photon is traced (pass 2 reads the global map only
+  // for indirect diffuse light and at the hits of glossy rays).
   scene::EffectSet effects = scene::EffectSet::all();
 };
 

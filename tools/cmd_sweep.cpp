@@ -181,8 +181,14 @@ void run(SweepArgs& a) {
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
   if (a.values.empty()) a.values = defaultValues(a.vary, scene);
+  // Each value must make sense for the setting it sets, checked before any cast.
+  const double most = a.vary == "photons" ? 1e8 : a.vary == "gather" ? 65536.0 : a.vary == "spp" ? double(rt::kMaxSpp)
+                    : a.vary == "k" ? 10000.0 : 1e30;
+  const bool integral = a.vary != "radius";
   for (double v : a.values)
-    if (!(v > 0.0) || !std::isfinite(v)) throw InputError("--values: " + format(v) + " is not a positive number");
+    if (!(v > 0.0) || !std::isfinite(v) || v > most || (integral && v != std::floor(v)))
+      throw InputError("--values: " + format(v) + " is not a valid " + a.vary + " (" + (integral ? "an integer " : "a number ") +
+                       "in (0, " + format(most) + "])");
   const Context ctx{a, scene, camera, plan};
   if (!a.images.empty()) std::filesystem::create_directories(a.images);
 
@@ -353,8 +359,10 @@ void addSweepCommand(CLI::App& app) {
   cmd->add_option("--images", a->images, "folder for every render (PNG), its x8 difference from the reference and the reference");
   cmd->add_option("--effects", a->effects, "force effects on or off, as for render");
   pm::PhotonMapSettings& p = a->photonmap;
-  cmd->add_option("--photons", p.globalPhotons, "photonmap: global photons (unless varied)")->capture_default_str();
-  cmd->add_option("--caustic-photons", p.causticPhotons, "photonmap: caustic photons (scaled with --photons when that is varied)")->capture_default_str();
+  cmd->add_option("--photons", p.globalPhotons, "photonmap: global photons (unless varied)")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))->capture_default_str();
+  cmd->add_option("--caustic-photons", p.causticPhotons, "photonmap: caustic photons (scaled with --photons when that is varied)")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))->capture_default_str();
   cmd->add_option("--gather", p.gatherRays, "photonmap: final-gather rays per record")->check(CLI::Range(1, 65536))->capture_default_str();
   cmd->add_option("--k", p.globalK, "photonmap: photons per global-map estimate")->check(CLI::Range(1, 10000))->capture_default_str();
   cmd->add_option("--radius", p.globalRadius, "photonmap: global-map radius (0 = automatic)")->check(CLI::NonNegativeNumber)->capture_default_str();

@@ -56,7 +56,7 @@ glm::vec4 textureLookup(const scene::Scene& scene, const scene::TextureRef& ref,
 
 bool usesTextures(const scene::Material& mat) {
   return mat.baseColorTexture.present() || mat.metallicRoughnessTexture.present() || mat.transmissionTexture.present() ||
-         (mat.isEmissive() && mat.emissiveTexture.present());
+         (mat.isEmissive() && mat.emissiveTexture.present()) || (mat.anisotropyStrength > 0.0f && mat.anisotropyTexture.present());
 }
 
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures) {
@@ -82,7 +82,7 @@ ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction
     // the rotation turns the direction counter-clockwise (KHR_materials_anisotropy).
     glm::vec2 dir(1.0f, 0.0f);
     float strength = mat.anisotropyStrength;
-    if (mat.anisotropyTexture.present()) {
+    if (textures && mat.anisotropyTexture.present()) {
       const glm::vec4 t = textureOr(scene, mat.anisotropyTexture, si.uv, false);
       const glm::vec2 d = glm::vec2(t) * 2.0f - 1.0f;
       if (glm::dot(d, d) > 1.0e-8f) dir = glm::normalize(d);

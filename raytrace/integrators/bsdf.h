@@ -55,7 +55,7 @@ struct ShadingMaterial {
 // textures = false evaluates the material from its factors alone (the plan's textures off).
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures = true);
 // Whether evalMaterial reads a texture for this material (base colour, metallic-roughness,
-// transmission or emission).
+// transmission, emission or anisotropy).
 bool usesTextures(const scene::Material& material);
 
 // Radiance emitted towards wo: the material's emission on its front side (both sides when

@@ -33,8 +33,9 @@ inline constexpr uint32_t kLobe = 5, kBsdfU = 6, kBsdfV = 7;
 inline constexpr uint32_t kRoulette = 8;
 // Further area-light samples at one vertex (IntegratorContext::directLight), three each.
 inline constexpr uint32_t kLightExtra = 16;
-// First dimension free for an integrator's own draws (photonmap: glossy rays).
-inline constexpr uint32_t kIntegratorOwn = 128;
+// First dimension free for an integrator's own draws (photonmap: gather and glossy rays),
+// above the extra area-light samples of up to 64 per vertex (16 + 3 x 63 = 205).
+inline constexpr uint32_t kIntegratorOwn = 256;
 }  // namespace Dim
 
 // A uniform number in [0, 1) for one (seed, pixel, sample, depth, dimension).

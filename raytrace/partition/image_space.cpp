@@ -60,7 +60,7 @@ class ImageSpacePartition final : public Partition {
     for (const TileTask& t : tiles) set.tasks.push_back({t.cost, t.x, t.y});
 
     // Each tile is rendered into its own film and sent, finished, to the assembler.
-    Film film(job.width, job.height, integrator.options().spp);
+    Film film(job.filmWidth(), job.filmHeight(), integrator.options().spp);
     FilmAssembly assembly(rt, film);
     PerPeTraceStats counters(rt.pes());
     std::atomic<int64_t> done{0};

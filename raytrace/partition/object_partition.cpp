@@ -72,7 +72,7 @@ class ObjectFrame {
     hits_ = &hits;
     // Materials, textures, lights and the directory of piece bounds and owners are replicated
     // on every PE, and so are the emitters (area-light sampling); other geometry is not.
-    recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), assignment_.directoryBytes());
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), assignment_.directoryBytes());
     rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();

@@ -68,7 +68,7 @@ class ObjectSpaceFrame {
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
-    recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
     rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;

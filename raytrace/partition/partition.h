@@ -87,15 +87,20 @@ struct TraceJob {
   // render's, options.integrator is then unused. nullptr: the built-in integrator that
   // options.integrator.kind names, built by the partition.
   std::shared_ptr<const Integrator> integrator = nullptr;
-  // False for a pre-pass program (PrePassTracer): its film is not assembled on PE 0 and gets no
-  // cost pre-pass (which would run the program's side effects twice); the image is then empty.
+  // False for a pre-pass program (PrePassTracer): it adds no radiance (its results are its own,
+  // per PE), so its film is one pixel, not assembled on PE 0, and it gets no cost pre-pass
+  // (which would run the program's side effects twice); the image is then 1 x 1 and black.
   bool assembleImage = true;
-  // The PEs hold the scene (and the world BVH handed in) already: a world-model tracer does not
-  // count its broadcast again (the second and later jobs of one render: pre-pass and render).
+  // The film a tracer shades into for this job: the image's, or one pixel for a program.
+  int filmWidth() const { return assembleImage ? width : 1; }
+  int filmHeight() const { return assembleImage ? height : 1; }
+  // The PEs hold the scene's replicated data already (the world model's scene and BVH, the
+  // partitioned tracers' shading data, emitters and directory): its broadcast is not counted
+  // again (the second and later jobs of one render: pre-pass programs and the render).
   bool sceneResident = false;
   // Put before the tracer's stage names ("build", "trace"), so that a pre-pass program's
   // stages are told apart from the render's in the run record ("photon-pass trace").
-  std::string stagePrefix;
+  std::string stagePrefix{};
   std::string stage(std::string_view name) const { return stagePrefix + std::string(name); }
 };
 

@@ -109,7 +109,7 @@ inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx)
 // films go to the assembler at the end (film_assembly.h).
 inline std::vector<std::unique_ptr<Film>> makeFilms(const TraceJob& job, int pes, int spp) {
   std::vector<std::unique_ptr<Film>> films;
-  for (int p = 0; p < pes; ++p) films.push_back(std::make_unique<Film>(job.width, job.height, spp));
+  for (int p = 0; p < pes; ++p) films.push_back(std::make_unique<Film>(job.filmWidth(), job.filmHeight(), spp));
   return films;
 }
 

@@ -67,15 +67,19 @@ class PartitionPrePass final : public PrePassTracer {
     job.integrator = program;
     job.assembleImage = false;
     job.stagePrefix = std::string(program->name()) + " ";
-    // The world-model PEs hold the scene already (the render counts its broadcast once).
-    job.sceneResident = render_.options.worldBvh != nullptr;
+    // The first job of the render sends the PEs what they keep (the scene, the world BVH, the
+    // shading data); the later ones find it there.
+    job.sceneResident = traced_;
     makePartition(partition_)->render(job, rt_);
+    traced_ = true;
   }
+  bool traced() const { return traced_; }
 
  private:
   const TraceJob& render_;
   std::string partition_;
   par::Runtime& rt_;
+  bool traced_ = false;
 };
 
 }  // namespace
@@ -109,7 +113,7 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
   }
   PartitionPrePass tracer(main, partition, rt);
   job.integrator->prePass(tracer, rt);
-  main.sceneResident = true;
+  main.sceneResident = tracer.traced();
   return p->render(main, rt);
 }
 

@@ -37,7 +37,7 @@ class SequentialPartition final : public Partition {
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
-    Film film(job.width, job.height, integrator.options().spp);
+    Film film(job.filmWidth(), job.filmHeight(), integrator.options().spp);
     PerPeTraceStats counters(rt.pes());
     rt.runStage(job.stage("trace"), par::TaskSet::uniform(1), [&](par::Pe& pe, par::TaskId) {
       TraceStats& stats = counters.of(pe.id());

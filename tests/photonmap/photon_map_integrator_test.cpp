@@ -8,6 +8,7 @@
 #include <cmath>
 #include <string>
 
+#include "common/parallel/metrics.h"
 #include "common/parallel/runtime.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
@@ -15,6 +16,7 @@
 #include "common/util/error.h"
 #include "photonmap/photon_map_integrator.h"
 #include "raytrace/partition/partition.h"
+#include "run_record_support.h"
 #include "test_support.h"
 
 using namespace pr;
@@ -77,13 +79,7 @@ double rmse(const image::Image& a, const image::Image& reference) {
   return n ? std::sqrt(sum / double(n)) : 0.0;
 }
 
-double counter(const par::Runtime& rt, const std::string& name) {
-  double sum = 0.0;
-  for (const par::CounterRecord& c : rt.record().counters)
-    if (c.name == name)
-      for (double v : c.perPe) sum += v;
-  return sum;
-}
+double counter(const par::Runtime& rt, const std::string& name) { return test::counterTotal(rt.record(), name); }
 
 }  // namespace
 
@@ -198,7 +194,7 @@ TEST_CASE("PhotonMapIntegrator: the pre-pass's photons, records and gather rays 
   CHECK(counter(runtime, "IrradianceCache/probes") <= kW * kH);
   CHECK(counter(runtime, "IrradianceCache/gather_hits") >= records * 30);
   CHECK(counter(runtime, "Photons/global_stored") > 0);
-  // The maps and the cache are broadcast to every PE.
+  // The cache's levels ran as stages of their own.
   bool cacheStage = false;
   for (const par::StageRecord& stage : runtime.record().stages) cacheStage |= stage.name == "irradiance-cache records 1/16";
   CHECK(cacheStage);
@@ -219,4 +215,32 @@ TEST_CASE("PhotonMapIntegrator: each bundled scene's analysed plan renders the a
     CHECK(a.pixels == all.pixels);
     if (!plan.on(scene::Effect::Caustics)) CHECK(counter(analysed, "Photons/caustic_emitted") == 0);
   }
+}
+
+TEST_CASE("PhotonMapIntegrator: the scene is broadcast once per render, the maps and the cache besides it") {
+  // Image-space with the photon map: the scene and BVH (as a path-traced render broadcasts
+  // them) once, the maps and precomputed irradiance once, the cache's records level by level
+  // and each level's chosen probes (under 256 bytes each) - not the scene again per program.
+  const scene::Scene s = cornell();
+  const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
+  auto broadcastPerPe = [](const par::Runtime& rt) {
+    return par::summarize(rt.record()).total.figure("broadcastBytesReceived").mean;
+  };
+  par::Runtime pathRuntime(2);
+  rt::TraceOptions path;
+  path.tileSizePx = 8;
+  rt::renderRays(s, cam, kW, kH, path, "image-space", pathRuntime);
+  const double scene = broadcastPerPe(pathRuntime);
+  par::Runtime runtime(2);
+  rt::TraceJob job{s, cam, kW, kH, {}};
+  const auto integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kW, kH, rt::IntegratorOptions{}, smallSettings());
+  job.integrator = integrator;
+  job.options.tileSizePx = 8;
+  rt::renderRays(job, "image-space", runtime);
+  const double replicated = double(integrator->maps().global.bytes() + integrator->maps().caustic.bytes() +
+                                   integrator->precomputedIrradiance().bytes() + integrator->cache().bytes());
+  const double records = counter(runtime, "IrradianceCache/records");
+  const double got = broadcastPerPe(runtime);
+  CHECK(got >= scene + replicated);
+  CHECK(got < scene + replicated + 256.0 * records);
 }

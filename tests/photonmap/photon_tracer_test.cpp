@@ -21,6 +21,7 @@
 #include "common/scene/camera_select.h"
 #include "raytrace/core/bvh.h"
 #include "raytrace/integrators/integrator_scenes.h"
+#include "run_record_support.h"
 #include "test_support.h"
 
 using namespace pr;
@@ -50,6 +51,13 @@ scene::Scene litFloor(float h, float height) {
   light.intensity = 1.0f;
   s.lights.push_back(light);
   return s;
+}
+
+// The irradiance litFloor(h, 1)'s light gives the floor at x: I cos / d^2 with I = 1.
+double pointLightIrradiance(const glm::vec3& x) {
+  const glm::vec3 toLight = glm::vec3(0, 1, 0) - x;
+  const float d = glm::length(toLight);
+  return double(toLight.y / d) / double(d * d);
 }
 
 scene::Scene cornell() { return scene::loadGltf(test::sourceDir() / "scenes" / "cornell.gltf"); }
@@ -135,13 +143,10 @@ TEST_CASE("PhotonTracer: global-map irradiance under a point light is I cos / d^
   double meanError = 0.0;
   const glm::vec3 points[] = {{0, 0, 0}, {0.3f, 0, 0}, {0, 0, -0.5f}, {0.6f, 0, 0.4f}, {-0.8f, 0, -0.8f}};
   for (const glm::vec3& x : points) {
-    const glm::vec3 toLight = glm::vec3(0, 1, 0) - x;
-    const float d = glm::length(toLight);
-    const double analytic = double(toLight.y / d) / double(d * d);
     const pm::DensityEstimate e = pm::estimateIrradiance(map, x, glm::vec3(0, 1, 0), density);
-    const double error = double(e.irradiance.x) / analytic - 1.0;
+    const double error = double(e.irradiance.x) / pointLightIrradiance(x) - 1.0;
     meanError += error / double(std::size(points));
-    MESSAGE("x = (" << x.x << ", " << x.z << "): E = " << e.irradiance.x << ", analytic " << analytic << ", error "
+    MESSAGE("x = (" << x.x << ", " << x.z << "): E = " << e.irradiance.x << ", analytic " << pointLightIrradiance(x) << ", error "
                     << error << ", r = " << std::sqrt(e.radiusSq));
     CHECK(std::fabs(error) <= 0.05);
   }
@@ -171,10 +176,8 @@ TEST_CASE("PhotonTracer: the point light's irradiance is within a tolerance that
     const double bound = 1.2 / std::sqrt(double(density.k)) + 0.01;
     double worst = 0.0;
     for (const glm::vec3 x : {glm::vec3(0, 0, 0), glm::vec3(0.3f, 0, 0), glm::vec3(0, 0, -0.5f), glm::vec3(0.6f, 0, 0.4f)}) {
-      const glm::vec3 toLight = glm::vec3(0, 1, 0) - x;
-      const float d = glm::length(toLight);
-      const double analytic = double(toLight.y / d) / double(d * d);
-      const double error = double(pm::estimateIrradiance(map, x, glm::vec3(0, 1, 0), density).irradiance.x) / analytic - 1.0;
+      const double error =
+          double(pm::estimateIrradiance(map, x, glm::vec3(0, 1, 0), density).irradiance.x) / pointLightIrradiance(x) - 1.0;
       worst = std::max(worst, std::fabs(error));
     }
     MESSAGE(count << " photons, k = " << density.k << ": worst relative error " << worst << " (bound " << bound << ")");
@@ -280,13 +283,7 @@ TEST_CASE("PhotonTracer: the maps are the same photons in the same order for eve
     CHECK(sameBytes(lists.global, reference.global));
     CHECK(sameBytes(lists.caustic, reference.caustic));
     // The run record's per-PE counters add up to the maps' figures.
-    auto total = [&](const char* name) {
-      double sum = 0.0;
-      for (const par::CounterRecord& c : runtime.record().counters)
-        if (c.name == name)
-          for (double v : c.perPe) sum += v;
-      return sum;
-    };
+    auto total = [&](const char* name) { return test::counterTotal(runtime.record(), name); };
     CHECK(total("Photons/global_emitted") == double(lists.stats.globalEmitted));
     CHECK(total("Photons/caustic_emitted") == double(lists.stats.causticEmitted));
     CHECK(total("Photons/global_stored") == double(lists.global.size()));

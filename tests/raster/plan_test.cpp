@@ -16,6 +16,7 @@
 #include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
 #include "raster/sort/sort_point.h"
+#include "run_record_support.h"
 #include "test_support.h"
 
 namespace pr::raster {
@@ -36,14 +37,6 @@ std::vector<glm::vec3> sequential(const scene::Scene& s, const scene::Camera& ca
   return toImage(fb).pixels;
 }
 
-double counter(const par::Runtime& rt, const std::string& name) {
-  double sum = 0.0;
-  for (const par::CounterRecord& c : rt.record().counters)
-    if (c.name == name)
-      for (double v : c.perPe) sum += v;
-  return sum;
-}
-
 // Every sort point at P = 3 with `effects` gives `expected`, and books `counterName` > 0.
 void checkSortPoints(const scene::Scene& s, const scene::Camera& cam, scene::EffectSet effects,
                      const std::vector<glm::vec3>& expected, const std::string& counterName) {
@@ -55,7 +48,7 @@ void checkSortPoints(const scene::Scene& s, const scene::Camera& cam, scene::Eff
     std::unique_ptr<SortPoint> sp = makeSortPoint(method);
     const RegionFramebuffer fb = renderFrame(*sp, s, makeFrameView(cam, kW, kH), options, rt);
     CHECK(toImage(fb).pixels == expected);
-    CHECK(counter(rt, counterName) > 0);
+    CHECK(test::counterTotal(rt.record(), counterName) > 0);
   }
 }
 

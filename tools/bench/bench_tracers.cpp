@@ -28,7 +28,7 @@ namespace {
 
 using namespace pr;
 
-double seconds(std::chrono::steady_clock::time_point since) {
+[[maybe_unused]] double seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
 

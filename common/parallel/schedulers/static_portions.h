@@ -17,7 +17,7 @@ class StaticPortionScheduler : public Scheduler {
   StaticPortionScheduler(std::string_view name, Split split) : name_(name), split_(std::move(split)) {}
   std::string_view name() const override { return name_; }
 
-  void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
+  void reset(const TaskSet& tasks, int pes, const ScheduleParams&) override {
     portions_ = split_(tasks, pes);
     sent_.assign(pes, 0);
   }

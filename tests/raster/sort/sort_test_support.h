@@ -11,6 +11,7 @@
 #include "raster/raster_test_scenes.h"
 #include "raster/sort/region_assignment.h"
 #include "raster/stages/geometry.h"
+#include "run_record_support.h"
 
 namespace pr::test {
 
@@ -83,18 +84,6 @@ inline ChannelSum channelTraffic(const par::RunRecord& record, const std::string
       sum.messages += c.messages;
       sum.bytes += c.bytes;
     }
-  }
-  return sum;
-}
-
-// The named per-PE counter of the run record, summed over PEs (pe < 0) or of one PE; 0 when
-// it was never recorded.
-inline double counterTotal(const par::RunRecord& record, const std::string& name, int pe = -1) {
-  double sum = 0.0;
-  for (const par::CounterRecord& c : record.counters) {
-    if (c.name != name) continue;
-    for (size_t p = 0; p < c.perPe.size(); ++p)
-      if (pe < 0 || int(p) == pe) sum += c.perPe[p];
   }
   return sum;
 }
