@@ -64,6 +64,8 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
       : IntegratorBase(scene, camera, width, height, options), maxDepth_(maxDepth), textures_(textures), perPe_(std::size_t(pes)) {}
 
   std::string_view name() const override { return "irradiance-cache probes"; }
+  // A probe that leaves the scene finds no surface; it adds nothing (one-pixel film).
+  void miss(const RayMessage&, rt::Emit&) const override {}
   // The render's camera rays (sample 0 of one per pixel), counted as the pre-pass's own rays
   // (continuations), not as the render's camera rays.
   void cameraRays(const rt::PixelRect& rect, int, std::vector<RayMessage>& out) const override {
@@ -122,6 +124,9 @@ class GatherProgram final : public rt::IntegratorBase<GatherProgram> {
         perPe_(std::size_t(pes)) {}
 
   std::string_view name() const override { return "irradiance-cache gather"; }
+  // A gather ray that leaves the scene sees the environment, which is direct light at the
+  // record (sampled there by the render): its cell stays dark, its distance infinite.
+  void miss(const RayMessage&, rt::Emit&) const override {}
 
   void cameraRays(const rt::PixelRect& rect, int, std::vector<RayMessage>& out) const override {
     for (int y = rect.y0; y < rect.y1; ++y)

@@ -75,6 +75,12 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
   // irradiance cache (irradiance_cache_pass.h), which broadcasts its records level by level.
   void prePass(rt::PrePassTracer& tracer, par::Runtime& rt) const override;
   void shade(const rt::SurfaceInteraction& si, const rt::RayMessage& msg, rt::Emit& out) const override;
+  // Eye paths see the environment; gathering and glossy rays do not (light sampling at their
+  // origin counted it as direct light).
+  void miss(const rt::RayMessage& msg, rt::Emit& out) const override {
+    if (msg.kind == rt::RayKind::Gather || (msg.kind == rt::RayKind::Continuation && msg.bsdfPdf > 0.0f)) return;
+    Integrator::miss(msg, out);
+  }
 
   const PhotonMapSettings& settings() const { return settings_; }
   // What the pre-pass built (valid after prePass).

@@ -46,6 +46,8 @@ class PhotonProgram final : public rt::IntegratorBase<PhotonProgram> {
         perPe_(std::size_t(pes)) {}
 
   std::string_view name() const override { return "photon-pass"; }
+  // A photon that leaves the scene is lost; it adds nothing (the program's film is one pixel).
+  void miss(const rt::RayMessage&, rt::Emit&) const override {}
 
   void cameraRays(const rt::PixelRect& rect, int, std::vector<rt::RayMessage>& out) const override {
     for (int y = rect.y0; y < rect.y1; ++y)

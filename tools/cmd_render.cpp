@@ -21,6 +21,7 @@
 #include "common/scene/gltf_loader.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
+#include "tools/lighting.h"
 #include "tools/render_methods.h"
 
 namespace pr::cli {
@@ -40,6 +41,7 @@ struct RenderArgs {
   par::RunOutputOptions outputs;
   RenderSettings settings;
   FamilyOptions family;
+  LightingOptions lighting;
 };
 
 // A progress bar on stderr: appears once a render has run for a second, redrawn when the
@@ -94,7 +96,8 @@ void run(RenderArgs& a) {
   if (ext != ".png" && ext != ".exr")
     throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
 
-  const scene::Scene scene = scene::loadGltf(a.scene);
+  scene::Scene scene = scene::loadGltf(a.scene);
+  const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
 
@@ -112,6 +115,7 @@ void run(RenderArgs& a) {
   const double wall = summary.wallSeconds;
   std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
               a.threads, a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+  std::printf("%s\n", lighting.c_str());
   std::printf("effects:\n");
   for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());
   if (!outcome.effects.empty()) std::printf("%s\n", outcome.effects.c_str());
@@ -157,6 +161,7 @@ void addRenderCommand(CLI::App& app) {
                       " (ray tracers skip the work of effects that are off; rasterization reports the plan only)");
   par::addScheduleOptions(*cmd, args->schedule);
   par::addRunOutputOptions(*cmd, args->outputs);
+  addLightingOptions(*cmd, args->lighting);
   addRayOptions(*cmd, args->settings, args->family);
   addRasterOptions(*cmd, args->settings, args->family);
   cmd->callback([args] { run(*args); });

@@ -31,6 +31,7 @@
 #include "raytrace/integrators/sampling.h"
 #include "tools/commands.h"
 #include "tools/integrators.h"
+#include "tools/lighting.h"
 #include "tools/render_methods.h"
 #include "tools/sweep/image_error.h"
 #include "tools/sweep/reference_cache.h"
@@ -68,6 +69,7 @@ struct SweepArgs {
   std::string csv, json, images, effects;
   pm::PhotonMapSettings photonmap;
   par::ScheduleOptions schedule;
+  LightingOptions lighting;
 };
 
 struct Timed {
@@ -177,7 +179,8 @@ void run(SweepArgs& a) {
   if (a.vary != "spp" && !photonmap)
     throw InputError("--vary " + a.vary + " varies a photon-map setting; add photonmap to --integrator or vary spp");
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
-  const scene::Scene scene = scene::loadGltf(a.scene);
+  scene::Scene scene = scene::loadGltf(a.scene);
+  std::fprintf(stderr, "%s\n", applyLighting(scene, a.lighting).c_str());
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
   if (a.values.empty()) a.values = defaultValues(a.vary, scene);
@@ -199,7 +202,9 @@ void run(SweepArgs& a) {
                         {"sceneBytes", std::filesystem::file_size(a.scene)},
                         {"sceneTime", std::filesystem::last_write_time(a.scene).time_since_epoch().count()},
                         {"camera", a.camera}, {"width", a.width}, {"height", a.height}, {"spp", a.referenceSpp},
-                        {"maxDepth", a.referenceDepth}, {"seed", a.seed ^ kReferenceSeedOffset}, {"effects", a.effects}};
+                        {"maxDepth", a.referenceDepth}, {"seed", a.seed ^ kReferenceSeedOffset}, {"effects", a.effects},
+                        {"env", a.lighting.env}, {"envStrength", a.lighting.strength},
+                        {"envRotate", a.lighting.rotateDegrees}, {"noDefaultLight", a.lighting.noDefault}};
   const ReferenceCache cache(a.referenceDir.empty() ? ReferenceCache::defaultDir() : std::filesystem::path(a.referenceDir));
   std::optional<image::Image> cached = a.noCache ? std::nullopt : cache.find(key);
   image::Image reference;
@@ -367,6 +372,7 @@ void addSweepCommand(CLI::App& app) {
   cmd->add_option("--k", p.globalK, "photonmap: photons per global-map estimate")->check(CLI::Range(1, 10000))->capture_default_str();
   cmd->add_option("--radius", p.globalRadius, "photonmap: global-map radius (0 = automatic)")->check(CLI::NonNegativeNumber)->capture_default_str();
   par::addScheduleOptions(*cmd, a->schedule);
+  addLightingOptions(*cmd, a->lighting);
   cmd->callback([a, pathSpp] {
     a->pathSppGiven = pathSpp->count() > 0;
     run(*a);

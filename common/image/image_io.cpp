@@ -99,7 +99,8 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
 }
 
 Image readImage(const fs::path& path) {
-  const Format format = formatOf(path);
+  // Radiance HDR (environment maps) reads as linear radiance, like EXR.
+  const Format format = lowerExtension(path) == ".hdr" ? Format::Exr : formatOf(path);
   if (!fs::is_regular_file(path)) throw InputError("image file '" + path.string() + "' does not exist");
 
   auto in = OIIO::ImageInput::open(path.string());

@@ -288,12 +288,15 @@ RenderPlan analyzeEffects(const Scene& scene, const Camera* camera) {
         scene.materials[scene.triangles[a.triangle].material].isEmissive())
       ++areaTriangles;
   const bool emission = has([](const MaterialUse& u) { return u.traits.emissive; });
-  const bool light = punctual > 0 || areaTriangles > 0;
-  const std::string lights = punctual == 0      ? plural(areaTriangles, "emissive triangle")
-                             : areaTriangles == 0 ? plural(punctual, "punctual light")
-                                                  : plural(punctual, "punctual light") + " and " +
-                                                        plural(areaTriangles, "emissive triangle");
-  const std::string noLight = "no light: no punctual lights and no emissive triangles";
+  const bool environment = scene.environment && scene.environment->meanLuminance() > 0.0f;
+  const bool light = punctual > 0 || areaTriangles > 0 || environment;
+  std::string lights = punctual == 0 && areaTriangles == 0 ? std::string()
+                       : punctual == 0                     ? plural(areaTriangles, "emissive triangle")
+                       : areaTriangles == 0                ? plural(punctual, "punctual light")
+                                                           : plural(punctual, "punctual light") + " and " +
+                                                                 plural(areaTriangles, "emissive triangle");
+  if (environment) lights += (lights.empty() ? "" : " and ") + std::string("the environment (") + scene.environment->description() + ")";
+  const std::string noLight = "no light: no punctual lights, no emissive triangles and no environment";
 
   const bool dielectric = has([](const MaterialUse& u) { return u.traits.dielectric; });
   const bool ideal = has([](const MaterialUse& u) { return u.traits.ideal; });

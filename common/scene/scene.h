@@ -7,11 +7,13 @@
 #include <filesystem>
 #include <limits>
 #include <string>
+#include <memory>
 #include <vector>
 
 #include <glm/glm.hpp>
 
 #include "common/scene/camera.h"
+#include "common/scene/environment.h"
 #include "common/scene/light.h"
 #include "common/scene/material.h"
 #include "common/scene/texture.h"
@@ -64,6 +66,9 @@ struct Scene {
   std::vector<Material> materials;  // always at least one: the glTF default material is last
   std::vector<Texture> textures;
   std::vector<PunctualLight> lights;
+  // Light from infinitely far away (--env, or the default light of a scene without lights);
+  // none when null. Shared read-only.
+  std::shared_ptr<const Environment> environment;
   std::vector<AreaLight> areaLights;  // emissive triangles
   std::vector<Camera> cameras;        // the file's cameras in node order; may be empty
 

@@ -56,7 +56,8 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
   if (!(opaqueWeight > 0.0f)) return;
   const bool area = lights_.hasAreaLights();
   if (!simulates(scene::Effect::DirectLight)) {
-    out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? uint64_t(std::max(1, areaSamples)) : 0u);
+    out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? uint64_t(std::max(1, areaSamples)) : 0u) +
+                                       (scene_->environment ? 1u : 0u);
     return;
   }
   const bool shadows = simulates(scene::Effect::Shadows);
@@ -93,6 +94,19 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
   LightSample ls;
   for (const scene::PunctualLight& light : scene_->lights)
     if (lights_.samplePunctual(light, si, ls)) addSample(ls, 1.0f);
+  // The environment: one sample by its own distribution; the shadow ray runs to infinity.
+  if (const scene::Environment* env = scene_->environment.get()) {
+    float pdf = 0.0f;
+    const glm::vec3 dir = env->sample(sample(msg, Dim::kEnvU), sample(msg, Dim::kEnvV), pdf);
+    if (pdf > 0.0f && std::isfinite(pdf)) {
+      LightSample es;
+      es.wi = dir;
+      es.pdf = pdf;
+      es.radiance = env->radiance(dir) / pdf;
+      es.shadowRay = spawnRay(si, dir);
+      addSample(es, 1.0f);
+    }
+  }
   if (!area) return;
   const int n = std::max(1, areaSamples);
   if (!simulates(scene::Effect::Emission)) {

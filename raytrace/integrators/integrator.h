@@ -195,9 +195,15 @@ class Integrator {
   // A camera or continuation ray hit si (made by makeInteraction from msg.ray's closest hit).
   virtual void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const = 0;
   // A ray found nothing: a shadow ray adds its contribution (unoccluded); any other ray sees
-  // the black background.
-  void miss(const RayMessage& msg, Emit& out) const {
-    if (msg.kind == RayKind::Shadow) out.addRadiance(msg.pixel, msg.throughput);
+  // the scene's environment in full (black without one). An integrator that samples the
+  // environment where a BSDF sample could also reach it weighs this (the path tracer's MIS).
+  virtual void miss(const RayMessage& msg, Emit& out) const {
+    if (msg.kind == RayKind::Shadow) {
+      out.addRadiance(msg.pixel, msg.throughput);
+      return;
+    }
+    if (const scene::Environment* env = ctx_.scene().environment.get())
+      out.addRadiance(msg.pixel, msg.throughput * env->radiance(glm::normalize(msg.ray.direction)));
   }
   // The message loop of a PE that holds the whole world: traces every message in queue and
   // every message shading spawns until none is left, against bvh (over context().scene()).

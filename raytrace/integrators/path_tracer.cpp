@@ -102,4 +102,17 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
   out.push(ctx.continuation(si, msg, wi, throughput, pdf));
 }
 
+void PathIntegrator::miss(const RayMessage& msg, Emit& out) const {
+  const scene::Environment* env = context().scene().environment.get();
+  if (msg.kind == RayKind::Shadow || !env || msg.kind != RayKind::Continuation || !(msg.bsdfPdf > 0.0f)) {
+    Integrator::miss(msg, out);
+    return;
+  }
+  if (!context().simulates(scene::Effect::DirectLight)) return Integrator::miss(msg, out);  // no light sample to weigh against
+  const glm::vec3 dir = glm::normalize(msg.ray.direction);
+  const float pl = env->pdf(dir);
+  const float weight = msg.bsdfPdf * msg.bsdfPdf / (msg.bsdfPdf * msg.bsdfPdf + pl * pl);
+  out.addRadiance(msg.pixel, msg.throughput * env->radiance(dir) * weight);
+}
+
 }  // namespace pr::rt

@@ -13,6 +13,8 @@ class PathIntegrator final : public IntegratorBase<PathIntegrator> {
   using IntegratorBase::IntegratorBase;
   std::string_view name() const override { return "path"; }
   void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
+  // The environment seen by a BSDF-sampled ray, weighted against its light sample (MIS).
+  void miss(const RayMessage& msg, Emit& out) const override;
   // Every effect but anisotropy: the BSDF (bsdf.h) is isotropic.
   scene::EffectSet simulated() const override {
     scene::EffectSet s = scene::EffectSet::all();

@@ -31,6 +31,7 @@ inline constexpr uint32_t kPixelX = 0, kPixelY = 1;
 inline constexpr uint32_t kLightPick = 2, kLightU = 3, kLightV = 4;
 inline constexpr uint32_t kLobe = 5, kBsdfU = 6, kBsdfV = 7;
 inline constexpr uint32_t kRoulette = 8;
+inline constexpr uint32_t kEnvU = 9, kEnvV = 10;  // the environment light's sample
 // Further area-light samples at one vertex (IntegratorContext::directLight), three each.
 inline constexpr uint32_t kLightExtra = 16;
 // First dimension free for an integrator's own draws (photonmap: gather and glossy rays),

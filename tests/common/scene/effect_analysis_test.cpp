@@ -105,7 +105,7 @@ TEST_CASE("EffectAnalysis: without lights nothing transports light; without emit
   for (Effect e : {Effect::DirectLight, Effect::IndirectDiffuse, Effect::Caustics}) {
     CAPTURE(plan.line(e));
     CHECK_FALSE(plan.on(e));
-    CHECK(plan[e].reason.find("no light: no punctual lights and no emissive triangles") != std::string::npos);
+    CHECK(plan[e].reason.find("no light: no punctual lights, no emissive triangles and no environment") != std::string::npos);
   }
   CHECK_FALSE(plan.on(Effect::Shadows));
   CHECK(plan[Effect::Shadows].reason.find("no direct light") != std::string::npos);

@@ -1,0 +1,65 @@
+// The lighting options (tools/lighting.h) run as a user would: a model without lights renders
+// lit in every ray tracer under the default environment, and the summary says so;
+// --no-default-light leaves it black but for nothing; --env FILE lights it from an image;
+// a missing environment file exits 2.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <string>
+
+#include "common/image/image_io.h"
+#include "test_support.h"
+
+using pr::test::join;
+using pr::test::runParrender;
+
+namespace {
+
+double meanOf(const std::filesystem::path& exr) {
+  const pr::image::Image img = pr::image::readImage(exr);
+  double sum = 0.0;
+  for (const glm::vec3& p : img.pixels) sum += p.x + p.y + p.z;
+  return sum / (3.0 * double(img.pixels.size()));
+}
+
+std::string duck() { return pr::test::quoted(pr::test::sharedScenes() / "Duck" / "glTF-Binary" / "Duck.glb"); }
+
+}  // namespace
+
+TEST_CASE("Lighting: a model without lights is lit by the default environment in every ray tracer") {
+  if (!pr::test::haveSharedScenes()) return;
+  const std::filesystem::path dir = pr::test::scratchDir("lighting");
+  for (const char* method : {"sequential", "image-space", "object-space", "object"}) {
+    CAPTURE(method);
+    const auto r = runParrender(join({"render ", duck(), " -m ", method, " --threads 2 --width 24 --height 24 --spp 2 -o \"",
+                                      (dir / (std::string(method) + ".exr")).string(), "\""}));
+    INFO(r.output);
+    REQUIRE(r.exitStatus == 0);
+    CHECK(r.output.find("lighting: the default, a uniform white environment") != std::string::npos);
+    CHECK(meanOf(dir / (std::string(method) + ".exr")) > 0.3);
+  }
+  const auto dark = runParrender(join({"render ", duck(), " --no-default-light --width 24 --height 24 --spp 2 -o \"",
+                                       (dir / "dark.exr").string(), "\""}));
+  INFO(dark.output);
+  REQUIRE(dark.exitStatus == 0);
+  CHECK(dark.output.find("lighting: none") != std::string::npos);
+  CHECK(meanOf(dir / "dark.exr") == 0.0);
+}
+
+TEST_CASE("Lighting: --env lights a scene from an equirectangular image; a missing file exits 2") {
+  const std::filesystem::path dir = pr::test::scratchDir("lighting_env");
+  pr::image::Image sky(16, 8, glm::vec3(0.5f));
+  pr::image::writeImage(dir / "sky.exr", sky);
+  const std::string cornell = pr::test::quoted(pr::test::sourceDir() / "scenes" / "cornell-diffuse.gltf");
+  const auto plain = runParrender(join({"render ", cornell, " --width 24 --height 24 --spp 2 -o \"", (dir / "plain.exr").string(), "\""}));
+  const auto lit = runParrender(join({"render ", cornell, " --env \"", (dir / "sky.exr").string(),
+                                      "\" --env-strength 4 --width 24 --height 24 --spp 2 -o \"", (dir / "lit.exr").string(), "\""}));
+  INFO(lit.output);
+  REQUIRE(plain.exitStatus == 0);
+  REQUIRE(lit.exitStatus == 0);
+  CHECK(lit.output.find("lighting: the scene's lights and the environment") != std::string::npos);
+  CHECK(meanOf(dir / "lit.exr") > meanOf(dir / "plain.exr"));
+  const auto missing = runParrender(join({"render ", cornell, " --env /nonexistent/sky.exr -o \"", (dir / "x.png").string(), "\""}));
+  CHECK(missing.exitStatus == 2);
+  CHECK(missing.output.find("--env") != std::string::npos);
+}

@@ -1,0 +1,36 @@
+// Lighting options (see lighting.h).
+#include "tools/lighting.h"
+
+#include <cmath>
+#include <memory>
+
+#include "common/image/image_io.h"
+
+namespace pr::cli {
+
+void addLightingOptions(CLI::App& command, LightingOptions& o) {
+  command.add_option("--env", o.env, "environment light: an equirectangular .exr or .hdr image (ray tracers)")->check(CLI::ExistingFile);
+  command.add_option("--env-strength", o.strength, "environment radiance scale")->check(CLI::NonNegativeNumber)->capture_default_str();
+  command.add_option("--env-rotate", o.rotateDegrees, "environment rotation about +y in degrees")
+      ->check(CLI::Range(-360.0f, 360.0f))->capture_default_str();
+  command.add_flag("--no-default-light", o.noDefault,
+                   "a scene without lights gets no default light (otherwise: a uniform white environment in the ray tracers)");
+}
+
+std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
+  constexpr float kDegrees = 3.14159265358979323846f / 180.0f;
+  if (!o.env.empty()) {
+    const image::Image image = image::readImage(o.env);
+    scene.environment = std::make_shared<const scene::Environment>(scene::Environment::fromImage(
+        image, o.strength, o.rotateDegrees * kDegrees, o.env));
+    return "lighting: the scene's lights and the environment " + o.env;
+  }
+  const bool lit = !scene.lights.empty() || !scene.areaLights.empty();
+  if (lit) return "lighting: the scene's own lights";
+  if (o.noDefault) return "lighting: none (the scene has no lights; --no-default-light)";
+  scene.environment = std::make_shared<const scene::Environment>(scene::Environment::uniform(
+      glm::vec3(o.strength), "uniform white, the default: the scene has no lights"));
+  return "lighting: the default, a uniform white environment (the scene has no lights; the rasterizer uses its headlight)";
+}
+
+}  // namespace pr::cli
