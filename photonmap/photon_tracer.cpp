@@ -26,7 +26,7 @@ using rt::kPi;
 // k + 1 the k-th surface interaction (rt::Dim numbers are reused there).
 constexpr std::uint32_t kGlobalStream = 0, kCausticStream = 1;
 namespace EmitDim {
-constexpr std::uint32_t kPick = 0, kPosU = 1, kPosV = 2, kDirU = 3, kDirV = 4, kTarget = 5;
+constexpr std::uint32_t kPick = 0, kPosU = 1, kPosV = 2, kDirU = 3, kDirV = 4, kTarget = 5, kEnvU = 6, kEnvV = 7;
 }
 
 // int over the sphere of spotFactor: the factor t^2 with t = (c - cosOuter) s, s the scale
@@ -107,8 +107,11 @@ std::vector<Target> specularTargets(const scene::Scene& scene) {
 // ---- emitters -------------------------------------------------------------------------------
 // One entry per punctual light, and one for all emissive triangles together (sampled by power,
 // as LightSampler does). power: luminance of the emitted flux, used to split the photons.
+// Emitter::light of the environment (Scene::environment).
+constexpr int kEnvironmentEmitter = -2;
+
 struct Emitter {
-  int light = -1;  // index into Scene::lights, -1 = the area lights
+  int light = -1;  // index into Scene::lights, -1 = the area lights, kEnvironmentEmitter
   double power = 0.0;
 };
 
@@ -198,6 +201,46 @@ glm::vec2 stratified(std::size_t j, std::size_t n, float u, float v) {
           std::min((float(cell / m) + v) / float(m), rt::kOneMinusEpsilon)};
 }
 
+// The origin of a photon travelling along dir from far away (a directional light, the
+// environment): a point on the disc of the scene's bounding sphere perpendicular to dir,
+// upstream of the scene - or, for a caustic photon, on the discs the specular targets project
+// onto that plane, one picked by area - and the area the photon stands for (the disc's, or the
+// targets' total over how many of them cover the point). False without a target to aim at.
+bool parallelOrigin(const Setup& s, const glm::vec3& dir, bool caustic, glm::vec2 dirUv, float pick, glm::vec3& origin,
+                    float& area) {
+  const rt::Frame f(dir);
+  const glm::vec3 plane = s.sceneCentre - dir * (s.sceneRadius * 1.01f);
+  if (!caustic) {
+    const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * s.sceneRadius;
+    origin = plane + f.toWorld({d.x, d.y, 0.0f});
+    area = kPi * s.sceneRadius * s.sceneRadius;
+    return true;
+  }
+  float total = 0.0f;
+  for (const Target& t : s.targets) total += kPi * t.radius * t.radius;
+  if (!(total > 0.0f)) return false;
+  std::size_t chosen = s.targets.size() - 1;
+  float running = 0.0f;
+  for (std::size_t i = 0; i < s.targets.size(); ++i) {
+    running += kPi * s.targets[i].radius * s.targets[i].radius;
+    if (pick * total < running) {
+      chosen = i;
+      break;
+    }
+  }
+  const Target& t = s.targets[chosen];
+  const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * t.radius;
+  const glm::vec3 c = f.toLocal(t.centre - plane);
+  origin = plane + f.toWorld({c.x + d.x, c.y + d.y, 0.0f});
+  int inside = 0;
+  for (const Target& o : s.targets) {
+    const glm::vec3 q = f.toLocal(o.centre - origin);
+    if (q.x * q.x + q.y * q.y <= o.radius * o.radius * 1.000001f) ++inside;
+  }
+  area = total / float(std::max(inside, 1));
+  return true;
+}
+
 // Photon `index` (global within its map) of emitter e, which owns n photons from `first` on.
 bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhoton& out) {
   const std::uint64_t seed = s.options->seed;
@@ -208,6 +251,20 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
   const bool caustic = map == kCausticStream;
   const Emitter& em = s.emitters[e];
   const scene::Scene& scene = *s.scene;
+  if (em.light == kEnvironmentEmitter) {
+    // From the environment: a direction by its own distribution (where the light comes
+    // from), then as a directional light along the opposite: power L(w) area / (pdf(w) N).
+    float pdf = 0.0f;
+    const glm::vec3 towards = scene.environment->sample(sample(EmitDim::kEnvU), sample(EmitDim::kEnvV), pdf);
+    if (!(pdf > 0.0f) || !std::isfinite(pdf)) return false;
+    glm::vec3 origin;
+    float area;
+    if (!parallelOrigin(s, -towards, caustic, dirUv, sample(EmitDim::kTarget), origin, area)) return false;
+    out.ray = rt::Ray{origin, 0.0f, -towards, rt::kInfinity};
+    out.power = scene.environment->radiance(towards) * (area / (pdf * float(n)));
+    out.range = 0.0f;
+    return rt::maxComponent(out.power) > 0.0f && rt::isFinite(out.power);
+  }
   if (em.light >= 0) {
     const scene::PunctualLight& light = scene.lights[std::size_t(em.light)];
     const glm::vec3 colour = light.color * light.intensity;
@@ -215,39 +272,9 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
     if (light.type == scene::LightType::Directional) {
       // A disc of the scene's bounding sphere, perpendicular to the light, upstream of it:
       // flux E pi R^2 (E in lux at normal incidence).
-      const rt::Frame f(light.direction);
-      const glm::vec3 plane = s.sceneCentre - light.direction * (s.sceneRadius * 1.01f);
       glm::vec3 origin;
       float area;
-      if (caustic) {
-        // Targets project to discs of their radius on the emission plane.
-        float total = 0.0f;
-        for (const Target& t : s.targets) total += kPi * t.radius * t.radius;
-        if (!(total > 0.0f)) return false;
-        std::size_t chosen = s.targets.size() - 1;
-        float running = 0.0f;
-        for (std::size_t i = 0; i < s.targets.size(); ++i) {
-          running += kPi * s.targets[i].radius * s.targets[i].radius;
-          if (sample(EmitDim::kTarget) * total < running) {
-            chosen = i;
-            break;
-          }
-        }
-        const Target& t = s.targets[chosen];
-        const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * t.radius;
-        const glm::vec3 c = f.toLocal(t.centre - plane);
-        origin = plane + f.toWorld({c.x + d.x, c.y + d.y, 0.0f});
-        int inside = 0;
-        for (const Target& o : s.targets) {
-          const glm::vec3 q = f.toLocal(o.centre - origin);
-          if (q.x * q.x + q.y * q.y <= o.radius * o.radius * 1.000001f) ++inside;
-        }
-        area = total / float(std::max(inside, 1));
-      } else {
-        const glm::vec2 d = concentricDisc(dirUv.x, dirUv.y) * s.sceneRadius;
-        origin = plane + f.toWorld({d.x, d.y, 0.0f});
-        area = kPi * s.sceneRadius * s.sceneRadius;
-      }
+      if (!parallelOrigin(s, light.direction, caustic, dirUv, sample(EmitDim::kTarget), origin, area)) return false;
       out.ray = rt::Ray{origin, 0.0f, light.direction, rt::kInfinity};
       out.power = colour * area / float(n);
       out.range = 0.0f;
@@ -439,6 +466,10 @@ void makeSetup(Setup& s, const scene::Scene& scene) {
     s.areaProb.push_back(float(triPower[i] / areaPower));
   }
   if (areaPower > 0.0) s.emitters.push_back({-1, areaPower});
+  // The environment's flux through the scene's disc from every direction: pi R^2 4 pi mean L.
+  if (scene.environment && scene.environment->meanLuminance() > 0.0f)
+    s.emitters.push_back({kEnvironmentEmitter, double(scene.environment->meanLuminance()) * 4.0 * double(kPi) *
+                                                   double(kPi) * double(s.sceneRadius) * double(s.sceneRadius)});
 
   // The caustic photons are split by the power each emitter sends towards the targets (the
   // projection map's solid angle fraction), so each carries about the same flux.
@@ -447,7 +478,8 @@ void makeSetup(Setup& s, const scene::Scene& scene) {
     power.push_back(e.power);
     double fraction = 0.0;
     if (!s.targets.empty()) {
-      if (e.light >= 0 && scene.lights[std::size_t(e.light)].type == scene::LightType::Directional) {
+      if (e.light == kEnvironmentEmitter ||
+          (e.light >= 0 && scene.lights[std::size_t(e.light)].type == scene::LightType::Directional)) {
         for (const Target& t : s.targets) fraction += double(t.radius * t.radius) / double(s.sceneRadius * s.sceneRadius);
       } else {
         const glm::vec3 p = e.light >= 0 ? scene.lights[std::size_t(e.light)].position : s.sceneCentre;

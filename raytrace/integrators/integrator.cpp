@@ -94,10 +94,19 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
   LightSample ls;
   for (const scene::PunctualLight& light : scene_->lights)
     if (lights_.samplePunctual(light, si, ls)) addSample(ls, 1.0f);
-  // The environment: one sample by its own distribution; the shadow ray runs to infinity.
+  // The environment: one sample by its own distribution, or - a uniform one, where no BSDF
+  // sample is weighed against it (no MIS) - cosine-distributed about the surface, which leaves
+  // an unoccluded diffuse point no variance at all. The shadow ray runs to infinity.
   if (const scene::Environment* env = scene_->environment.get()) {
     float pdf = 0.0f;
-    const glm::vec3 dir = env->sample(sample(msg, Dim::kEnvU), sample(msg, Dim::kEnvV), pdf);
+    glm::vec3 dir;
+    if (!mis && env->isUniform()) {
+      const glm::vec3 local = cosineHemisphere(sample(msg, Dim::kEnvU), sample(msg, Dim::kEnvV));
+      dir = Frame(ng).toWorld(local);
+      pdf = local.z * kInvPi;
+    } else {
+      dir = env->sample(sample(msg, Dim::kEnvU), sample(msg, Dim::kEnvV), pdf);
+    }
     if (pdf > 0.0f && std::isfinite(pdf)) {
       LightSample es;
       es.wi = dir;
