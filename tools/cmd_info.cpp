@@ -14,6 +14,7 @@
 #include "common/scene/gltf_loader.h"
 #include "common/scene/scene_stats.h"
 #include "tools/commands.h"
+#include "tools/lighting.h"
 
 namespace pr::cli {
 
@@ -23,6 +24,7 @@ struct InfoOptions {
   std::string scene;
   bool json = false;
   std::string camera;
+  LightingOptions lighting;  // as render applies them, so the plan is the render's
 };
 
 // Camera framing does not depend on an image here; a square image is assumed.
@@ -129,13 +131,17 @@ std::string toTable(const scene::SceneStats& s, const scene::Camera& camera, con
 
 void runInfo(const InfoOptions& options) {
   scene::Scene scene = scene::loadGltf(options.scene);
+  const std::string lighting = applyLighting(scene, options.lighting);
   scene::Camera camera = scene::selectCamera(scene, options.camera, kInfoAspect);
   scene::SceneStats stats = scene::computeStats(scene);
   const scene::RenderPlan plan = scene::analyzeEffects(scene, &camera);
   if (options.json) {
-    std::printf("%s\n", toJson(stats, camera, plan).dump(2).c_str());
+    nlohmann::json j = toJson(stats, camera, plan);
+    j["lighting"] = lighting.substr(lighting.find(':') + 2);
+    std::printf("%s\n", j.dump(2).c_str());
   } else {
     std::printf("%s", toTable(stats, camera, plan).c_str());
+    std::printf("%s\n", lighting.c_str());
   }
 }
 
@@ -156,6 +162,7 @@ void addInfoCommand(CLI::App& app) {
   cmd->add_option("--camera", options->camera,
                   "camera to report: an index or a name from the file, or \"auto\" for the framing camera "
                   "(default: the file's first camera, else auto)");
+  addLightingOptions(*cmd, options->lighting);
   cmd->callback([options] { runInfo(*options); });
 }
 

@@ -1,4 +1,4 @@
-// The lighting options of the commands that render (render, sweep): --env FILE.exr|.hdr
+// The lighting options of the commands that render or plan a render (render, sweep, info): --env FILE.exr|.hdr
 // (an equirectangular environment, --env-strength, --env-rotate degrees about +y) and the
 // default light of a scene without lights - a uniform white environment, unless
 // --no-default-light - so that a model downloaded without lights does not render black in the

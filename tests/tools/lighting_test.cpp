@@ -1,5 +1,5 @@
 // The lighting options (tools/lighting.h) run as a user would: a model without lights renders
-// lit in every ray tracer under the default environment, and the summary says so;
+// lit in every ray tracer under the default environment, and the summary and info say so;
 // --no-default-light leaves it black but for nothing; --env FILE lights it from an image;
 // a missing environment file exits 2.
 #include <doctest/doctest.h>
@@ -44,6 +44,13 @@ TEST_CASE("Lighting: a model without lights is lit by the default environment in
   REQUIRE(dark.exitStatus == 0);
   CHECK(dark.output.find("lighting: none") != std::string::npos);
   CHECK(meanOf(dir / "dark.exr") == 0.0);
+  // info applies the same lighting, so its plan is the render's.
+  const auto info = runParrender(join({"info ", duck()}));
+  CHECK(info.exitStatus == 0);
+  CHECK(info.output.find("lighting: the default") != std::string::npos);
+  CHECK(info.output.find("direct: on - the environment") != std::string::npos);
+  const auto unlit = runParrender(join({"info ", duck(), " --no-default-light"}));
+  CHECK(unlit.output.find("direct: off - no light") != std::string::npos);
 }
 
 TEST_CASE("Lighting: --env lights a scene from an equirectangular image; a missing file exits 2") {
