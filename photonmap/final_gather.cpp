@@ -35,7 +35,11 @@ void cellAngles(GatherStrata strata, std::uint32_t id, std::uint32_t j, std::uin
 glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
                             const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
                             NearestPhotons& scratch) {
-  const rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures);
+  return globalMapRadiance(rt::evalMaterial(scene, si, textures), global, precomputed, si, density, scratch);
+}
+
+glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, const PrecomputedIrradiance* precomputed,
+                            const rt::SurfaceInteraction& si, const DensityOptions& density, NearestPhotons& scratch) {
   const glm::vec3 diffuse = (1.0f - m.dielectricWeight()) * m.diffuseColor();
   if (!(rt::maxComponent(diffuse) > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
@@ -67,38 +71,40 @@ GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& glo
                                     const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
                                     const GatherOptions& options, NearestPhotons& scratch) {
   GatherInteraction out;
-  out.radiance = throughput * globalMapRadiance(scene, global, options.precomputed, si, options.global, options.textures, scratch);
-  if (bounce >= options.specularBounces) return out;
-  // On through an ideal mirror or glass: a dielectric's reflection or refraction chosen by its
-  // Fresnel term (which cancels the choice's weight), an opaque mirror's reflection (its
-  // selection probability 1 - dielectric cancels its weight).
   const rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
+  out.radiance = throughput * globalMapRadiance(m, global, options.precomputed, si, options.global, scratch);
+  if (bounce >= options.specularBounces) return out;
   const rt::ShadingFrame sf(si);
-  const float dielectric = m.dielectricWeight();
   const float u = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kBranchDim);
-  glm::vec3 wi;
-  out.throughput = throughput;
+  glm::vec3 wi, factor;
+  if (!idealSpecularBounce(m, si, sf, u, wi, factor)) return out;
+  out.throughput = throughput * factor;
+  if (!(rt::maxComponent(out.throughput) > 0.0f)) return out;
+  out.continues = true;
+  out.next = rt::spawnRay(si, wi);
+  return out;
+}
+
+bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf,
+                         float u, glm::vec3& wi, glm::vec3& factor) {
+  const float dielectric = m.dielectricWeight();
   if (u < dielectric) {
     const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
     const float cosI = glm::dot(sf.ns, si.wo);
     glm::vec3 wt;
     if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
       wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
+      factor = glm::vec3(1.0f);
     } else {
       wi = wt;
-      out.throughput *= m.baseColor;
+      factor = m.baseColor;
     }
-  } else if (m.hasSpecular() && m.deltaSpecular()) {
-    out.throughput *= rt::fresnelSchlick(m.specularF0(), sf.woLocal.z);
-    wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-    if (glm::dot(wi, sf.ng) <= 0.0f) return out;
-  } else {
-    return out;
+    return true;
   }
-  if (!(rt::maxComponent(out.throughput) > 0.0f)) return out;
-  out.continues = true;
-  out.next = rt::spawnRay(si, wi);
-  return out;
+  if (!m.hasSpecular() || !m.deltaSpecular()) return false;
+  wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
+  factor = rt::fresnelSchlick(m.specularF0(), sf.woLocal.z);
+  return glm::dot(wi, sf.ng) > 0.0f;
 }
 
 IrradianceRecord combineGather(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata,

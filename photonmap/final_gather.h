@@ -44,6 +44,17 @@ struct GatherOptions {
 glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
                             const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
                             NearestPhotons& scratch);
+// The same with the material at si already evaluated.
+glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, const PrecomputedIrradiance* precomputed,
+                            const rt::SurfaceInteraction& si, const DensityOptions& density, NearestPhotons& scratch);
+
+// How a gathering (or glossy) path goes on through an ideal specular surface at si to the
+// diffuse surface behind it, with u in [0, 1): a dielectric's reflection or refraction chosen
+// by its Fresnel term (which cancels the choice's weight), else an opaque mirror's reflection
+// (its selection probability 1 - dielectric cancels its weight). wi and the factor that
+// multiplies the path's throughput; false when there is no ideal specular part to follow.
+bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf,
+                         float u, glm::vec3& wi, glm::vec3& factor);
 
 // The M x N (theta, phi) strata of a record's rays: M = round(sqrt(rays / pi)), N = round(rays / M).
 struct GatherStrata {

@@ -92,6 +92,10 @@ class KdTree {
   }
 
  private:
+  // The traversal both searches share; see its definition below.
+  template <class Visit, class Bound>
+  void walk(const glm::vec3& x, Visit&& visit, Bound&& bound) const;
+
   std::vector<Photon> nodes_;  // heap order
 };
 
@@ -111,46 +115,21 @@ struct PendingSubtree {
 inline constexpr int kMaxDepth = 64;
 }  // namespace detail
 
-// Jensen's locate_photons, iterative: visit a node, push its far child with the distance to
-// the splitting plane, descend to the near child; pop a far child only while its plane is
-// still inside the (shrinking) search sphere. Until k photons are found the sphere is the
-// maximum radius (inclusive: the bound is the next float above maxRadius^2, compared with <);
-// from then on it is the k-th distance, so only strictly nearer photons replace the farthest.
-template <class Accept>
-void KdTree::nearest(const glm::vec3& x, int k, float maxRadius, Accept&& accept, NearestPhotons& out) const {
-  out.neighbors.clear();
-  out.radiusSq = 0.0f;
-  if (k <= 0 || !(maxRadius >= 0.0f)) return;
-  const float maxSq = maxRadius * maxRadius;
-  out.radiusSq = maxSq;
+// Jensen's locate_photons, iterative, for both searches: visit a node (visit(index, photon,
+// squared distance to x)), push its far child with the squared distance to its splitting plane
+// (a lower bound for every photon in it), descend to the near child; pop a far child only while
+// its plane is still inside the search sphere, whose squared radius bound() may shrink as
+// visit() finds photons. At most one pending subtree per level.
+template <class Visit, class Bound>
+void KdTree::walk(const glm::vec3& x, Visit&& visit, Bound&& bound) const {
   if (nodes_.empty()) return;
-  const auto capacity = static_cast<std::size_t>(k);
-  out.neighbors.reserve(std::min(capacity, nodes_.size()));
   const auto n = static_cast<std::uint32_t>(nodes_.size());
-  const Photon* nodes = nodes_.data();
-  float bound = std::nextafter(maxSq, std::numeric_limits<float>::infinity());
-  auto farther = [](const Neighbor& a, const Neighbor& b) { return a.distSq < b.distSq; };
-
   detail::PendingSubtree stack[detail::kMaxDepth];
   int top = 0;
   std::uint32_t i = 0;
   for (;;) {
-    const Photon& p = nodes[i];
-    const float d2 = detail::distSq(p.position, x);
-    if (d2 < bound && accept(p)) {
-      if (out.neighbors.size() < capacity) {
-        out.neighbors.push_back({d2, i});
-        if (out.neighbors.size() == capacity) {
-          std::make_heap(out.neighbors.begin(), out.neighbors.end(), farther);
-          bound = out.neighbors.front().distSq;
-        }
-      } else {
-        std::pop_heap(out.neighbors.begin(), out.neighbors.end(), farther);
-        out.neighbors.back() = {d2, i};
-        std::push_heap(out.neighbors.begin(), out.neighbors.end(), farther);
-        bound = out.neighbors.front().distSq;
-      }
-    }
+    const Photon& p = nodes_[i];
+    visit(i, p, detail::distSq(p.position, x));
     const std::uint32_t left = 2 * i + 1;
     if (left < n) {
       const int axis = p.splitAxis();
@@ -164,13 +143,9 @@ void KdTree::nearest(const glm::vec3& x, int k, float maxRadius, Accept&& accept
       }
     }
     for (;;) {
-      if (top == 0) {
-        if (out.neighbors.size() == capacity) out.radiusSq = bound;
-        else if (out.neighbors.size() > 1) std::make_heap(out.neighbors.begin(), out.neighbors.end(), farther);
-        return;
-      }
+      if (top == 0) return;
       const detail::PendingSubtree& s = stack[--top];
-      if (s.planeDistSq < bound) {
+      if (s.planeDistSq < bound()) {
         i = s.node;
         break;
       }
@@ -178,36 +153,52 @@ void KdTree::nearest(const glm::vec3& x, int k, float maxRadius, Accept&& accept
   }
 }
 
+// The k nearest: until k photons are found the sphere is the maximum radius (inclusive: the
+// bound is the next float above maxRadius^2, compared with <); from then on it is the k-th
+// distance, so only strictly nearer photons replace the farthest.
+template <class Accept>
+void KdTree::nearest(const glm::vec3& x, int k, float maxRadius, Accept&& accept, NearestPhotons& out) const {
+  out.neighbors.clear();
+  out.radiusSq = 0.0f;
+  if (k <= 0 || !(maxRadius >= 0.0f)) return;
+  const float maxSq = maxRadius * maxRadius;
+  out.radiusSq = maxSq;
+  if (nodes_.empty()) return;
+  const auto capacity = static_cast<std::size_t>(k);
+  out.neighbors.reserve(std::min(capacity, nodes_.size()));
+  float bound = std::nextafter(maxSq, std::numeric_limits<float>::infinity());
+  auto farther = [](const Neighbor& a, const Neighbor& b) { return a.distSq < b.distSq; };
+  walk(
+      x,
+      [&](std::uint32_t i, const Photon& p, float d2) {
+        if (!(d2 < bound) || !accept(p)) return;
+        if (out.neighbors.size() < capacity) {
+          out.neighbors.push_back({d2, i});
+          if (out.neighbors.size() == capacity) {
+            std::make_heap(out.neighbors.begin(), out.neighbors.end(), farther);
+            bound = out.neighbors.front().distSq;
+          }
+        } else {
+          std::pop_heap(out.neighbors.begin(), out.neighbors.end(), farther);
+          out.neighbors.back() = {d2, i};
+          std::push_heap(out.neighbors.begin(), out.neighbors.end(), farther);
+          bound = out.neighbors.front().distSq;
+        }
+      },
+      [&] { return bound; });
+  if (out.neighbors.size() == capacity) out.radiusSq = bound;
+  else if (out.neighbors.size() > 1) std::make_heap(out.neighbors.begin(), out.neighbors.end(), farther);
+}
+
 template <class Fn>
 void KdTree::forEachWithin(const glm::vec3& x, float radius, Fn&& fn) const {
-  if (nodes_.empty() || !(radius >= 0.0f)) return;
+  if (!(radius >= 0.0f)) return;
   const float bound = std::nextafter(radius * radius, std::numeric_limits<float>::infinity());
-  const auto n = static_cast<std::uint32_t>(nodes_.size());
-  detail::PendingSubtree stack[detail::kMaxDepth];
-  int top = 0;
-  std::uint32_t i = 0;
-  for (;;) {
-    const Photon& p = nodes_[i];
-    const float d2 = detail::distSq(p.position, x);
-    if (d2 < bound) fn(i, d2);
-    const std::uint32_t left = 2 * i + 1;
-    if (left < n) {
-      const int axis = p.splitAxis();
-      const float d = x[axis] - p.position[axis];
-      const std::uint32_t near = d < 0.0f ? left : left + 1;
-      const std::uint32_t far = d < 0.0f ? left + 1 : left;
-      if (far < n && d * d < bound) stack[top++] = {far, d * d};
-      if (near < n) {
-        i = near;
-        continue;
-      }
-    }
-    for (;;) {
-      if (top == 0) return;
-      i = stack[--top].node;
-      break;
-    }
-  }
+  walk(
+      x, [&](std::uint32_t i, const Photon&, float d2) {
+        if (d2 < bound) fn(i, d2);
+      },
+      [&] { return bound; });
 }
 
 }  // namespace pr::pm

@@ -111,11 +111,9 @@ float PhotonMapIntegrator::smoothWeight(std::uint16_t sample) const {
 
 glm::vec3 PhotonMapIntegrator::mapRadiance(const KdTree& map, const DensityOptions& density,
                                            const rt::SurfaceInteraction& si, const rt::ShadingMaterial& m) const {
-  const glm::vec3 diffuse = (1.0f - m.dielectricWeight()) * m.diffuseColor();
-  if (!(rt::maxComponent(diffuse) > 0.0f) || map.empty()) return glm::vec3(0.0f);
+  if (map.empty()) return glm::vec3(0.0f);
   thread_local NearestPhotons scratch;
-  const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
-  return lambertianRadiance(diffuse, estimateIrradiance(map, si.position, ng, density, scratch).irradiance);
+  return globalMapRadiance(m, map, nullptr, si, density, scratch);  // any map's density estimate, read the same way
 }
 
 // ---- pre-pass ---------------------------------------------------------------------------------
@@ -194,25 +192,12 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const bool secondary = msg.kind == RayKind::Gather || (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f);
   if (secondary) {
     thread_local NearestPhotons scratch;
-    out.addRadiance(msg.pixel, msg.throughput * globalMapRadiance(ctx.scene(), state.maps.global, &state.irradiance, si,
-                                                                  globalDensity_, ctx.simulates(scene::Effect::Textures), scratch));
+    out.addRadiance(msg.pixel, msg.throughput * globalMapRadiance(m, state.maps.global, &state.irradiance, si,
+                                                                  globalDensity_, scratch));
     if (msg.depth >= options().maxDepth) return;
-    const float mark = msg.kind == RayKind::Gather ? 0.0f : msg.bsdfPdf;
-    const float u = ctx.sample(msg, rt::Dim::kLobe);
-    RayMessage next;
-    if (u < dielectric) {
-      const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-      const float cosI = glm::dot(sf.ns, si.wo);
-      glm::vec3 wt;
-      if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt))
-        next = ctx.continuation(si, msg, glm::normalize(2.0f * cosI * sf.ns - si.wo), msg.throughput, mark);
-      else
-        next = ctx.continuation(si, msg, wt, msg.throughput * m.baseColor, mark);
-    } else if (m.hasSpecular() && m.deltaSpecular() && glm::dot(mirror(), sf.ng) > 0.0f) {
-      next = ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z), mark);
-    } else {
-      return;
-    }
+    glm::vec3 wi, factor;
+    if (!idealSpecularBounce(m, si, sf, ctx.sample(msg, rt::Dim::kLobe), wi, factor)) return;
+    RayMessage next = ctx.continuation(si, msg, wi, msg.throughput * factor, msg.kind == RayKind::Gather ? 0.0f : msg.bsdfPdf);
     next.kind = msg.kind;
     if (msg.kind == RayKind::Gather)
       spawn(scene::Effect::IndirectDiffuse, &rt::TraceStats::indirectRaysSkipped, next);

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <cstdint>
+#include <iterator>
 
 namespace pr::rt {
 
@@ -24,21 +25,35 @@ struct TraceStats {
   uint64_t textureEvaluationsSkipped = 0; // textures off: textured materials evaluated from their factors
   // Rays traced (the cost figure of image-space's pre-pass); skips are not work done.
   uint64_t total() const { return cameraRays + continuationRays + shadowRays; }
-  TraceStats& operator+=(const TraceStats& o) {
-    cameraRays += o.cameraRays;
-    continuationRays += o.continuationRays;
-    shadowRays += o.shadowRays;
-    lightSamplesSkipped += o.lightSamplesSkipped;
-    shadowTestsSkipped += o.shadowTestsSkipped;
-    specularRaysSkipped += o.specularRaysSkipped;
-    glossyRaysSkipped += o.glossyRaysSkipped;
-    transmissionRaysSkipped += o.transmissionRaysSkipped;
-    causticRaysSkipped += o.causticRaysSkipped;
-    indirectRaysSkipped += o.indirectRaysSkipped;
-    emissionSkipped += o.emissionSkipped;
-    textureEvaluationsSkipped += o.textureEvaluationsSkipped;
-    return *this;
-  }
+  TraceStats& operator+=(const TraceStats& o);
 };
+
+// Every field with the run-record counter it is put in (recordRayCounters): the one list
+// that sums, records and names them.
+struct TraceCounter {
+  const char* name;
+  uint64_t TraceStats::*field;
+};
+inline constexpr TraceCounter kTraceCounters[] = {
+    {"Rays/camera", &TraceStats::cameraRays},
+    {"Rays/continuation", &TraceStats::continuationRays},
+    {"Rays/shadow", &TraceStats::shadowRays},
+    {"Plan/light_samples_skipped", &TraceStats::lightSamplesSkipped},
+    {"Plan/shadow_tests_skipped", &TraceStats::shadowTestsSkipped},
+    {"Plan/specular_rays_skipped", &TraceStats::specularRaysSkipped},
+    {"Plan/glossy_rays_skipped", &TraceStats::glossyRaysSkipped},
+    {"Plan/transmission_rays_skipped", &TraceStats::transmissionRaysSkipped},
+    {"Plan/caustic_rays_skipped", &TraceStats::causticRaysSkipped},
+    {"Plan/indirect_rays_skipped", &TraceStats::indirectRaysSkipped},
+    {"Plan/emission_skipped", &TraceStats::emissionSkipped},
+    {"Plan/texture_evaluations_skipped", &TraceStats::textureEvaluationsSkipped},
+};
+
+static_assert(sizeof(TraceStats) == std::size(kTraceCounters) * sizeof(uint64_t), "every TraceStats field is in kTraceCounters");
+
+inline TraceStats& TraceStats::operator+=(const TraceStats& o) {
+  for (const TraceCounter& c : kTraceCounters) this->*c.field += o.*c.field;
+  return *this;
+}
 
 }  // namespace pr::rt

@@ -29,19 +29,7 @@ std::unique_ptr<Partition> makePartition(std::string_view name) { return partiti
 TraceStats recordRayCounters(par::Runtime& rt, const std::vector<TraceStats>& perPe) {
   TraceStats sum;
   for (size_t p = 0; p < perPe.size(); ++p) {
-    rt.addCounter("Rays/camera", int(p), double(perPe[p].cameraRays));
-    rt.addCounter("Rays/continuation", int(p), double(perPe[p].continuationRays));
-    rt.addCounter("Rays/shadow", int(p), double(perPe[p].shadowRays));
-    const TraceStats& s = perPe[p];
-    rt.addCounter("Plan/light_samples_skipped", int(p), double(s.lightSamplesSkipped));
-    rt.addCounter("Plan/shadow_tests_skipped", int(p), double(s.shadowTestsSkipped));
-    rt.addCounter("Plan/specular_rays_skipped", int(p), double(s.specularRaysSkipped));
-    rt.addCounter("Plan/glossy_rays_skipped", int(p), double(s.glossyRaysSkipped));
-    rt.addCounter("Plan/transmission_rays_skipped", int(p), double(s.transmissionRaysSkipped));
-    rt.addCounter("Plan/caustic_rays_skipped", int(p), double(s.causticRaysSkipped));
-    rt.addCounter("Plan/indirect_rays_skipped", int(p), double(s.indirectRaysSkipped));
-    rt.addCounter("Plan/emission_skipped", int(p), double(s.emissionSkipped));
-    rt.addCounter("Plan/texture_evaluations_skipped", int(p), double(s.textureEvaluationsSkipped));
+    for (const TraceCounter& c : kTraceCounters) rt.addCounter(c.name, int(p), double(perPe[p].*c.field));
     sum += perPe[p];
   }
   return sum;

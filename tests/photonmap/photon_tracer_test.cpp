@@ -60,6 +60,14 @@ double pointLightIrradiance(const glm::vec3& x) {
   return double(toLight.y / d) / double(d * d);
 }
 
+// The global map's photons of first hits (bounce 0): the direct light, in a kd-tree.
+pm::KdTree firstHitMap(const pm::PhotonLists& lists, par::Runtime& runtime) {
+  std::vector<pm::Photon> direct;
+  for (const pm::Photon& p : lists.global)
+    if (p.bounces == 0) direct.push_back(p);
+  return pm::KdTree::build(std::move(direct), runtime);
+}
+
 scene::Scene cornell() { return scene::loadGltf(test::sourceDir() / "scenes" / "cornell.gltf"); }
 
 bool sameBytes(const std::vector<pm::Photon>& a, const std::vector<pm::Photon>& b) {
@@ -133,10 +141,7 @@ TEST_CASE("PhotonTracer: global-map irradiance under a point light is I cos / d^
   pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
   CHECK(lists.caustic.empty());
   CHECK(lists.stats.causticEmitted == 0);
-  std::vector<pm::Photon> direct;
-  for (const pm::Photon& p : lists.global)
-    if (p.bounces == 0) direct.push_back(p);
-  const pm::KdTree map = pm::KdTree::build(std::move(direct), runtime);
+  const pm::KdTree map = firstHitMap(lists, runtime);
   pm::DensityOptions density;
   density.k = 400;
   density.maxRadius = 0.5f;
@@ -166,10 +171,7 @@ TEST_CASE("PhotonTracer: the point light's irradiance is within a tolerance that
     options.globalPhotons = count;
     options.causticPhotons = 0;
     pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
-    std::vector<pm::Photon> direct;
-    for (const pm::Photon& p : lists.global)
-      if (p.bounces == 0) direct.push_back(p);
-    const pm::KdTree map = pm::KdTree::build(std::move(direct), runtime);
+    const pm::KdTree map = firstHitMap(lists, runtime);
     pm::DensityOptions density;
     density.k = int(count / 400);
     density.maxRadius = 1.0f;
@@ -358,11 +360,8 @@ TEST_CASE("PhotonTracer: photons from a uniform environment give a plane open to
   options.causticPhotons = 0;
   par::Runtime runtime(2);
   pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
-  std::vector<pm::Photon> direct;
-  for (const pm::Photon& p : lists.global)
-    if (p.bounces == 0) direct.push_back(p);
-  REQUIRE(direct.size() > 1000);
-  const pm::KdTree map = pm::KdTree::build(std::move(direct), runtime);
+  const pm::KdTree map = firstHitMap(lists, runtime);
+  REQUIRE(map.size() > 1000);
   pm::DensityOptions density;
   density.k = 200;
   density.maxRadius = 0.5f;
