@@ -71,10 +71,10 @@ GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& glo
                                     const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
                                     const GatherOptions& options, NearestPhotons& scratch) {
   GatherInteraction out;
-  const rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
+  rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
   out.radiance = throughput * globalMapRadiance(m, global, options.precomputed, si, options.global, scratch);
   if (bounce >= options.specularBounces) return out;
-  const rt::ShadingFrame sf(si);
+  const rt::ShadingFrame sf(si, m);
   const float u = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kBranchDim);
   glm::vec3 wi, factor;
   if (!idealSpecularBounce(m, si, sf, u, wi, factor)) return out;
@@ -103,7 +103,7 @@ bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteract
   }
   if (!m.hasSpecular() || !m.deltaSpecular()) return false;
   wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-  factor = rt::fresnelSchlick(m.specularF0(), sf.woLocal.z);
+  factor = m.specularFresnel(sf.woLocal.z);
   return glm::dot(wi, sf.ng) > 0.0f;
 }
 

@@ -77,14 +77,14 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
   void shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const override {
     const scene::Scene& scene = context().scene();
     const float travelled = msg.bsdfPdf + si.t * glm::length(msg.ray.direction);
-    const rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures_);
+    rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures_);
     if (rt::maxComponent((1.0f - m.dielectricWeight()) * m.diffuseColor()) > 0.0f) {
       perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, si, travelled});
       return;
     }
     if (msg.depth + 1 >= maxDepth_) return;
     // Through ideal mirrors and glass along the dominant branch.
-    const rt::ShadingFrame sf(si);
+    const rt::ShadingFrame sf(si, m);
     glm::vec3 wi;
     if (m.dielectricWeight() >= 0.5f) {
       const float eta = si.frontFace ? m.ior : 1.0f / m.ior;

@@ -166,7 +166,7 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
 void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const {
   const rt::IntegratorContext& ctx = context();
   const State& state = *state_;
-  const rt::ShadingMaterial m = ctx.material(si, out);
+  rt::ShadingMaterial m = ctx.material(si, out);
 
   if (settings_.view != PhotonView::Full) {
     const bool global = settings_.view == PhotonView::GlobalMap;
@@ -175,7 +175,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     return;
   }
 
-  const rt::ShadingFrame sf(si);
+  const rt::ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
   // One of `of` rays that share a weight: the cut-off applies to their sum, not to each.
@@ -260,7 +260,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     if (m.deltaSpecular()) {
       if (glm::dot(mirror(), sf.ng) > 0.0f)
         spawn(scene::Effect::IdealSpecular, &rt::TraceStats::specularRaysSkipped,
-              ctx.continuation(si, msg, mirror(), msg.throughput * rt::fresnelSchlick(m.specularF0(), sf.woLocal.z) * opaque, 0.0f));
+              ctx.continuation(si, msg, mirror(), msg.throughput * m.specularFresnel(sf.woLocal.z) * opaque, 0.0f));
     } else {
       const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
       for (int i = 0; i < n; ++i) {

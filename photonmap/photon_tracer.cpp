@@ -356,7 +356,7 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   const bool caustic = map == kCausticStream;
   const std::uint64_t seed = s.options->seed;
   if (bounce == 0) power *= scene::rangeWindow(hit.t * glm::length(ray.direction), range);
-  const rt::ShadingMaterial m = rt::evalMaterial(*s.scene, si, s.options->textures);
+  rt::ShadingMaterial m = rt::evalMaterial(*s.scene, si, s.options->textures);
   const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 
   // Storage: the photon's incident flux wherever the surface has a diffuse part.
@@ -379,7 +379,7 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   // weight, reflection against refraction by the Fresnel term, else the opaque lobes by
   // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
   // left, f cos / pdf, is the part's albedo along the sampled direction.
-  const rt::ShadingFrame sf(si);
+  const rt::ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
   const float lobe = sample(rt::Dim::kLobe);

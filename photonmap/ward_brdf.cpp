@@ -19,7 +19,7 @@ glm::vec3 evalWard(const WardLobe& lobe, const glm::vec3& wo, const glm::vec3& w
   // tan^2(theta_h) (cos^2 phi / ax^2 + sin^2 phi / ay^2) = (hx^2 / ax^2 + hy^2 / ay^2) / hz^2
   const float e = ((h.x * h.x) / (ax * ax) + (h.y * h.y) / (ay * ay)) / (h.z * h.z);
   const float d = std::exp(-e) / (4.0f * kPi * ax * ay * std::sqrt(wo.z * wi.z));
-  return rt::fresnelSchlick(lobe.f0, glm::dot(h, wo)) * d;
+  return rt::fresnelSchlick(lobe.f0, glm::dot(h, wo), lobe.f90) * d;
 }
 
 rt::BsdfSample sampleWard(const WardLobe& lobe, const glm::vec3& wo, float u, float v) {
@@ -42,7 +42,7 @@ rt::BsdfSample sampleWard(const WardLobe& lobe, const glm::vec3& wo, float u, fl
   const float ph = std::exp(-tan2 * a) / (kPi * ax * ay * cosH * cosH * cosH);
   s.pdf = ph / (4.0f * oh);
   if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return s;
-  s.weight = rt::fresnelSchlick(lobe.f0, oh) * (oh * cosH * cosH * cosH * std::sqrt(s.wi.z / wo.z));
+  s.weight = rt::fresnelSchlick(lobe.f0, oh, lobe.f90) * (oh * cosH * cosH * cosH * std::sqrt(s.wi.z / wo.z));
   s.valid = rt::isFinite(s.weight);
   return s;
 }
@@ -50,6 +50,7 @@ rt::BsdfSample sampleWard(const WardLobe& lobe, const glm::vec3& wo, float u, fl
 WardLobe wardLobe(const rt::ShadingMaterial& m) {
   WardLobe lobe;
   lobe.f0 = m.specularF0();
+  lobe.f90 = m.specularF90();
   const float alpha = std::max(m.alpha, kMinAlpha);
   const float k = m.anisotropy * m.anisotropy;
   lobe.alphaX = alpha + (1.0f - alpha) * k;

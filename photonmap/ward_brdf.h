@@ -17,6 +17,7 @@ struct WardLobe {
   glm::vec3 f0{0.04f};  // specular reflectance at normal incidence (Schlick's F at h . wo scales the lobe)
   float alphaX = 0.1f;  // rms slope along the anisotropy direction
   float alphaY = 0.1f;  // and across it
+  float f90 = 1.0f;     // reflectance at grazing incidence (KHR_materials_specular)
 };
 
 // f(wo, wi) = F(h.wo) / (4 pi ax ay sqrt(cos_i cos_o)) exp(-tan^2(theta_h) (cos^2 phi_h / ax^2 + sin^2 phi_h / ay^2)),

@@ -3,6 +3,7 @@
 #include "raster/parallel_pipeline.h"
 
 #include <glm/gtc/matrix_transform.hpp>
+#include "raster/stages/background.h"
 
 namespace pr::raster {
 
@@ -12,6 +13,7 @@ void renderFrame(SortPoint& sortPoint, const scene::Scene& scene, const FrameVie
   const Rect screen{0, 0, view.width, view.height};
   if (!(image.rect() == screen)) image = RegionFramebuffer(screen);
   sortPoint.renderFrame(FrameInputs{scene, view, options}, runtime, image);
+  if (showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
   // The plan's skipped work leaves the sort point as run-record counters, per PE.
   const std::vector<ShadeCounters> shade = sortPoint.takeShadeCounters();
   for (size_t p = 0; p < shade.size() && int(p) < runtime.pes(); ++p) {

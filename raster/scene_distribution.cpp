@@ -8,9 +8,7 @@
 namespace pr::raster {
 
 uint64_t geometryBytes(const scene::Scene& s) {
-  return s.positions.size() * sizeof(glm::vec3) + s.normals.size() * sizeof(glm::vec3) +
-         s.uvs.size() * sizeof(glm::vec2) + s.colors.size() * sizeof(glm::vec4) +
-         s.triangles.size() * sizeof(scene::Triangle) + s.objects.size() * sizeof(scene::Object);
+  return s.geometryBytes();
 }
 
 uint64_t shadingDataBytes(const scene::Scene& s) {

@@ -8,6 +8,7 @@
 #include "common/util/error.h"
 #include "raster/stages/draw_region.h"
 #include "raster/stages/setup.h"
+#include "raster/stages/background.h"
 
 namespace pr::raster {
 
@@ -27,7 +28,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
     processTriangles(scene, view, first, std::min(options.batchSize, total - first), tris, &st.geometry);
   }
 
-  const ShadingContext ctx = makeShadingContext(scene, view, options.effects);
+  const ShadingContext ctx = makeShadingContext(scene, view, options.effects, options.headlight);
   st.usesHeadlight = ctx.usesHeadlight;
   auto draw = [&](std::span<const ScreenTriangle> list, const PixelWindow& pixels) {
     drawRegion(ctx, list, pixels, &st.raster, &st.shade);
@@ -36,6 +37,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
   };
   if (options.regions.empty()) {
     draw(tris, image.window());
+    if (showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
     return;
   }
 
@@ -53,6 +55,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
     }
     draw(bin, image.window(r));
   }
+  if (showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
 }
 
 RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& view,

@@ -25,6 +25,8 @@ struct SequentialOptions {
   uint32_t batchSize = 4096;
   // The RenderPlan's effects shading honours (see SortOptions::effects).
   scene::EffectSet effects = scene::EffectSet::all();
+  // --headlight: a scene without lights is lit from the eye instead of by its environment.
+  bool headlight = false;
 };
 
 struct RasterStats {

@@ -130,7 +130,7 @@ std::string toTable(const scene::SceneStats& s, const scene::Camera& camera, con
 }
 
 void runInfo(const InfoOptions& options) {
-  scene::Scene scene = scene::loadGltf(options.scene);
+  scene::Scene scene = loadScene(options.scene, options.lighting);
   const std::string lighting = applyLighting(scene, options.lighting);
   scene::Camera camera = scene::selectCamera(scene, options.camera, kInfoAspect);
   scene::SceneStats stats = scene::computeStats(scene);

@@ -96,7 +96,7 @@ void run(RenderArgs& a) {
   if (ext != ".png" && ext != ".exr")
     throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
 
-  scene::Scene scene = scene::loadGltf(a.scene);
+  scene::Scene scene = loadScene(a.scene, a.lighting);
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);

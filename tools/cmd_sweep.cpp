@@ -179,7 +179,7 @@ void run(SweepArgs& a) {
   if (a.vary != "spp" && !photonmap)
     throw InputError("--vary " + a.vary + " varies a photon-map setting; add photonmap to --integrator or vary spp");
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
-  scene::Scene scene = scene::loadGltf(a.scene);
+  scene::Scene scene = loadScene(a.scene, a.lighting);
   std::fprintf(stderr, "%s\n", applyLighting(scene, a.lighting).c_str());
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);

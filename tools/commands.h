@@ -7,6 +7,7 @@
 namespace pr::cli {
 
 // One declaration per subcommand, each defined in its cmd_*.cpp.
+void addGalleryCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "common/image/image_io.h"
+#include "common/scene/gltf_loader.h"
 
 namespace pr::cli {
 
@@ -14,7 +15,12 @@ void addLightingOptions(CLI::App& command, LightingOptions& o) {
   command.add_option("--env-rotate", o.rotateDegrees, "environment rotation about +y in degrees")
       ->check(CLI::Range(-360.0f, 360.0f))->capture_default_str();
   command.add_flag("--no-default-light", o.noDefault,
-                   "a scene without lights gets no default light (otherwise: a uniform white environment in the ray tracers)");
+                   "a scene without lights gets no default light (otherwise: a uniform white environment)");
+  command.add_option("--variant", o.variant, "KHR_materials_variants: the material variant to render (default: the default materials)");
+}
+
+scene::Scene loadScene(const std::string& path, const LightingOptions& o) {
+  return scene::loadGltf(path, scene::LoadOptions{o.variant});
 }
 
 std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
@@ -30,7 +36,7 @@ std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
   if (o.noDefault) return "lighting: none (the scene has no lights; --no-default-light)";
   scene.environment = std::make_shared<const scene::Environment>(scene::Environment::uniform(
       glm::vec3(o.strength), "uniform white, the default: the scene has no lights"));
-  return "lighting: the default, a uniform white environment (the scene has no lights; the rasterizer uses its headlight)";
+  return "lighting: the default, a uniform white environment (the scene has no lights)";
 }
 
 }  // namespace pr::cli

@@ -2,7 +2,9 @@
 // (an equirectangular environment, --env-strength, --env-rotate degrees about +y) and the
 // default light of a scene without lights - a uniform white environment, unless
 // --no-default-light - so that a model downloaded without lights does not render black in the
-// ray tracers. The rasterizer keeps its headlight for such a scene (the summary says so).
+// ray tracers and the rasterizer (which lights it by image-based lighting, or --headlight).
+// Also --variant NAME (KHR_materials_variants), the other option that decides what the loaded
+// scene is.
 #pragma once
 
 #include <string>
@@ -18,9 +20,13 @@ struct LightingOptions {
   float strength = 1.0f;      // --env-strength
   float rotateDegrees = 0.0f; // --env-rotate
   bool noDefault = false;     // --no-default-light
+  std::string variant;        // --variant
 };
 
 void addLightingOptions(CLI::App& command, LightingOptions& options);
+
+// Loads the scene with the options' material variant.
+scene::Scene loadScene(const std::string& path, const LightingOptions& options);
 
 // Sets scene.environment from the options; returns the summary line saying what lights the
 // scene ("lighting: ..."). Throws pr::InputError for an unreadable or invalid environment file.

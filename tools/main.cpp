@@ -14,6 +14,7 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   app.set_version_flag("--version", "parrender 0.1.0");
   // One line per subcommand (tools/commands.h).
+  pr::cli::addGalleryCommand(app);
   pr::cli::addGenerateCommand(app);
   pr::cli::addInfoCommand(app);
   pr::cli::addRenderCommand(app);

@@ -98,6 +98,7 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   options.tileSizePx = o.tileSizePx;
   options.compositor = o.compositor;
   options.sparse = o.sparse;
+  options.headlight = o.headlight;
   options.effects = r.plan.enabled();
   std::unique_ptr<raster::SortPoint> sortPoint = raster::makeSortPoint(name);
   raster::RegionFramebuffer last;
@@ -110,9 +111,9 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   }
   const par::RunRecord& record = r.runtime.record();
   // The raster stages (raster/stages/shade.cpp) shade each visible pixel once: direct light
-  // from punctual lights (a headlight without them) with its glossy highlight, emission and
-  // textures, each skipped (and counted) when the plan has it off; no shadows, reflection or
-  // refraction rays.
+  // from punctual lights and the environment (image-based; a headlight without either) with
+  // its glossy highlight, emission and textures, each skipped (and counted) when the plan has
+  // it off; no shadows, reflection or refraction rays.
   scene::EffectSet rasterEffects = scene::EffectSet::none();
   for (scene::Effect e : {scene::Effect::DirectLight, scene::Effect::Emission, scene::Effect::Textures})
     rasterEffects.set(e, true);
@@ -124,7 +125,14 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   for (const char* c : {"Plan/texture_evaluations_skipped", "Plan/emission_skipped", "Plan/light_samples_skipped"})
     if (const uint64_t n = counterTotal(record, c); n > 0)
       skipped += (skipped.empty() ? "" : ", ") + std::string(c + 5) + " " + std::to_string(n);
-  out.effects = "rasterization simulates direct light (punctual lights, no shadows), emission and textures" +
+  out.effects = std::string("rasterization simulates direct light (") +
+                (r.scene.lights.empty() && (o.headlight || !r.scene.environment)
+                     ? "a headlight"
+                     : std::string(r.scene.lights.empty() ? "" : "punctual lights") +
+                           (r.scene.environment ? std::string(r.scene.lights.empty() ? "" : ", ") +
+                                                      "the environment by image-based lighting"
+                                                : "")) +
+                ", no shadows), emission and textures" +
                 (missing.empty() ? std::string() : "; not simulated: " + missing) +
                 "; skipped work: " + (skipped.empty() ? "none" : skipped);
   out.details = "frames " + std::to_string(o.frames) + (o.orbit ? " (orbit)" : "") + ", regions " + o.regions +
@@ -242,6 +250,9 @@ void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions
                           ->check(CLI::Validator([](std::string& v) { return raster::compositors().problem(v); }, "COMPOSITOR")),
                       MethodFamily::Raster);
   family.emplace_back(command.add_flag("--sparse", r.sparse, "sort-last: composite covered pixels only"), MethodFamily::Raster);
+  family.emplace_back(command.add_flag("--headlight", r.headlight,
+                                       "rasterization: light a scene without lights from the eye instead of by its environment"),
+                      MethodFamily::Raster);
   family.emplace_back(command.add_option("--frames", r.frames, "rasterization: frames to render (the last is written)")
                           ->check(CLI::Range(1, 100000))
                           ->capture_default_str(),

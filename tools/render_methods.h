@@ -51,6 +51,7 @@ struct RasterOptions {
   bool sparse = false;
   int frames = 1;
   bool orbit = false;
+  bool headlight = false;
 };
 
 // Every family's options, filled by CLI11.

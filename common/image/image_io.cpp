@@ -99,8 +99,10 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
 }
 
 Image readImage(const fs::path& path) {
-  // Radiance HDR (environment maps) reads as linear radiance, like EXR.
-  const Format format = lowerExtension(path) == ".hdr" ? Format::Exr : formatOf(path);
+  // Radiance HDR (environment maps) reads as linear radiance, like EXR; JPEG (reference
+  // screenshots) is sRGB-encoded, like PNG.
+  const std::string ext = lowerExtension(path);
+  const Format format = ext == ".hdr" ? Format::Exr : ext == ".jpg" || ext == ".jpeg" ? Format::Png : formatOf(path);
   if (!fs::is_regular_file(path)) throw InputError("image file '" + path.string() + "' does not exist");
 
   auto in = OIIO::ImageInput::open(path.string());

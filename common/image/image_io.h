@@ -21,8 +21,8 @@ struct WriteOptions {
 // or a path that cannot be written (naming the path).
 void writeImage(const std::filesystem::path& path, const Image& image, const WriteOptions& options = {});
 
-// Reads an image as linear RGB: EXR and Radiance HDR values as stored, 8/16-bit PNG decoded from sRGB (the tone
-// map is not inverted). Grey images are replicated to RGB, alpha is dropped.
+// Reads an image as linear RGB: EXR and Radiance HDR values as stored, 8/16-bit PNG and JPEG decoded from sRGB
+// (the tone map is not inverted). Grey images are replicated to RGB, alpha is dropped.
 // Throws pr::InputError naming the path when it is missing, unreadable or not .exr/.png.
 Image readImage(const std::filesystem::path& path);
 

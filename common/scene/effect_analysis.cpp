@@ -50,18 +50,24 @@ MaterialTraits traitsOf(const Material& m) {
   // transmission is 1 and metallic 0 everywhere.
   t.opaque = !(transmissionMin >= 1.0f && metallicMax <= 0.0f);
   t.diffuse = t.opaque && base && metallicMin < 1.0f && transmissionMin < 1.0f;
-  // specularF0 = mix(0.04 (1 - transmission) [roughness < 1 only], base, metallic) > 0.
+  // specularF0 = mix(F0 (1 - transmission) [roughness < 1 only], base, metallic) > 0, or F90 > 0.
   auto specularAt = [&](float roughnessLo) {
-    const bool dielectricCoat = roughnessLo < 1.0f && transmissionMin < 1.0f && metallicMin < 1.0f;
+    // KHR_materials_specular 0 (factor without texture) removes the dielectric lobe.
+    const bool dielectricCoat = roughnessLo < 1.0f && transmissionMin < 1.0f && metallicMin < 1.0f &&
+                                m.specularFactor > 0.0f;
     const bool metal = metallicMax > 0.0f && base;
     return dielectricCoat || metal;
   };
   t.ideal = t.opaque && roughnessMin < kIdealSpecularRoughness && specularAt(roughnessMin);
   t.glossy = t.opaque && roughnessMax >= kIdealSpecularRoughness &&
              specularAt(std::max(roughnessMin, kIdealSpecularRoughness));
+  // The clear coat is a GGX lobe of its own, never narrow enough to be a mirror in the tracers.
+  t.glossy = t.glossy || (t.opaque && m.hasClearcoat());
   t.anisotropic = m.anisotropyStrength > 0.0f;
   for (const TextureRef* r : {&m.baseColorTexture, &m.metallicRoughnessTexture, &m.normalTexture, &m.emissiveTexture,
-                              &m.transmissionTexture, &m.anisotropyTexture})
+                              &m.transmissionTexture, &m.anisotropyTexture, &m.specularTexture, &m.specularColorTexture,
+                              &m.clearcoatTexture, &m.clearcoatRoughnessTexture, &m.clearcoatNormalTexture,
+                              &m.sheenColorTexture, &m.sheenRoughnessTexture})
     t.textures += r->present() ? 1 : 0;
   return t;
 }

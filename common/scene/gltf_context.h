@@ -19,6 +19,7 @@ struct Context {
   std::string file;  // as given by the user, so messages name what they typed
   Scene& scene;
   std::set<std::string> warned;  // each distinct warning once, however many instances repeat it
+  int variant = -1;              // KHR_materials_variants index applied, -1 = default materials
 
   // Bad input: one message naming the file, the element and the problem.
   [[noreturn]] void fail(const std::string& what) const { throw InputError(file + ": " + what); }

@@ -8,6 +8,7 @@
 #include <array>
 #include <cmath>
 #include <fstream>
+#include <span>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -15,6 +16,7 @@
 #include "common/scene/gltf_accessor.h"
 #include "common/scene/gltf_context.h"
 #include "common/scene/gltf_material.h"
+#include "common/scene/tangent_frame.h"
 #include "common/util/limits.h"
 
 namespace pr::scene {
@@ -25,14 +27,21 @@ using gltf::Context;
 using gltf::describe;
 
 // Extensions whose content parrender honours; only these may appear in extensionsRequired.
-constexpr std::array<const char*, 7> kSupportedExtensions = {
+constexpr std::array<const char*, 11> kSupportedExtensions = {
     "KHR_lights_punctual",      "KHR_materials_emissive_strength", "KHR_materials_transmission",
     "KHR_materials_ior",        "KHR_materials_volume",            "KHR_materials_anisotropy",
-    "KHR_texture_transform"};
+    "KHR_materials_specular",   "KHR_materials_clearcoat",         "KHR_materials_sheen",
+    "KHR_materials_variants",   "KHR_texture_transform"};
 
 bool supported(const std::string& name) {
   return std::any_of(kSupportedExtensions.begin(), kSupportedExtensions.end(),
                      [&](const char* s) { return name == s; });
+}
+
+std::string supportedList() {
+  std::string out;
+  for (const char* s : kSupportedExtensions) out += (out.empty() ? "" : ", ") + std::string(s);
+  return out;
 }
 
 // Unit vector, or `fallback` for a zero / non-finite one (degenerate triangle, zero scale).
@@ -154,6 +163,7 @@ class Flattener {
   void finish() {
     Scene& s = ctx_.scene;
     if (!anyColors_) s.colors.clear();
+    if (!anyTangents_) s.tangents.clear();
     for (uint32_t t = 0; t < s.triangles.size(); ++t) {
       const Triangle& tri = s.triangles[t];
       const Material& material = s.materials[tri.material];
@@ -229,6 +239,30 @@ class Flattener {
     return tris;
   }
 
+  // The material the selected variant maps this primitive to, or -1 (no variant, no mapping).
+  int variantMaterial(const tinygltf::Primitive& prim, const std::string& where) {
+    if (ctx_.variant < 0) return -1;
+    auto it = prim.extensions.find("KHR_materials_variants");
+    if (it == prim.extensions.end() || !it->second.Has("mappings") || !it->second.Get("mappings").IsArray()) return -1;
+    const tinygltf::Value& mappings = it->second.Get("mappings");
+    for (size_t i = 0; i < mappings.ArrayLen(); ++i) {
+      const tinygltf::Value& m = mappings.Get(int(i));
+      if (!m.Has("variants") || !m.Get("variants").IsArray() || !m.Has("material") || !m.Get("material").IsNumber()) continue;
+      const tinygltf::Value& vs = m.Get("variants");
+      for (size_t k = 0; k < vs.ArrayLen(); ++k) {
+        if (!vs.Get(int(k)).IsNumber() || vs.Get(int(k)).GetNumberAsInt() != ctx_.variant) continue;
+        const int material = m.Get("material").GetNumberAsInt();
+        if (material < 0 || size_t(material) + 1 >= ctx_.scene.materials.size()) {
+          ctx_.fail(where + ": KHR_materials_variants maps to material " + std::to_string(material) +
+                    ", which is out of range (the file has " + std::to_string(ctx_.scene.materials.size() - 1) +
+                    " materials)");
+        }
+        return material;
+      }
+    }
+    return -1;
+  }
+
   void addPrimitive(int nodeIndex, const tinygltf::Node& node, int meshIndex, const tinygltf::Mesh& mesh, int primIndex,
                     const glm::dmat4& world) {
     const tinygltf::Primitive& prim = mesh.primitives[size_t(primIndex)];
@@ -275,6 +309,7 @@ class Flattener {
     const gltf::FloatAccessor* normal = optional("NORMAL", 3, 3);
     const gltf::FloatAccessor* uv = optional("TEXCOORD_0", 2, 2);
     const gltf::FloatAccessor* color = optional("COLOR_0", 3, 4);
+    const gltf::FloatAccessor* tangent = optional("TANGENT", 4, 4);
 
     uint32_t material = uint32_t(ctx_.scene.materials.size() - 1);  // the default material
     if (prim.material >= 0) {
@@ -284,6 +319,7 @@ class Flattener {
       }
       material = uint32_t(prim.material);
     }
+    if (const int mapped = variantMaterial(prim, where); mapped >= 0) material = uint32_t(mapped);
 
     std::vector<uint32_t> local = triangleList(prim, count, where);
     if (local.empty()) return;
@@ -340,6 +376,28 @@ class Flattener {
       }
       // A vertex only on zero-area triangles has no defined normal; +Y is as good as any.
       s.normals.push_back(safeNormalize(n, glm::vec3(0.0f, 1.0f, 0.0f)));
+    }
+
+    // Tangents, only where a normal map needs them: the file's (xyz by the node transform; a
+    // mirroring transform flips the bitangent, so w too), else generated from the UVs.
+    const Material& mat = s.materials[material];
+    const bool normalMapped = (mat.normalTexture.present() || mat.clearcoatNormalTexture.present()) && uv;
+    s.tangents.resize(s.positions.size(), glm::vec4(0.0f));
+    if (normalMapped) {
+      anyTangents_ = true;
+      const std::span<glm::vec4> out(s.tangents.data() + base, count);
+      if (tangent) {
+        const glm::mat3 linear{glm::dmat3(world)};
+        for (size_t i = 0; i < count; ++i) {
+          const float* a = tangent->element(i);
+          const glm::vec3 n = s.normals[base + i];
+          glm::vec3 t = linear * glm::vec3(a[0], a[1], a[2]);
+          t = safeNormalize(t - glm::dot(t, n) * n, glm::vec3(0.0f));
+          out[i] = glm::vec4(t, (a[3] < 0.0f) != mirrored ? -1.0f : 1.0f);
+        }
+      } else {
+        generateTangents(s, base, firstTriangle, out);
+      }
     }
 
     Object object;
@@ -431,24 +489,47 @@ class Flattener {
   gltf::AccessorReader accessors_;
   std::vector<bool> onPath_;
   bool anyColors_ = false;
+  bool anyTangents_ = false;
 };
+
+// KHR_materials_variants: the names the file defines, and the index of the one asked for.
+void selectVariant(Context& ctx, const std::string& name) {
+  auto it = ctx.model.extensions.find("KHR_materials_variants");
+  if (it != ctx.model.extensions.end() && it->second.Has("variants") && it->second.Get("variants").IsArray()) {
+    const tinygltf::Value& list = it->second.Get("variants");
+    for (size_t i = 0; i < list.ArrayLen(); ++i) {
+      const tinygltf::Value& v = list.Get(int(i));
+      ctx.scene.variants.push_back(v.Has("name") && v.Get("name").IsString() ? v.Get("name").Get<std::string>()
+                                                                           : "variant " + std::to_string(i));
+    }
+  }
+  if (name.empty()) return;
+  auto found = std::find(ctx.scene.variants.begin(), ctx.scene.variants.end(), name);
+  if (found == ctx.scene.variants.end()) {
+    std::string known;
+    for (const std::string& v : ctx.scene.variants) known += (known.empty() ? "" : ", ") + v;
+    ctx.fail("has no material variant '" + name + "' (" +
+             (known.empty() ? std::string("it defines none") : "it defines: " + known) + ")");
+  }
+  ctx.variant = int(found - ctx.scene.variants.begin());
+  ctx.scene.variant = name;
+}
 
 }  // namespace
 
-Scene loadGltf(const std::filesystem::path& path) {
+Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
   Scene scene;
   scene.source = path;
   std::vector<std::string> tinyWarnings;
   tinygltf::Model model = parse(path, tinyWarnings);
   Context ctx{model, path.string(), scene, {}};
+  selectVariant(ctx, options.variant);
 
   // A required extension we cannot honour makes the file unrenderable; an optional one is
   // only ignored (glTF 2.0 spec 3.12).
   for (const std::string& ext : model.extensionsRequired) {
     if (!supported(ext)) {
-      ctx.fail("requires extension " + ext + ", which parrender does not support (supported: KHR_lights_punctual, "
-               "KHR_materials_emissive_strength, KHR_materials_transmission, KHR_materials_ior, KHR_materials_volume, "
-               "KHR_materials_anisotropy, KHR_texture_transform)");
+      ctx.fail("requires extension " + ext + ", which parrender does not support (supported: " + supportedList() + ")");
     }
   }
   scene.extensionsUsed = model.extensionsUsed;

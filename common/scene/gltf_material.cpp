@@ -177,6 +177,27 @@ Material convert(Context& ctx, const tinygltf::Material& m, const std::string& w
     out.anisotropyRotation = number(*e, "anisotropyRotation", 0.0f);
     out.anisotropyTexture = textureRef(ctx, *e, "anisotropyTexture", where + " anisotropyTexture");
   }
+  if (const tinygltf::Value* e = extension(m.extensions, "KHR_materials_specular")) {
+    out.specularFactor = number(*e, "specularFactor", 1.0f);
+    out.specularTexture = textureRef(ctx, *e, "specularTexture", where + " specularTexture");
+    out.specularColorFactor = numbers<3>(*e, "specularColorFactor", glm::vec3(1.0f));
+    out.specularColorTexture = textureRef(ctx, *e, "specularColorTexture", where + " specularColorTexture");
+  }
+  if (const tinygltf::Value* e = extension(m.extensions, "KHR_materials_clearcoat")) {
+    out.clearcoatFactor = number(*e, "clearcoatFactor", 0.0f);
+    out.clearcoatTexture = textureRef(ctx, *e, "clearcoatTexture", where + " clearcoatTexture");
+    out.clearcoatRoughnessFactor = number(*e, "clearcoatRoughnessFactor", 0.0f);
+    out.clearcoatRoughnessTexture = textureRef(ctx, *e, "clearcoatRoughnessTexture", where + " clearcoatRoughnessTexture");
+    out.clearcoatNormalTexture = textureRef(ctx, *e, "clearcoatNormalTexture", where + " clearcoatNormalTexture");
+    if (e->Has("clearcoatNormalTexture") && e->Get("clearcoatNormalTexture").IsObject())
+      out.clearcoatNormalScale = number(e->Get("clearcoatNormalTexture"), "scale", 1.0f);
+  }
+  if (const tinygltf::Value* e = extension(m.extensions, "KHR_materials_sheen")) {
+    out.sheenColorFactor = numbers<3>(*e, "sheenColorFactor", glm::vec3(0.0f));
+    out.sheenColorTexture = textureRef(ctx, *e, "sheenColorTexture", where + " sheenColorTexture");
+    out.sheenRoughnessFactor = number(*e, "sheenRoughnessFactor", 0.0f);
+    out.sheenRoughnessTexture = textureRef(ctx, *e, "sheenRoughnessTexture", where + " sheenRoughnessTexture");
+  }
   return out;
 }
 

@@ -1,5 +1,6 @@
 // Materials of the render-ready scene: glTF pbrMetallicRoughness plus the KHR extensions
-// parrender honours (emissive_strength, transmission, ior, volume, anisotropy, texture_transform).
+// parrender honours (emissive_strength, transmission, ior, volume, anisotropy, specular,
+// clearcoat, sheen, texture_transform).
 // Colour factors are linear; textures keep their 8-bit texels and are decoded per slot
 // (base colour and emissive are sRGB-encoded, every other slot is linear data).
 #pragma once
@@ -54,6 +55,23 @@ struct Material {
   float anisotropyStrength = 0.0f;
   float anisotropyRotation = 0.0f;  // radians
   TextureRef anisotropyTexture;     // RG = direction, B = strength (KHR_materials_anisotropy)
+  // KHR_materials_specular: scales the dielectric Fresnel (F0 and F90) and tints its F0
+  float specularFactor = 1.0f;
+  TextureRef specularTexture;       // A = factor
+  glm::vec3 specularColorFactor{1.0f};
+  TextureRef specularColorTexture;  // RGB, sRGB-encoded
+  // KHR_materials_clearcoat: a clear dielectric GGX layer (ior 1.5) over the material
+  float clearcoatFactor = 0.0f;
+  TextureRef clearcoatTexture;           // R = factor
+  float clearcoatRoughnessFactor = 0.0f;
+  TextureRef clearcoatRoughnessTexture;  // G = roughness
+  TextureRef clearcoatNormalTexture;
+  float clearcoatNormalScale = 1.0f;
+  // KHR_materials_sheen: a Charlie-distribution retro-reflective layer (cloth, velvet)
+  glm::vec3 sheenColorFactor{0.0f};
+  TextureRef sheenColorTexture;      // RGB, sRGB-encoded
+  float sheenRoughnessFactor = 0.0f;
+  TextureRef sheenRoughnessTexture;  // A = roughness
   // core flags
   bool doubleSided = false;
   AlphaMode alphaMode = AlphaMode::Opaque;
@@ -61,6 +79,8 @@ struct Material {
 
   glm::vec3 emission() const { return emissiveFactor * emissiveStrength; }
   bool isEmissive() const { return glm::any(glm::greaterThan(emission(), glm::vec3(0.0f))); }
+  bool hasClearcoat() const { return clearcoatFactor > 0.0f; }
+  bool hasSheen() const { return glm::any(glm::greaterThan(sheenColorFactor, glm::vec3(0.0f))); }
   // The dominant kind, in priority order emissive > glass > anisotropic > specular > diffuse.
   // Specular: a metal (metallic >= 0.5) with roughness < 0.2, i.e. a mirror-like lobe.
   MaterialKind kind() const;

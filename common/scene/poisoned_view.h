@@ -31,6 +31,7 @@ inline std::unique_ptr<Scene> poisonedView(const Scene& s, std::span<const uint3
     if (v < view->normals.size()) view->normals[v] = glm::vec3(nan);
     if (v < view->uvs.size()) view->uvs[v] = glm::vec2(nan);
     if (v < view->colors.size()) view->colors[v] = glm::vec4(nan);
+    if (v < view->tangents.size()) view->tangents[v] = glm::vec4(nan);
   }
   return view;
 }

@@ -11,10 +11,14 @@ size_t bytesOf(const std::vector<T>& v) {
 }
 }  // namespace
 
+size_t Scene::geometryBytes() const {
+  return bytesOf(positions) + bytesOf(normals) + bytesOf(uvs) + bytesOf(colors) + bytesOf(tangents) +
+         bytesOf(triangles) + bytesOf(objects);
+}
+
 size_t Scene::memoryBytes() const {
-  size_t bytes = bytesOf(positions) + bytesOf(normals) + bytesOf(uvs) + bytesOf(colors) +
-                 bytesOf(triangles) + bytesOf(objects) + bytesOf(materials) + bytesOf(textures) +
-                 bytesOf(lights) + bytesOf(areaLights) + bytesOf(cameras);
+  size_t bytes = geometryBytes() + bytesOf(materials) + bytesOf(textures) + bytesOf(lights) + bytesOf(areaLights) +
+                 bytesOf(cameras);
   for (const Texture& t : textures) bytes += t.memoryBytes();
   return bytes;
 }

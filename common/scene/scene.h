@@ -55,11 +55,15 @@ struct Scene {
   std::filesystem::path source;  // the file it was loaded from (empty when built in code)
 
   // Vertices, world space. normals are unit length (generated, area-weighted, when absent);
-  // uvs is UV set 0 (zero when absent); colors is COLOR_0, empty when no primitive has it.
+  // uvs is UV set 0 (zero when absent); colors is COLOR_0 (1 where a primitive has none),
+  // empty when no primitive has it.
   std::vector<glm::vec3> positions;
   std::vector<glm::vec3> normals;
   std::vector<glm::vec2> uvs;
   std::vector<glm::vec4> colors;
+  // Per-vertex tangents (w = bitangent handedness) for normal mapping; empty when no material
+  // has a normal map, zero on vertices of primitives without one (common/scene/tangent_frame.h).
+  std::vector<glm::vec4> tangents;
 
   std::vector<Triangle> triangles;
   std::vector<Object> objects;
@@ -74,10 +78,15 @@ struct Scene {
 
   Bounds bounds;
   std::vector<std::string> extensionsUsed;  // as listed by the file
+  std::vector<std::string> variants;        // KHR_materials_variants names, in file order
+  std::string variant;                      // the one applied (empty: the default materials)
   std::vector<std::string> warnings;        // optional content that was skipped or ignored
 
   // Bytes held by the arrays above (the render-ready layout), textures included.
   size_t memoryBytes() const;
+  // The part of it that is geometry: vertex arrays, triangles and objects (what a partitioned
+  // method distributes rather than replicates).
+  size_t geometryBytes() const;
 };
 
 }  // namespace pr::scene

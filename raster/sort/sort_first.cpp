@@ -96,7 +96,7 @@ class ReadableScene {
  public:
   ReadableScene(const FrameInputs& f, std::span<const uint32_t> ids)
       : shared_(f.scene), view_(f.options.poisonForeignGeometry ? scene::poisonedView(f.scene, ids) : nullptr) {
-    if (view_) shading_ = makeShadingContext(*view_, f.view, f.options.effects);
+    if (view_) shading_ = makeShadingContext(*view_, f.view, f.options.effects, f.options.headlight);
   }
   const scene::Scene& scene() const { return view_ ? *view_ : shared_; }
   // The shading context over the same scene (deferred shading reads vertex attributes).
@@ -121,7 +121,7 @@ class SortFirst : public SortPoint {
     const int pes = rt.pes();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects, f.options.headlight);
     declareSortCounters(name(), rt);
     // The first frame on a scene and runtime hands every PE its initial share; each PE keeps
     // that share, so a later loss of coherence (below) starts again from it at no cost.

@@ -26,7 +26,7 @@ class SortLast : public SortPoint {
     // The compositor is chosen (and a bad name rejected) before any work is done.
     std::unique_ptr<Compositor> compositor = makeCompositor(f.options.compositor);
     const Rect screen{0, 0, f.view.width, f.view.height};
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects, f.options.headlight);
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
 

@@ -44,7 +44,7 @@ class SortMiddle : public SortPoint {
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
     const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
-    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects);
+    const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects, f.options.headlight);
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
     FrameAssembly frame(rt, image, pool_);

@@ -36,6 +36,8 @@ struct SortOptions {
   // off, and the work not done is put in the run record (Plan/texture_evaluations_skipped,
   // Plan/emission_skipped, Plan/light_samples_skipped, per PE), as the ray tracers do.
   scene::EffectSet effects = scene::EffectSet::all();
+  // --headlight: a scene without lights is lit from the eye instead of by its environment.
+  bool headlight = false;
 };
 
 // The algorithm counters of the sort points, named per PE in the run record (Sort/...): the

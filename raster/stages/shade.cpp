@@ -12,6 +12,8 @@
 #include <cstring>
 #include <numbers>
 
+#include "common/scene/material_layers.h"
+#include "common/scene/surface_material.h"
 #include "common/scene/texture.h"
 #include "raster/framebuffer.h"
 #include "raster/stages/setup.h"
@@ -35,12 +37,6 @@ glm::vec3 barycentricsFromEdges(const ScreenTriangle& tri, int64_t e0, int64_t e
   float inv = 1.0f / (w0 + w1 + w2);
   glm::vec2 b = (w0 * inv) * tri.bary[0] + (w1 * inv) * tri.bary[1] + (w2 * inv) * tri.bary[2];
   return glm::vec3(1.0f - b.x - b.y, b.x, b.y);
-}
-
-glm::vec4 sampleSlot(const scene::Scene& scene, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
-  // KHR_texture_transform: the slot's matrix applied to (u, v, 1).
-  glm::vec2 st(ref.uvTransform * glm::vec3(uv, 1.0f));
-  return scene.textures[static_cast<size_t>(ref.texture)].sample(st, srgb);
 }
 
 // Irradiance at normal incidence (lux) and direction towards the light, KHR_lights_punctual.
@@ -93,15 +89,23 @@ SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm
   if (!scene.colors.empty()) {
     sp.colour = b.x * scene.colors[t.v[0]] + b.y * scene.colors[t.v[1]] + b.z * scene.colors[t.v[2]];
   }
+  if (!scene.tangents.empty()) {
+    const glm::vec4 t0 = scene.tangents[t.v[0]];
+    glm::vec3 tangent = b.x * glm::vec3(t0) + b.y * glm::vec3(scene.tangents[t.v[1]]) + b.z * glm::vec3(scene.tangents[t.v[2]]);
+    // A back face seen through double-sidedness mirrors the frame: the bitangent flips with it.
+    sp.tangent = glm::vec4(tangent, tri.backFacing ? -t0.w : t0.w);
+  }
   return sp;
 }
 
-ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view, scene::EffectSet effects) {
+ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view, scene::EffectSet effects,
+                                  bool headlight) {
   ShadingContext ctx;
   ctx.scene = &scene;
   ctx.view = view;
   ctx.lights = scene.lights;
-  ctx.usesHeadlight = ctx.lights.empty();
+  ctx.usesHeadlight = ctx.lights.empty() && (headlight || !scene.environment);
+  if (!ctx.usesHeadlight) ctx.ibl = ImageBasedLight::of(scene.environment);
   ctx.textures = effects.has(scene::Effect::Textures);
   ctx.emission = effects.has(scene::Effect::Emission);
   ctx.direct = effects.has(scene::Effect::DirectLight);
@@ -111,7 +115,8 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
 namespace {
 
 // evalBrdf's body, inlined into the per-pixel light loop.
-inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L) {
+inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L,
+                      glm::vec3 dielectricF0, float dielectricF90) {
   float NdotL = std::max(glm::dot(N, L), 0.0f);
   if (NdotL <= 0.0f) return glm::vec3(0.0f);
   // Interpolated normals can face slightly away from the eye at silhouettes; keep NdotV > 0.
@@ -136,17 +141,19 @@ inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3
   float gl = NdotL * (1.0f - k) + k;
   float gv = NdotV * (1.0f - k) + k;
   float specularScale = alpha2 / (4.0f * kPi * denom * denom * gl * gv);
-  glm::vec3 F0 = glm::mix(glm::vec3(0.04f), base, metallic);
+  glm::vec3 F0 = glm::mix(dielectricF0, base, metallic);
+  float F90 = dielectricF90 + (1.0f - dielectricF90) * metallic;
   float f = 1.0f - VdotH;
   float f5 = f * f * f * f * f;
-  glm::vec3 F = F0 + (glm::vec3(1.0f) - F0) * f5;
+  glm::vec3 F = F0 + (glm::vec3(F90) - F0) * f5;
   glm::vec3 diffuse = ((1.0f - metallic) / kPi) * base;
   return diffuse + F * specularScale;
 }
 
 // brdf() for L = V (the headlight): then H = V, NdotH = NdotL = NdotV, VdotH = 1 and F = F0,
 // which saves normalizing H. |N x V|^2 stands for 1 - NdotV^2 as in brdf().
-inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V) {
+inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V,
+                               glm::vec3 dielectricF0) {
   float r = std::max(roughness, kMinRoughness);
   float alpha = r * r;
   float alpha2 = alpha * alpha;
@@ -156,60 +163,119 @@ inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, 
   float k = 0.5f * alpha;
   float g = c * (1.0f - k) + k;
   float specularScale = alpha2 / (4.0f * kPi * denom * denom * g * g);
-  glm::vec3 F0 = glm::mix(glm::vec3(0.04f), base, metallic);
+  glm::vec3 F0 = glm::mix(dielectricF0, base, metallic);
   glm::vec3 diffuse = ((1.0f - metallic) / kPi) * base;
   return diffuse + F0 * specularScale;
 }
 
 }  // namespace
 
-glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L) {
-  return brdf(base, metallic, roughness, N, V, L);
+glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L, glm::vec3 f0,
+                   float f90) {
+  return brdf(base, metallic, roughness, N, V, L, f0, f90);
 }
+
+namespace {
+
+float maxComponent(const glm::vec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+// f_r cos for light arriving from L: the base BRDF, then sheen over it and the clear coat on
+// top (common/scene/material_layers.h), each layer with the cosine of its own normal.
+glm::vec3 layeredLight(const scene::SurfaceMaterial& r, glm::vec3 V, glm::vec3 L) {
+  const glm::vec3 N = r.normal;
+  const float NdotL = glm::dot(N, L);
+  glm::vec3 out(0.0f);
+  if (NdotL > 0.0f) {
+    glm::vec3 f = brdf(r.baseColor, r.metallic, r.roughness, N, V, L, r.dielectricF0(), r.dielectricF90());
+    if (r.hasSheen()) {
+      const float NdotV = std::max(glm::dot(N, V), 1e-4f);
+      const float NdotH = glm::dot(N, glm::normalize(V + L));
+      const float scale = 1.0f - maxComponent(r.sheenColor) * std::max(scene::sheenAlbedo(r.sheenRoughness, NdotV),
+                                                                        scene::sheenAlbedo(r.sheenRoughness, NdotL));
+      f = f * scale + r.sheenColor * scene::sheenLobe(r.sheenRoughness, NdotH, NdotL, NdotV);
+    }
+    out = f * NdotL;
+  }
+  if (r.clearcoat > 0.0f) {
+    const glm::vec3& C = r.clearcoatNormal;
+    const float CdotV = std::max(glm::dot(C, V), 1e-4f), CdotL = glm::dot(C, L);
+    out *= 1.0f - r.clearcoat * scene::coatFresnel(CdotV);
+    if (CdotL > 0.0f) {
+      const glm::vec3 H = glm::normalize(V + L);
+      out += glm::vec3(r.clearcoat * scene::coatLobe(r.clearcoatRoughness, glm::dot(C, H), CdotL, CdotV, glm::dot(V, H)) * CdotL);
+    }
+  }
+  return out;
+}
+
+// Radiance reflected from the environment by image-based lighting: diffuse from the SH
+// irradiance, specular by the split sum, sheen and clear coat layered as under a light.
+glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMaterial& r, glm::vec3 V) {
+  const glm::vec3 N = r.normal;
+  const float NdotV = std::max(glm::dot(N, V), 1e-4f);
+  const glm::vec3 irradiance = ibl.irradiance(N);
+  const float roughness = std::max(r.roughness, kMinRoughness);
+  const glm::vec2 ab = specularAlbedo(NdotV, roughness);
+  const glm::vec3 F0 = glm::mix(r.dielectricF0(), r.baseColor, r.metallic);
+  const float F90 = r.dielectricF90() + (1.0f - r.dielectricF90()) * r.metallic;
+  const glm::vec3 R = 2.0f * glm::dot(N, V) * N - V;
+  glm::vec3 out = ((1.0f - r.metallic) / kPi) * r.baseColor * irradiance + ibl.prefiltered(R, roughness) * (F0 * ab.x + F90 * ab.y);
+  if (r.hasSheen()) {
+    const float albedo = scene::sheenAlbedo(r.sheenRoughness, NdotV);
+    out = out * (1.0f - maxComponent(r.sheenColor) * albedo) + r.sheenColor * (albedo / kPi) * irradiance;
+  }
+  if (r.clearcoat > 0.0f) {
+    const glm::vec3& C = r.clearcoatNormal;
+    const float CdotV = std::max(glm::dot(C, V), 1e-4f);
+    const float coatRoughness = std::max(r.clearcoatRoughness, kMinRoughness);
+    const glm::vec2 abc = specularAlbedo(CdotV, coatRoughness);
+    const glm::vec3 Rc = 2.0f * glm::dot(C, V) * C - V;
+    out = out * (1.0f - r.clearcoat * scene::coatFresnel(CdotV)) +
+          r.clearcoat * ibl.prefiltered(Rc, coatRoughness) * (0.04f * abc.x + abc.y);
+  }
+  return out;
+}
+
+}  // namespace
 
 glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeCounters* counters) {
   const scene::Scene& scene = *ctx.scene;
   const scene::Material& m = scene.materials[sp.material];
-  // A texture lookup the plan skips is counted, and the factor alone used.
-  auto texture = [&](const scene::TextureRef& ref, bool srgb) {
-    if (ctx.textures) return sampleSlot(scene, ref, sp.uv, srgb);
-    if (counters) ++counters->textureEvaluationsSkipped;
-    return glm::vec4(1.0f);
-  };
-  glm::vec4 base = m.baseColorFactor * sp.colour;
-  if (m.baseColorTexture.present()) base *= texture(m.baseColorTexture, true);
-  float metallic = m.metallicFactor, roughness = m.roughnessFactor;
-  if (m.metallicRoughnessTexture.present()) {
-    glm::vec4 mr = texture(m.metallicRoughnessTexture, false);
-    roughness *= mr.y;  // G channel
-    metallic *= mr.z;    // B channel
-  }
+  // Textures the plan skips are counted, and the factors alone used.
+  const scene::SurfaceMaterial r = scene::resolveMaterial(scene, sp.material, {sp.uv, sp.colour, sp.normal, sp.tangent},
+                                                          ctx.textures, counters ? &counters->textureEvaluationsSkipped : nullptr);
   glm::vec3 radiance(0.0f);
   if (ctx.emission) {
-    radiance = m.emission();
-    if (m.emissiveTexture.present()) radiance *= glm::vec3(texture(m.emissiveTexture, true));
+    radiance = r.emission;
   } else if (counters && m.isEmissive()) {
     ++counters->emissionSkipped;
   }
   if (!ctx.direct) {
-    if (counters) counters->lightSamplesSkipped += ctx.usesHeadlight ? 1 : ctx.lights.size();
+    if (counters) counters->lightSamplesSkipped += (ctx.usesHeadlight ? 1 : ctx.lights.size()) + (ctx.ibl ? 1 : 0);
     return radiance;
   }
 
   glm::vec3 V = ctx.view.perspective ? glm::normalize(ctx.view.eye - sp.position) : -ctx.view.forward;
-  glm::vec3 albedo(base);
+  const bool layered = r.hasSheen() || r.clearcoat > 0.0f;
   if (ctx.usesHeadlight) {
-    float NdotV = glm::dot(sp.normal, V);
-    if (NdotV > 0.0f) radiance += headlightBrdf(albedo, metallic, roughness, sp.normal, V) * (kHeadlightLux * NdotV);
+    const float NdotV = glm::dot(r.normal, V);
+    if (layered) radiance += layeredLight(r, V, V) * kHeadlightLux;
+    else if (NdotV > 0.0f)
+      radiance += headlightBrdf(r.baseColor, r.metallic, r.roughness, r.normal, V, r.dielectricF0()) * (kHeadlightLux * NdotV);
     return radiance;
   }
   for (const scene::PunctualLight& light : ctx.lights) {
     glm::vec3 L, E;
     if (!incidentLight(light, sp.position, L, E)) continue;
-    float NdotL = glm::dot(sp.normal, L);
+    if (layered) {
+      radiance += layeredLight(r, V, L) * E;
+      continue;
+    }
+    float NdotL = glm::dot(r.normal, L);
     if (NdotL <= 0.0f) continue;
-    radiance += brdf(albedo, metallic, roughness, sp.normal, V, L) * E * NdotL;
+    radiance += brdf(r.baseColor, r.metallic, r.roughness, r.normal, V, L, r.dielectricF0(), r.dielectricF90()) * E * NdotL;
   }
+  if (ctx.ibl) radiance += environmentLight(*ctx.ibl, r, V);
   return radiance;
 }
 
@@ -248,19 +314,20 @@ struct HeadlightMaterial {
   glm::vec3 f0{0.0f}, diffuse{0.0f}, emission{0.0f};
 };
 
-HeadlightMaterial headlightMaterial(const scene::Material& m) {
+HeadlightMaterial headlightMaterial(const scene::Scene& scene, uint32_t id) {
+  const scene::Material& m = scene.materials[id];
   HeadlightMaterial h;
-  h.fast = !m.baseColorTexture.present() && !m.metallicRoughnessTexture.present() && !m.emissiveTexture.present();
+  h.fast = !scene::usesTextures(m) && !m.hasSheen() && !m.hasClearcoat();
   // As shadeSurface and headlightBrdf compute them (sp.colour = 1 without vertex colours).
-  glm::vec3 base(m.baseColorFactor * glm::vec4(1.0f));
-  float r = std::max(m.roughnessFactor, kMinRoughness);
-  float alpha = r * r;
+  const scene::SurfaceMaterial r = scene::resolveMaterial(scene, id, {});
+  float rough = std::max(r.roughness, kMinRoughness);
+  float alpha = rough * rough;
   h.alpha2 = alpha * alpha;
   h.k = 0.5f * alpha;
   h.oneMinusK = 1.0f - h.k;
-  h.f0 = glm::mix(glm::vec3(0.04f), base, m.metallicFactor);
-  h.diffuse = ((1.0f - m.metallicFactor) / kPi) * base;
-  h.emission = m.emission();
+  h.f0 = glm::mix(r.dielectricF0(), r.baseColor, r.metallic);
+  h.diffuse = ((1.0f - r.metallic) / kPi) * r.baseColor;
+  h.emission = r.emission;
   return h;
 }
 
@@ -396,7 +463,7 @@ void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris
   std::vector<HeadlightMaterial> materials;
   if (lanes) {
     materials.reserve(scene.materials.size());
-    for (const scene::Material& m : scene.materials) materials.push_back(headlightMaterial(m));
+    for (uint32_t m = 0; m < scene.materials.size(); ++m) materials.push_back(headlightMaterial(scene, m));
   }
   const bool vertexNormals = !scene.normals.empty();
   LaneBatch batch;

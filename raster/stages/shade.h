@@ -1,11 +1,13 @@
 // Shading stage, the last stage of every pipeline (deferred: after all triangles of a region
 // are rasterized, each visible pixel is shaded once from the triangle that won its depth test).
-// Perspective-correct attributes, base-colour / metallic-roughness / emissive textures through
-// Texture::sample (bilinear, the sampler's wrap modes), the scene's punctual lights with
-// Lambert plus a GGX glossy lobe, emission; no shadows. Runs on the PE owning the framebuffer.
+// Perspective-correct attributes, the material resolved by scene::resolveMaterial (textures,
+// vertex colour, normal maps: the same as the ray tracers'), the scene's punctual lights with
+// Lambert plus a GGX glossy lobe under sheen and clear coat, the environment by image-based
+// lighting, emission; no shadows. Runs on the PE owning the framebuffer.
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -15,6 +17,7 @@
 #include "common/scene/light.h"
 #include "common/scene/scene.h"
 #include "raster/framebuffer.h"
+#include "raster/stages/image_based_light.h"
 #include "raster/stages/geometry.h"
 
 namespace pr::raster {
@@ -25,6 +28,7 @@ struct SurfacePoint {
   glm::vec3 normal{0.0f, 0.0f, 1.0f};  // unit; flipped towards the viewer on double-sided back faces
   glm::vec2 uv{0.0f};
   glm::vec4 colour{1.0f};    // COLOR_0, 1 when the scene has none
+  glm::vec4 tangent{0.0f};   // w = handedness; zero when the scene has no normal maps
   uint32_t material = 0;
 };
 
@@ -41,11 +45,13 @@ SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm
 struct ShadingContext {
   const scene::Scene* scene = nullptr;
   FrameView view;
-  // The scene's punctual lights. When it has none, a headlight: light arriving from the eye
-  // at every point (L = V) with pi lux, so that a white Lambertian surface facing the camera
-  // has radiance 1 and walls seen at an angle stay visible (a scene lit only by emission is
-  // still readable). usesHeadlight says so; lights is then empty.
+  // The scene's punctual lights, and its environment (--env, or the default light of a scene
+  // without lights) through image-based lighting. A scene with neither, or one without lights
+  // when the headlight is asked for, gets a headlight instead: light arriving from the eye at
+  // every point (L = V) with pi lux, so that a white Lambertian surface facing the camera has
+  // radiance 1. usesHeadlight says so; lights and ibl are then empty.
   std::vector<scene::PunctualLight> lights;
+  std::shared_ptr<const ImageBasedLight> ibl;
   bool usesHeadlight = false;
   // The RenderPlan's effects (common/scene/effect_analysis.h) this stage can skip: textures off
   // shades from the material factors, emission off adds no emitted radiance, direct off adds
@@ -54,13 +60,15 @@ struct ShadingContext {
 };
 
 ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view,
-                                  scene::EffectSet effects = scene::EffectSet::all());
+                                  scene::EffectSet effects = scene::EffectSet::all(), bool headlight = false);
 
 // BRDF value f_r(V, L) for the metallic-roughness model (glTF 2.0, Appendix B): Lambert
 // (1 - metallic) * base / pi plus the Cook-Torrance lobe D G F / (4 NdotL NdotV) with the GGX
 // distribution (alpha = roughness^2), Schlick-GGX geometry (k = alpha/2) and Schlick Fresnel
-// (F0 = mix(0.04, base, metallic)). N, V, L are unit vectors.
-glm::vec3 evalBrdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L);
+// from F0 = mix(f0, base, metallic) to F90 = mix(f90, 1, metallic), f0 and f90 the dielectric's
+// (0.04 and 1 in the core model; KHR_materials_specular changes them). N, V, L are unit vectors.
+glm::vec3 evalBrdf(glm::vec3 baseColor, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L,
+                   glm::vec3 f0 = glm::vec3(0.04f), float f90 = 1.0f);
 
 struct ShadeCounters {
   uint64_t pixelsShaded = 0;

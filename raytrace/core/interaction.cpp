@@ -48,6 +48,14 @@ SurfaceInteraction makeInteraction(const scene::Scene& scene, const Ray& ray, co
   }
   if (scene.uvs.size() == scene.positions.size())
     si.uv = b0 * scene.uvs[tri.v[0]] + b1 * scene.uvs[tri.v[1]] + b2 * scene.uvs[tri.v[2]];
+  if (scene.colors.size() == scene.positions.size())
+    si.colour = b0 * scene.colors[tri.v[0]] + b1 * scene.colors[tri.v[1]] + b2 * scene.colors[tri.v[2]];
+  if (scene.tangents.size() == scene.positions.size()) {
+    const glm::vec4 t0 = scene.tangents[tri.v[0]], t1 = scene.tangents[tri.v[1]], t2 = scene.tangents[tri.v[2]];
+    // The handedness is per vertex and the same over a primitive's triangle (MikkTSpace splits
+    // vertices where it changes); interpolating it would only blur the sign.
+    si.tangent = glm::vec4(glm::vec3(b0 * t0 + b1 * t1 + b2 * t2), t0.w);
+  }
   const float dirLen = glm::length(ray.direction);
   si.wo = dirLen > 0.0f ? -ray.direction / dirLen : glm::vec3(0.0f);
   si.material = tri.material;

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/scene/material_layers.h"
+#include "common/scene/surface_material.h"
 #include "raytrace/integrators/sampling.h"
 
 namespace pr::rt {
@@ -47,51 +49,39 @@ glm::vec3 ggxReflection(float alpha, const glm::vec3& wo, float u, float v) {
   return 2.0f * glm::dot(wo, h) * h - wo;
 }
 
-glm::vec4 textureLookup(const scene::Scene& scene, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
-  if (!ref.present() || size_t(ref.texture) >= scene.textures.size()) return glm::vec4(1.0f);
-  return scene.textures[size_t(ref.texture)].sample(ref.transformUv(uv), srgb);
-}
-
 }  // namespace
-
-bool usesTextures(const scene::Material& mat) {
-  return mat.baseColorTexture.present() || mat.metallicRoughnessTexture.present() || mat.transmissionTexture.present() ||
-         (mat.isEmissive() && mat.emissiveTexture.present()) || (mat.anisotropyStrength > 0.0f && mat.anisotropyTexture.present());
-}
 
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures) {
   const scene::Material& mat = scene.materials[si.material];
-  auto textureOr = [&](const scene::Scene& sc, const scene::TextureRef& ref, glm::vec2 uv, bool srgb) {
-    return textures ? textureLookup(sc, ref, uv, srgb) : glm::vec4(1.0f);
-  };
+  scene::SurfaceGeometry at;
+  at.uv = si.uv;
+  at.colour = si.colour;
+  at.normal = si.shadingNormal;
+  at.tangent = si.tangent;
+  const scene::SurfaceMaterial r = scene::resolveMaterial(scene, si.material, at, textures);
   ShadingMaterial m;
-  const glm::vec4 base = mat.baseColorFactor * textureOr(scene, mat.baseColorTexture, si.uv, true);
-  m.baseColor = glm::clamp(glm::vec3(base), 0.0f, 1.0f);
-  const glm::vec4 mr = textureOr(scene, mat.metallicRoughnessTexture, si.uv, false);
-  m.metallic = std::clamp(mat.metallicFactor * mr.z, 0.0f, 1.0f);
-  m.roughness = std::clamp(mat.roughnessFactor * mr.y, 0.0f, 1.0f);
+  m.baseColor = r.baseColor;
+  m.metallic = r.metallic;
+  m.roughness = r.roughness;
   m.alpha = m.roughness * m.roughness;
-  m.transmission = std::clamp(mat.transmissionFactor * textureOr(scene, mat.transmissionTexture, si.uv, false).x, 0.0f, 1.0f);
-  // An ior of 1 (or a nonsensical one) would make refraction the identity or undefined.
+  m.transmission = r.transmission;
+  // Refraction with an ior of 1 (or a nonsensical one) would be the identity or undefined;
+  // the Fresnel terms below use the material's own ior.
   m.ior = std::isfinite(mat.ior) && mat.ior > 1.0001f ? mat.ior : 1.5f;
-  if (mat.isEmissive())
-    m.emission = glm::max(mat.emission() * glm::vec3(textureOr(scene, mat.emissiveTexture, si.uv, true)), glm::vec3(0.0f));
+  m.emission = r.emission;
   m.doubleSided = mat.doubleSided;
-  if (mat.anisotropyStrength > 0.0f) {
-    // The texture's RG is a tangent-space direction in [-1, 1]^2 and B scales the strength;
-    // the rotation turns the direction counter-clockwise (KHR_materials_anisotropy).
-    glm::vec2 dir(1.0f, 0.0f);
-    float strength = mat.anisotropyStrength;
-    if (textures && mat.anisotropyTexture.present()) {
-      const glm::vec4 t = textureOr(scene, mat.anisotropyTexture, si.uv, false);
-      const glm::vec2 d = glm::vec2(t) * 2.0f - 1.0f;
-      if (glm::dot(d, d) > 1.0e-8f) dir = glm::normalize(d);
-      strength *= t.z;
-    }
-    const float c = std::cos(mat.anisotropyRotation), s = std::sin(mat.anisotropyRotation);
-    m.anisotropyDirection = glm::vec2(c * dir.x - s * dir.y, s * dir.x + c * dir.y);
-    m.anisotropy = std::clamp(strength, 0.0f, 1.0f);
-  }
+  m.anisotropy = r.anisotropy;
+  m.anisotropyDirection = r.anisotropyDirection;
+  m.dielectricF0 = r.dielectricF0();
+  m.dielectricF90 = r.dielectricF90();
+  // A normal map may bend the normal below the geometric surface; shading then keeps the
+  // interpolated one, as makeInteraction keeps the geometric side.
+  m.normal = glm::dot(r.normal, si.geometricNormal) > 0.0f ? r.normal : si.shadingNormal;
+  m.sheenColor = r.sheenColor;
+  m.sheenRoughness = r.sheenRoughness;
+  m.clearcoat = r.clearcoat;
+  m.clearcoatRoughness = r.clearcoatRoughness;
+  m.clearcoatNormalWorld = glm::dot(r.clearcoatNormal, si.geometricNormal) > 0.0f ? r.clearcoatNormal : si.shadingNormal;
   return m;
 }
 
@@ -99,10 +89,14 @@ glm::vec3 emittedRadiance(const ShadingMaterial& m, const SurfaceInteraction& si
   return (si.frontFace || m.doubleSided) ? m.emission : glm::vec3(0.0f);
 }
 
-glm::vec3 fresnelSchlick(const glm::vec3& f0, float cosTheta) {
+glm::vec3 fresnelSchlick(const glm::vec3& f0, float cosTheta, float f90) {
   const float c = std::clamp(1.0f - cosTheta, 0.0f, 1.0f);
   const float c2 = c * c;
-  return f0 + (glm::vec3(1.0f) - f0) * (c2 * c2 * c);
+  return f0 + (glm::vec3(f90) - f0) * (c2 * c2 * c);
+}
+
+glm::vec3 ShadingMaterial::specularFresnel(float cosTheta) const {
+  return fresnelSchlick(specularF0(), cosTheta, specularF90());
 }
 
 float fresnelDielectric(float cosI, float eta) {
@@ -126,7 +120,7 @@ bool refractDirection(const glm::vec3& w, const glm::vec3& n, float eta, glm::ve
 
 float specularProbability(const ShadingMaterial& m, float cosO) {
   if (!m.hasSpecular()) return 0.0f;
-  const float ws = luminance(fresnelSchlick(m.specularF0(), cosO));
+  const float ws = luminance(m.specularFresnel(cosO));
   const float wd = luminance(m.diffuseColor());
   return ws + wd > 0.0f ? ws / (ws + wd) : 0.0f;
 }
@@ -136,7 +130,7 @@ glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::v
   const glm::vec3 h = glm::normalize(wo + wi);
   const float d = ggxD(m.alpha, h.z);
   const float g = ggxG1(m.alpha, wo.z) * ggxG1(m.alpha, wi.z);
-  return fresnelSchlick(m.specularF0(), glm::dot(wo, h)) * (d * g / (4.0f * wo.z * wi.z));
+  return m.specularFresnel(glm::dot(wo, h)) * (d * g / (4.0f * wo.z * wi.z));
 }
 
 BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v) {
@@ -151,35 +145,93 @@ BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, 
   return s;
 }
 
-glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
-  if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
-  return m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi);
+namespace {
+
+float maxComponent3(const glm::vec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+// The base (diffuse + GGX) with the sheen layer over it: the base loses what the sheen's
+// directional albedo takes, so the pair never reflects more than the base alone could.
+glm::vec3 evalBaseAndSheen(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  glm::vec3 f = m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi);
+  if (!m.hasSheen()) return f;
+  const glm::vec3 h = glm::normalize(wo + wi);
+  const float r = m.sheenRoughness;
+  const float scale = 1.0f - maxComponent3(m.sheenColor) * std::max(scene::sheenAlbedo(r, wo.z), scene::sheenAlbedo(r, wi.z));
+  return f * scale + m.sheenColor * scene::sheenLobe(r, h.z, wi.z, wo.z);
 }
 
-float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
-  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+// The clear coat's share of the reflection towards wo (its Fresnel term times its factor).
+float coatWeight(const ShadingMaterial& m, const glm::vec3& wo) {
+  if (!m.hasClearcoat()) return 0.0f;
+  return m.clearcoat * scene::coatFresnel(std::max(glm::dot(m.clearcoatNormal, wo), 0.0f));
+}
+
+glm::vec3 evalCoat(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  const glm::vec3& n = m.clearcoatNormal;
+  const glm::vec3 h = glm::normalize(wo + wi);
+  return glm::vec3(m.clearcoat * scene::coatLobe(m.clearcoatRoughness, glm::dot(n, h), glm::dot(n, wi), glm::dot(n, wo),
+                                                 glm::dot(wo, h)));
+}
+
+// Pdf of a GGX reflection about the coat normal.
+float coatPdf(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  const glm::vec3 h = glm::normalize(wo + wi);
+  const float oh = glm::dot(wo, h);
+  const float nh = glm::dot(m.clearcoatNormal, h);
+  if (oh <= 0.0f || nh <= 0.0f) return 0.0f;
+  return ggxD(scene::coatAlpha(m.clearcoatRoughness), nh) * nh / (4.0f * oh);
+}
+
+// The base layer's pdf (diffuse cosine and GGX, by specularProbability).
+float pdfBase(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   const float ps = specularProbability(m, wo.z);
   float pdf = (1.0f - ps) * wi.z * kInvPi;
   if (ps > 0.0f && !m.deltaSpecular()) pdf += ps * ggxPdf(m.alpha, wo, wi);
   return pdf;
 }
 
+}  // namespace
+
+float coatProbability(const ShadingMaterial& m, const glm::vec3& wo) { return std::min(coatWeight(m, wo), 0.9f); }
+
+glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
+  const glm::vec3 base = evalBaseAndSheen(m, wo, wi);
+  if (!m.hasClearcoat()) return base;
+  return base * (1.0f - coatWeight(m, wo)) + evalCoat(m, wo, wi);
+}
+
+float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  const float pc = coatProbability(m, wo);
+  const float base = pdfBase(m, wo, wi);
+  return pc > 0.0f ? pc * coatPdf(m, wo, wi) + (1.0f - pc) * base : base;
+}
+
 BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v) {
   BsdfSample s;
   if (wo.z <= 0.0f) return s;
-  const float ps = specularProbability(m, wo.z);
-  if (lobe < ps) {
-    if (m.deltaSpecular()) {
-      // Perfect mirror: f cos / pdf = F / (probability of this lobe).
-      s.wi = glm::vec3(-wo.x, -wo.y, wo.z);
-      s.weight = fresnelSchlick(m.specularF0(), wo.z) / ps;
-      s.delta = true;
-      s.valid = true;
-      return s;
-    }
-    s.wi = ggxReflection(m.alpha, wo, u, v);
+  const float pc = coatProbability(m, wo);
+  if (lobe < pc) {
+    // The coat's GGX lobe about its own normal.
+    const Frame coat(m.clearcoatNormal);
+    s.wi = coat.toWorld(ggxReflection(scene::coatAlpha(m.clearcoatRoughness), coat.toLocal(wo), u, v));
   } else {
-    s.wi = cosineHemisphere(u, v);
+    lobe = pc > 0.0f ? std::min((lobe - pc) / (1.0f - pc), 0.99999994f) : lobe;
+    const float ps = specularProbability(m, wo.z);
+    if (lobe < ps) {
+      if (m.deltaSpecular()) {
+        // Perfect mirror: f cos / pdf = F / (probability of this lobe), under the coat's share.
+        s.wi = glm::vec3(-wo.x, -wo.y, wo.z);
+        s.weight = m.specularFresnel(wo.z) * ((1.0f - coatWeight(m, wo)) / (ps * (1.0f - pc)));
+        s.delta = true;
+        s.valid = isFinite(s.weight);
+        return s;
+      }
+      s.wi = ggxReflection(m.alpha, wo, u, v);
+    } else {
+      s.wi = cosineHemisphere(u, v);
+    }
   }
   if (s.wi.z <= 0.0f) return s;
   s.pdf = pdfOpaque(m, wo, s.wi);

@@ -1,12 +1,15 @@
-// The glTF material at a hit as the integrators see it: textures resolved, and the BSDF it
-// stands for — a Lambertian diffuse part, a GGX microfacet specular part whose roughness makes
-// the glossy lobe (a mirror below kDeltaAlpha), and a smooth dielectric part for transmission.
+// The glTF material at a hit as the integrators see it: resolved by the shared
+// scene::resolveMaterial (textures, vertex colour, normal maps), and the BSDF it stands for - a
+// Lambertian diffuse part, a GGX microfacet specular part whose roughness makes the glossy lobe
+// (a mirror below kDeltaAlpha), a smooth dielectric part for transmission, and the sheen and
+// clear-coat layers over the opaque part (common/scene/material_layers.h).
 // Evaluated by the PE that shades the hit; shared by the Whitted and path-tracing integrators.
 #pragma once
 
 #include <glm/glm.hpp>
 
 #include "common/scene/scene.h"
+#include "common/scene/surface_material.h"
 #include "raytrace/core/interaction.h"
 
 namespace pr::rt {
@@ -31,6 +34,18 @@ struct ShadingMaterial {
   // ignores them; the photon map's Ward lobe reads them.
   float anisotropy = 0.0f;
   glm::vec2 anisotropyDirection{1.0f, 0.0f};
+  // KHR_materials_specular: the dielectric Fresnel's F0 and F90 (0.04 and 1 without it).
+  glm::vec3 dielectricF0{0.04f};
+  float dielectricF90 = 1.0f;
+  // The shading normal with the normal map applied (world space, on the geometric front side).
+  glm::vec3 normal{0.0f, 0.0f, 1.0f};
+  // KHR_materials_sheen and KHR_materials_clearcoat layers.
+  glm::vec3 sheenColor{0.0f};
+  float sheenRoughness = 0.0f;
+  float clearcoat = 0.0f;
+  float clearcoatRoughness = 0.0f;
+  glm::vec3 clearcoatNormalWorld{0.0f, 0.0f, 1.0f};
+  glm::vec3 clearcoatNormal{0.0f, 0.0f, 1.0f};  // in the local shading frame (set by ShadingFrame)
 
   // Weight of the Lambertian part: the non-metallic, non-transmissive share of baseColor.
   glm::vec3 diffuseColor() const { return (1.0f - metallic) * (1.0f - transmission) * baseColor; }
@@ -38,15 +53,25 @@ struct ShadingMaterial {
   // dielectric (roughness 1) is taken as pure Lambertian so its albedo is exactly baseColor
   // (the white-furnace test relies on it), as in Jensen's purely diffuse Cornell walls.
   glm::vec3 specularF0() const {
-    const float dielectric = roughness < 1.0f ? 0.04f : 0.0f;
-    return glm::mix(glm::vec3(dielectric) * (1.0f - transmission), baseColor, metallic);
+    const glm::vec3 dielectric = roughness < 1.0f ? dielectricF0 : glm::vec3(0.0f);
+    return glm::mix(dielectric * (1.0f - transmission), baseColor, metallic);
   }
-  // No specular lobe at all when F0 is zero (a fully rough dielectric): Schlick's grazing
-  // term would otherwise add a little reflection on top of the Lambertian albedo.
+  // Reflectance at grazing incidence: 1 for metals, specularFactor for dielectrics (with the
+  // same fully-rough exception as F0).
+  float specularF90() const {
+    const float dielectric = roughness < 1.0f ? dielectricF90 : 0.0f;
+    return dielectric * (1.0f - transmission) * (1.0f - metallic) + metallic;
+  }
+  // No specular lobe at all when F0 and F90 are zero (a fully rough dielectric, or
+  // specularFactor 0): the material is then exactly Lambertian.
   bool hasSpecular() const {
     const glm::vec3 f0 = specularF0();
-    return f0.x > 0.0f || f0.y > 0.0f || f0.z > 0.0f;
+    return f0.x > 0.0f || f0.y > 0.0f || f0.z > 0.0f || specularF90() > 0.0f;
   }
+  // The specular lobe's Fresnel term at cosine cosTheta (Schlick from F0 to F90).
+  glm::vec3 specularFresnel(float cosTheta) const;
+  bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
+  bool hasClearcoat() const { return clearcoat > 0.0f; }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }
   // Share of the smooth dielectric (refracting) part.
   float dielectricWeight() const { return transmission * (1.0f - metallic); }
@@ -54,16 +79,15 @@ struct ShadingMaterial {
 
 // textures = false evaluates the material from its factors alone (the plan's textures off).
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures = true);
-// Whether evalMaterial reads a texture for this material (base colour, metallic-roughness,
-// transmission, emission or anisotropy).
-bool usesTextures(const scene::Material& material);
+using scene::usesTextures;
 
 // Radiance emitted towards wo: the material's emission on its front side (both sides when
 // double-sided), zero otherwise.
 glm::vec3 emittedRadiance(const ShadingMaterial& m, const SurfaceInteraction& si);
 
-// Schlick's approximation of the conductor/dielectric Fresnel term (glTF 2.0 appendix B).
-glm::vec3 fresnelSchlick(const glm::vec3& f0, float cosTheta);
+// Schlick's approximation of the conductor/dielectric Fresnel term (glTF 2.0 appendix B),
+// rising from f0 at normal incidence to f90 at grazing.
+glm::vec3 fresnelSchlick(const glm::vec3& f0, float cosTheta, float f90 = 1.0f);
 // Exact unpolarised Fresnel reflectance of a smooth dielectric interface; eta = n_t / n_i,
 // cosI > 0 on the incident side. Returns 1 for total internal reflection.
 float fresnelDielectric(float cosI, float eta);
@@ -94,5 +118,7 @@ glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::v
 BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v);
 // Probability that sampleOpaque picks the specular lobe (from Fresnel and diffuse luminance).
 float specularProbability(const ShadingMaterial& m, float cosO);
+// Probability that sampleOpaque picks the clear-coat lobe (its Fresnel weight towards wo).
+float coatProbability(const ShadingMaterial& m, const glm::vec3& wo);
 
 }  // namespace pr::rt

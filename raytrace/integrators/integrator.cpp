@@ -22,9 +22,17 @@ IntegratorContext::IntegratorContext(const scene::Scene& scene, const scene::Cam
            "max depth out of range: " + std::to_string(options.maxDepth));
 }
 
-ShadingFrame::ShadingFrame(const SurfaceInteraction& si)
+ShadingFrame::ShadingFrame(const SurfaceInteraction& si) : ShadingFrame(si, si.shadingNormal) {}
+
+ShadingFrame::ShadingFrame(const SurfaceInteraction& si, ShadingMaterial& m) : ShadingFrame(si, m.normal) {
+  if (!m.hasClearcoat()) return;
+  const glm::vec3 coat = si.frontFace ? m.clearcoatNormalWorld : -m.clearcoatNormalWorld;
+  m.clearcoatNormal = glm::dot(coat, si.wo) > 1.0e-6f ? frame.toLocal(coat) : glm::vec3(0.0f, 0.0f, 1.0f);
+}
+
+ShadingFrame::ShadingFrame(const SurfaceInteraction& si, const glm::vec3& shadingNormal)
     : ng(si.frontFace ? si.geometricNormal : -si.geometricNormal),
-      ns(si.frontFace ? si.shadingNormal : -si.shadingNormal),
+      ns(si.frontFace ? shadingNormal : -shadingNormal),
       frame(ns),
       woLocal(0.0f) {
   // Interpolated normals can put wo below the shading hemisphere at silhouettes; the

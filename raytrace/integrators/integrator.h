@@ -127,11 +127,17 @@ class IntegratorContext {
 
 // The shading frame on the side of wo: geometric and shading normals flipped to the side the
 // ray came from, the shading normal replaced by the geometric one when wo is below it.
+// Given the material, its normal-mapped normal is the shading normal, and the material's
+// clear-coat normal is expressed in the frame.
 struct ShadingFrame {
   glm::vec3 ng, ns;
   Frame frame;
   glm::vec3 woLocal;
   explicit ShadingFrame(const SurfaceInteraction& si);
+  ShadingFrame(const SurfaceInteraction& si, ShadingMaterial& m);
+
+ private:
+  ShadingFrame(const SurfaceInteraction& si, const glm::vec3& shadingNormal);
 };
 
 struct TraceStats;  // trace_stats.h

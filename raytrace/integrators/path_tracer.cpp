@@ -21,14 +21,16 @@ constexpr float kMaxSurvival = 0.95f;
 
 void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
   const IntegratorContext& ctx = context();
-  const ShadingMaterial m = ctx.material(si, out);
+  ShadingMaterial m = ctx.material(si, out);
 
   // Emission: full weight for camera rays and after delta events; otherwise MIS against the
   // light sample taken at the previous vertex (power heuristic).
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (maxComponent(le) > 0.0f) {
     float weight = 1.0f;
-    if (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f) {
+    if (msg.kind == RayKind::Continuation && msg.bsdfPdf < 0.0f) {
+      weight = 0.0f;  // light sampling at the previous vertex took this light in full (no MIS)
+    } else if (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f) {
       const float distance = si.t * glm::length(msg.ray.direction);
       const float cosLight = std::fabs(glm::dot(si.geometricNormal, si.wo));
       const float pl = ctx.lights().areaPdf(si.triangle, distance, cosLight);
@@ -38,10 +40,18 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
   }
   if (msg.depth >= ctx.options().maxDepth) return;
 
-  const ShadingFrame sf(si);
+  const ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
-  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, true, out);
+  // MIS between light and BSDF sampling needs both: when the plan skips a rough lobe's
+  // continuation (indirect or glossy off), light sampling alone carries the direct light
+  // (also the environment's, which no surface analysis sees), and a continuation still spawned
+  // must not add the light it reaches again: it carries bsdfPdf < 0.
+  const float ps = specularProbability(m, sf.woLocal.z);
+  const bool diffuseLobe = ps < 1.0f, glossyLobe = (ps > 0.0f && !m.deltaSpecular()) || m.hasClearcoat();
+  const bool mis = (!diffuseLobe || ctx.simulates(scene::Effect::IndirectDiffuse)) &&
+                   (!glossyLobe || ctx.simulates(scene::Effect::GlossySpecular));
+  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, mis, out);
 
   // Choose the part: the dielectric with probability `dielectric` (its selection probability
   // cancels its weight), else the opaque lobes.
@@ -49,7 +59,7 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
   // A path that arrived by a diffuse or glossy bounce (a non-delta BSDF sample, bsdfPdf > 0)
   // and continues through an ideal mirror or a refraction is a caustic path (L S+ D E read
   // from the light).
-  const bool afterRoughBounce = msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f;
+  const bool afterRoughBounce = msg.kind == RayKind::Continuation && msg.bsdfPdf != 0.0f;
   auto skip = [&](uint64_t TraceStats::*counter) { ++(out.stats().*counter); };
   glm::vec3 wi;
   glm::vec3 throughput;
@@ -72,8 +82,13 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
     }
   } else {
     const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, kOneMinusEpsilon);
-    // The lobe sampleOpaque will take for u (its own test): specular below the probability.
-    if (u < specularProbability(m, sf.woLocal.z)) {
+    // The lobe sampleOpaque will take for u (its own test): the clear coat below its
+    // probability, then (u rescaled) specular below the specular probability.
+    const float pc = coatProbability(m, sf.woLocal);
+    const float ub = pc > 0.0f ? (u - pc) / (1.0f - pc) : u;
+    if (u < pc) {
+      if (!ctx.simulates(scene::Effect::GlossySpecular)) return skip(&TraceStats::glossyRaysSkipped);
+    } else if (ub < ps) {
       if (m.deltaSpecular()) {
         if (!ctx.simulates(scene::Effect::IdealSpecular)) return skip(&TraceStats::specularRaysSkipped);
         if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
@@ -89,7 +104,7 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
     // A reflection must leave on the side it arrived from (no leaks through the surface).
     if (glm::dot(wi, sf.ng) <= 0.0f) return;
     throughput = msg.throughput * s.weight;
-    pdf = s.delta ? 0.0f : s.pdf * opaque;
+    pdf = s.delta ? 0.0f : mis ? s.pdf * opaque : -1.0f;
   }
 
   // Russian roulette (Arvo and Kirk 1990): survive with q = max throughput component.
@@ -104,6 +119,7 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, 
 
 void PathIntegrator::miss(const RayMessage& msg, Emit& out) const {
   const scene::Environment* env = context().scene().environment.get();
+  if (msg.kind == RayKind::Continuation && msg.bsdfPdf < 0.0f) return;  // its light was sampled in full
   if (msg.kind == RayKind::Shadow || !env || msg.kind != RayKind::Continuation || !(msg.bsdfPdf > 0.0f)) {
     Integrator::miss(msg, out);
     return;

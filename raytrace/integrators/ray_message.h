@@ -31,7 +31,8 @@ struct RayMessage {
   RayKind kind = RayKind::Camera;
   // Solid-angle pdf of the BSDF sample that made this ray, for multiple importance sampling
   // of the emitter it may hit; 0 after a specular (delta) event or for camera rays, which
-  // count emission fully.
+  // count emission fully; negative after a rough bounce whose vertex sampled the lights
+  // without MIS, so that the light it reaches counts not at all.
   float bsdfPdf = 0.0f;
 };
 

@@ -16,21 +16,21 @@ constexpr float kMinThroughput = 1.0f / 4096.0f;
 
 void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
   const IntegratorContext& ctx = context();
-  const ShadingMaterial m = ctx.material(si, out);
+  ShadingMaterial m = ctx.material(si, out);
   // Every ray of a Whitted tracer reaches an emitter only through camera, mirror or
   // refraction paths, which light sampling never covers, so emission counts fully.
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= ctx.options().maxDepth) return;
 
-  const ShadingFrame sf(si);
+  const ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
   ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out);
 
   // Mirror-like metals and smooth dielectric coats: one ideal reflection ray.
   if (opaque > 0.0f && m.deltaSpecular()) {
-    const glm::vec3 f = fresnelSchlick(m.specularF0(), sf.woLocal.z) * opaque;
+    const glm::vec3 f = m.specularFresnel(sf.woLocal.z) * opaque;
     const glm::vec3 t = msg.throughput * f;
     if (maxComponent(t) > kMinThroughput) {
       const glm::vec3 wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));

@@ -49,9 +49,7 @@ inline constexpr uint64_t kTriangleVertexBytes =
 // The replicated, read-only part of the scene every PE shades with: everything but the
 // geometry (vertices, triangles, objects), counted as one broadcast per PE.
 inline uint64_t shadingDataBytes(const scene::Scene& s) {
-  const uint64_t geometry = s.positions.size() * sizeof(glm::vec3) + s.normals.size() * sizeof(glm::vec3) +
-                            s.uvs.size() * sizeof(glm::vec2) + s.colors.size() * sizeof(glm::vec4) +
-                            s.triangles.size() * sizeof(scene::Triangle) + s.objects.size() * sizeof(scene::Object);
+  const uint64_t geometry = s.geometryBytes();
   const uint64_t all = s.memoryBytes();
   return all > geometry ? all - geometry : 0;
 }

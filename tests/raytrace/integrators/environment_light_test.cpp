@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "common/parallel/runtime.h"
+#include "common/scene/effect_analysis.h"
 #include "raytrace/integrators/integrator_scenes.h"
 #include "raytrace/partition/partition.h"
 
@@ -23,8 +24,10 @@ scene::Scene furnace(float albedo, float radiance) {
   return s;
 }
 
-image::Image render(const scene::Scene& s, rt::IntegratorKind kind, const std::string& partition, int pes, int spp) {
+image::Image render(const scene::Scene& s, rt::IntegratorKind kind, const std::string& partition, int pes, int spp,
+                    scene::EffectSet effects = scene::EffectSet::all()) {
   rt::TraceOptions o;
+  o.integrator.effects = effects;
   o.integrator.kind = kind;
   o.integrator.spp = spp;
   o.integrator.maxDepth = 8;
@@ -54,6 +57,23 @@ TEST_CASE("EnvironmentLight: the white furnace reflects rho L, background L, for
     CHECK(sum / n == doctest::Approx(rho * l).epsilon(0.01));
     CHECK(img.pixels[0].x == doctest::Approx(l));
   }
+}
+
+TEST_CASE("EnvironmentLight: the furnace stays rho L when the plan turns indirect light off") {
+  // A convex sphere receives no light from another surface, so the analysis turns indirect
+  // (and glossy) continuations off; the environment's direct light must then come from light
+  // sampling in full, not from an MIS share whose BSDF half is never traced.
+  const float rho = 0.6f, l = 2.0f;
+  const scene::Scene s = furnace(rho, l);
+  const scene::Camera camera = test::perspectiveAt(glm::vec3(0.0f), 0.6f);
+  const scene::RenderPlan plan = scene::analyzeEffects(s, &camera);
+  REQUIRE_FALSE(plan.enabled().has(scene::Effect::IndirectDiffuse));
+  const image::Image img = render(s, rt::IntegratorKind::Path, "sequential", 1, 256, plan.enabled());
+  double sum = 0.0;
+  int n = 0;
+  for (int y = kN / 2 - 6; y < kN / 2 + 6; ++y)
+    for (int x = kN / 2 - 6; x < kN / 2 + 6; ++x, ++n) sum += img.pixels[size_t(y * kN + x)].x;
+  CHECK(sum / n == doctest::Approx(rho * l).epsilon(0.01));
 }
 
 TEST_CASE("EnvironmentLight: every tracer gives the same image under an environment") {

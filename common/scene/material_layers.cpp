@@ -1,0 +1,96 @@
+// Sheen and clear-coat lobes (see material_layers.h).
+#include "common/scene/material_layers.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+
+namespace pr::scene {
+
+namespace {
+
+constexpr float kPi = std::numbers::pi_v<float>;
+// Below this a the Charlie lobe's exponent 1/a overflows sin^(1/a) to a spike nothing samples.
+constexpr float kMinSheenAlpha = 0.07f * 0.07f;
+
+float sheenAlpha(float roughness) { return std::max(roughness * roughness, kMinSheenAlpha); }
+
+float smithG1(float alpha, float c) {
+  if (c <= 0.0f) return 0.0f;
+  const float a2 = alpha * alpha;
+  return 2.0f * c / (c + std::sqrt(a2 + (1.0f - a2) * c * c));
+}
+
+// E_sheen on a grid of NdotV x roughness, integrated once by the midpoint rule in (cos theta, phi).
+constexpr int kAlbedoSize = 32;
+using AlbedoTable = std::array<float, kAlbedoSize * kAlbedoSize>;
+
+AlbedoTable integrateAlbedo() {
+  AlbedoTable table{};
+  constexpr int kTheta = 96, kPhi = 48;
+  for (int r = 0; r < kAlbedoSize; ++r) {
+    const float roughness = float(r) / float(kAlbedoSize - 1);
+    for (int v = 0; v < kAlbedoSize; ++v) {
+      const float cosV = std::max(float(v) / float(kAlbedoSize - 1), 1.0e-3f);
+      const float sinV = std::sqrt(1.0f - cosV * cosV);
+      double sum = 0.0;
+      for (int i = 0; i < kTheta; ++i) {
+        const float cosL = (float(i) + 0.5f) / float(kTheta);
+        const float sinL = std::sqrt(1.0f - cosL * cosL);
+        for (int j = 0; j < kPhi; ++j) {
+          const float phi = kPi * (float(j) + 0.5f) / float(kPhi);  // symmetric in phi: half the circle, twice
+          // V = (sinV, 0, cosV), L = (sinL cos phi, sinL sin phi, cosL), H = normalize(V + L).
+          const float hx = sinV + sinL * std::cos(phi), hy = sinL * std::sin(phi), hz = cosV + cosL;
+          const float cosH = hz / std::sqrt(hx * hx + hy * hy + hz * hz);
+          sum += double(sheenLobe(roughness, cosH, cosL, cosV) * cosL);
+        }
+      }
+      table[size_t(r * kAlbedoSize + v)] = float(sum * (2.0 * kPi / kPhi) / kTheta);
+    }
+  }
+  return table;
+}
+
+}  // namespace
+
+float sheenLobe(float roughness, float NdotH, float NdotL, float NdotV) {
+  if (NdotL <= 0.0f || NdotV <= 0.0f) return 0.0f;
+  const float a = sheenAlpha(roughness);
+  const float sin2 = std::max(0.0f, 1.0f - NdotH * NdotH);
+  const float d = (2.0f + 1.0f / a) * std::pow(sin2, 0.5f / a) / (2.0f * kPi);
+  const float vis = 1.0f / (4.0f * (NdotL + NdotV - NdotL * NdotV));
+  return d * vis;
+}
+
+float sheenAlbedo(float roughness, float NdotV) {
+  static const AlbedoTable table = integrateAlbedo();
+  const float x = std::clamp(NdotV, 0.0f, 1.0f) * float(kAlbedoSize - 1);
+  const float y = std::clamp(roughness, 0.0f, 1.0f) * float(kAlbedoSize - 1);
+  const int x0 = std::min(int(x), kAlbedoSize - 2), y0 = std::min(int(y), kAlbedoSize - 2);
+  const float fx = x - float(x0), fy = y - float(y0);
+  auto at = [&](int r, int v) { return table[size_t(r * kAlbedoSize + v)]; };
+  const float lo = at(y0, x0) * (1.0f - fx) + at(y0, x0 + 1) * fx;
+  const float hi = at(y0 + 1, x0) * (1.0f - fx) + at(y0 + 1, x0 + 1) * fx;
+  return std::clamp(lo * (1.0f - fy) + hi * fy, 0.0f, 1.0f);
+}
+
+float coatFresnel(float cosTheta) {
+  const float c = std::clamp(1.0f - cosTheta, 0.0f, 1.0f);
+  const float c2 = c * c;
+  return 0.04f + 0.96f * (c2 * c2 * c);
+}
+
+float coatAlpha(float roughness) { return std::max(roughness * roughness, 2.0e-3f); }
+
+float coatLobe(float roughness, float NdotH, float NdotL, float NdotV, float VdotH) {
+  if (NdotL <= 0.0f || NdotV <= 0.0f || NdotH <= 0.0f) return 0.0f;
+  const float alpha = coatAlpha(roughness);
+  const float a2 = alpha * alpha;
+  const float d = NdotH * NdotH * (a2 - 1.0f) + 1.0f;
+  const float D = a2 / (kPi * d * d);
+  const float G = smithG1(alpha, NdotL) * smithG1(alpha, NdotV);
+  return D * G * coatFresnel(VdotH) / (4.0f * NdotL * NdotV);
+}
+
+}  // namespace pr::scene
