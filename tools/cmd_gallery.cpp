@@ -45,7 +45,7 @@ struct GalleryArgs {
 // The glTF files under dir, in path order.
 std::vector<fs::path> findModels(const fs::path& dir) {
   std::vector<fs::path> out;
-  for (const auto& e : fs::recursive_directory_iterator(dir, fs::directory_options::skip_permission_denied)) {
+  for (const auto& e : fs::recursive_directory_iterator(dir, fs::directory_options::skip_permission_denied | fs::directory_options::follow_directory_symlink)) {
     const std::string ext = e.path().extension().string();
     if (e.is_regular_file() && (ext == ".gltf" || ext == ".glb")) out.push_back(e.path());
   }

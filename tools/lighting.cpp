@@ -1,6 +1,7 @@
 // Lighting options (see lighting.h).
 #include "tools/lighting.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -23,6 +24,18 @@ scene::Scene loadScene(const std::string& path, const LightingOptions& o) {
   return scene::loadGltf(path, scene::LoadOptions{o.variant});
 }
 
+namespace {
+
+// An emitter bright enough to light a scene: above 1 nit in some channel. glTF's emissive
+// factor alone stops at 1 (a glowing sign or screen, as bright as a white surface under the
+// default light); a lamp needs KHR_materials_emissive_strength to pass it.
+bool isLamp(const scene::Material& m) {
+  const glm::vec3 e = m.emission();
+  return std::max(e.x, std::max(e.y, e.z)) > 1.0f;
+}
+
+}  // namespace
+
 std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
   constexpr float kDegrees = 3.14159265358979323846f / 180.0f;
   if (!o.env.empty()) {
@@ -31,8 +44,10 @@ std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
         image, o.strength, o.rotateDegrees * kDegrees, o.env));
     return "lighting: the scene's lights and the environment " + o.env;
   }
-  const bool lit = !scene.lights.empty() || !scene.areaLights.empty();
-  if (lit) return "lighting: the scene's own lights";
+  if (!scene.lights.empty() || std::any_of(scene.areaLights.begin(), scene.areaLights.end(), [&](const scene::AreaLight& a) {
+        return isLamp(scene.materials[scene.triangles[a.triangle].material]);
+      }))
+    return "lighting: the scene's own lights";
   if (o.noDefault) return "lighting: none (the scene has no lights; --no-default-light)";
   scene.environment = std::make_shared<const scene::Environment>(scene::Environment::uniform(
       glm::vec3(o.strength), "uniform white, the default: the scene has no lights"));

@@ -1,6 +1,7 @@
 // The lighting options of the commands that render or plan a render (render, sweep, info): --env FILE.exr|.hdr
 // (an equirectangular environment, --env-strength, --env-rotate degrees about +y) and the
-// default light of a scene without lights - a uniform white environment, unless
+// default light of a scene without lights (no punctual light and no emitter above 1 nit, the
+// brightest glTF emission without KHR_materials_emissive_strength) - a uniform white environment, unless
 // --no-default-light - so that a model downloaded without lights does not render black in the
 // ray tracers and the rasterizer (which lights it by image-based lighting, or --headlight).
 // Also --variant NAME (KHR_materials_variants), the other option that decides what the loaded

@@ -25,7 +25,24 @@ bool usesTextures(const Material& m) {
          (m.hasSheen() && (m.sheenColorTexture.present() || m.sheenRoughnessTexture.present()));
 }
 
-bool alphaMasked(const Material& m, float opacity) { return m.alphaMode == AlphaMode::Mask && opacity < m.alphaCutoff; }
+bool alphaCuts(const Material& m) { return m.alphaMode != AlphaMode::Opaque; }
+
+float opacityAt(const Scene& scene, uint32_t material, glm::vec2 uv, glm::vec4 colour) {
+  const Material& m = scene.materials[material];
+  float a = m.baseColorFactor.w * colour.w;
+  if (m.baseColorTexture.present() && size_t(m.baseColorTexture.texture) < scene.textures.size())
+    a *= scene.textures[size_t(m.baseColorTexture.texture)].sample(m.baseColorTexture.transformUv(uv), true).w;
+  return std::clamp(a, 0.0f, 1.0f);
+}
+
+bool alphaPasses(const Material& m, float opacity, float xi) {
+  switch (m.alphaMode) {
+    case AlphaMode::Opaque: return true;
+    case AlphaMode::Mask: return opacity >= m.alphaCutoff;
+    case AlphaMode::Blend: return xi < opacity;
+  }
+  return true;
+}
 
 SurfaceMaterial resolveMaterial(const Scene& scene, uint32_t material, const SurfaceGeometry& at, bool textures,
                                 uint64_t* skipped) {

@@ -59,8 +59,13 @@ SurfaceMaterial resolveMaterial(const Scene& scene, uint32_t material, const Sur
 // Whether resolveMaterial reads a texture for this material.
 bool usesTextures(const Material& material);
 
-// alphaMode MASK: whether the point is cut away (opacity below the cutoff). Never for OPAQUE
-// and BLEND materials.
-bool alphaMasked(const Material& material, float opacity);
+// Whether a material's alpha can make a surface point invisible (alphaMode MASK or BLEND).
+bool alphaCuts(const Material& material);
+// The base alpha at a point: baseColorFactor.a * base-colour texture alpha * COLOR_0 alpha.
+float opacityAt(const Scene& scene, uint32_t material, glm::vec2 uv, glm::vec4 colour);
+// Whether the surface is there at a point of this opacity: OPAQUE always; MASK when the opacity
+// reaches alphaCutoff; BLEND with probability opacity (stochastic transparency, Enderton et al.
+// 2010), decided by xi in [0, 1), which each family draws from what it is sampling.
+bool alphaPasses(const Material& material, float opacity, float xi);
 
 }  // namespace pr::scene

@@ -51,7 +51,8 @@ class SortLast : public SortPoint {
       const uint32_t first = static_cast<uint32_t>(t) * batch;
       processTriangles(f.scene, f.view, first, std::min(batch, total - first), mine);
       for (size_t i = before; i < mine.size(); ++i)
-        rasterizeTriangle(mine[i], static_cast<uint32_t>(i), buffers[pe.id()]);
+        rasterizeTriangle(mine[i], static_cast<uint32_t>(i), buffers[pe.id()].window(), nullptr,
+                          ctx.alphaTested ? &f.scene : nullptr);
     });
 
     // Stage 2, shading of each PE's visible pixels, in its own buffer.

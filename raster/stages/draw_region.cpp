@@ -6,7 +6,7 @@ namespace pr::raster {
 void drawRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const PixelWindow& pixels,
                 RasterCounters* raster, ShadeCounters* shade) {
   pixels.clear();
-  rasterizeTriangles(tris, pixels, raster);
+  rasterizeTriangles(tris, pixels, raster, ctx.alphaTested ? ctx.scene : nullptr);
   shadeRegion(ctx, tris, pixels, shade);
 }
 

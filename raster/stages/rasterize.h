@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <span>
 
+#include "common/scene/scene.h"
 #include "raster/framebuffer.h"
 #include "raster/region.h"
 #include "raster/stages/setup.h"
@@ -97,12 +98,16 @@ void forEachCoveredPixel(const TriangleSetup& s, const Rect& region, Visit&& vis
 // Rasterizes one triangle into the owner's pixels, clipped to the window's rectangle, with the
 // depth test of depth_resolve.h; a winning fragment stores its key and localIndex (the
 // triangle's position in the list the shade stage will read). Touches the window only.
+// alphaScene, when given, is the scene whose alpha-cut materials (MASK, BLEND) drop fragments
+// where the surface is not there (scene::alphaPasses); BLEND by stochastic transparency, its
+// random number a hash of the pixel and the primitive, so every sort point, region split and P
+// keep the same fragments. Only triangles of such materials pay for the test.
 void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, const PixelWindow& pixels,
-                       RasterCounters* counters = nullptr);
+                       RasterCounters* counters = nullptr, const scene::Scene* alphaScene = nullptr);
 
 // All triangles of a list, localIndex = position in the list.
 void rasterizeTriangles(std::span<const ScreenTriangle> tris, const PixelWindow& pixels,
-                        RasterCounters* counters = nullptr);
+                        RasterCounters* counters = nullptr, const scene::Scene* alphaScene = nullptr);
 
 // The same into a whole framebuffer.
 inline void rasterizeTriangle(const ScreenTriangle& tri, uint32_t localIndex, RegionFramebuffer& fb,

@@ -54,4 +54,16 @@ inline int64_t edgeAt(const EdgeFunctions& s, int k, int x, int y) {
   return s.a[k] * samplePosition(x) + s.b[k] * samplePosition(y) + s.c[k];
 }
 
+// Scene-triangle barycentrics (b0, b1, b2) from the exact edge values at a sample: the
+// perspective-correct interpolation of shade.h (sceneBarycentrics), shared with the alpha
+// test of the rasterization stage.
+inline glm::vec3 barycentricsFromEdges(const ScreenTriangle& tri, int64_t e0, int64_t e1, int64_t e2) {
+  float w0 = float(e0) * tri.invW[0];
+  float w1 = float(e1) * tri.invW[1];
+  float w2 = float(e2) * tri.invW[2];
+  float inv = 1.0f / (w0 + w1 + w2);
+  glm::vec2 b = (w0 * inv) * tri.bary[0] + (w1 * inv) * tri.bary[1] + (w2 * inv) * tri.bary[2];
+  return glm::vec3(1.0f - b.x - b.y, b.x, b.y);
+}
+
 }  // namespace pr::raster

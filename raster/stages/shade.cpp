@@ -29,16 +29,6 @@ constexpr float kMinRoughness = 0.045f;
 // Headlight irradiance: pi lux makes a white Lambertian surface facing the camera radiance 1.
 constexpr float kHeadlightLux = kPi;
 
-// Scene-triangle barycentrics from the exact edge values at a sample (shade.h).
-glm::vec3 barycentricsFromEdges(const ScreenTriangle& tri, int64_t e0, int64_t e1, int64_t e2) {
-  float w0 = float(e0) * tri.invW[0];
-  float w1 = float(e1) * tri.invW[1];
-  float w2 = float(e2) * tri.invW[2];
-  float inv = 1.0f / (w0 + w1 + w2);
-  glm::vec2 b = (w0 * inv) * tri.bary[0] + (w1 * inv) * tri.bary[1] + (w2 * inv) * tri.bary[2];
-  return glm::vec3(1.0f - b.x - b.y, b.x, b.y);
-}
-
 // Irradiance at normal incidence (lux) and direction towards the light, KHR_lights_punctual.
 bool incidentLight(const scene::PunctualLight& light, glm::vec3 p, glm::vec3& L, glm::vec3& E) {
   if (light.type == scene::LightType::Directional) {
@@ -106,6 +96,8 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
   ctx.lights = scene.lights;
   ctx.usesHeadlight = ctx.lights.empty() && (headlight || !scene.environment);
   if (!ctx.usesHeadlight) ctx.ibl = ImageBasedLight::of(scene.environment);
+  ctx.alphaTested = std::any_of(scene.materials.begin(), scene.materials.end(),
+                                [](const scene::Material& m) { return scene::alphaCuts(m); });
   ctx.textures = effects.has(scene::Effect::Textures);
   ctx.emission = effects.has(scene::Effect::Emission);
   ctx.direct = effects.has(scene::Effect::DirectLight);

@@ -53,6 +53,8 @@ struct ShadingContext {
   std::vector<scene::PunctualLight> lights;
   std::shared_ptr<const ImageBasedLight> ibl;
   bool usesHeadlight = false;
+  // Some material is alpha-cut (MASK or BLEND): rasterization tests its fragments' alpha.
+  bool alphaTested = false;
   // The RenderPlan's effects (common/scene/effect_analysis.h) this stage can skip: textures off
   // shades from the material factors, emission off adds no emitted radiance, direct off adds
   // no light (punctual or headlight). The work not done is counted in ShadeCounters.

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string_view>
 #include <vector>
@@ -13,6 +14,7 @@
 #include <glm/glm.hpp>
 
 #include "common/scene/scene.h"
+#include "raytrace/core/alpha_test.h"
 #include "raytrace/core/ray.h"
 
 namespace pr::rt {
@@ -68,6 +70,9 @@ struct BvhBuildOptions {
   int maxLeafSize = 4;    // a leaf never holds more triangles than this (1..16)
   float traversalCost = 1.0f;     // SAH cost of visiting a node, relative to one triangle test
   float intersectionCost = 1.0f;  // SAH cost of one watertight triangle test
+  // Alpha-cut surfaces (alpha_test.h): hits where it fails do not count, in both queries. The
+  // scene constructor makes it for a scene that needs one when none is given.
+  std::shared_ptr<const AlphaTest> alpha;
 };
 
 // Counts of one build, for benchmarks and reports (Category/what naming in the run record).
@@ -117,6 +122,7 @@ class Bvh {
   std::vector<BvhTriangle> triangles_;
   BvhStats stats_;
   float magnitude_ = 0.0f;  // largest |coordinate| of any vertex, for the traversal slack
+  std::shared_ptr<const AlphaTest> alpha_;
 };
 
 }  // namespace pr::rt

@@ -253,6 +253,7 @@ Bvh::Bvh(const scene::Scene& scene, const BvhBuildOptions& options) {
   std::vector<uint32_t> all(scene.triangles.size());
   for (uint32_t i = 0; i < all.size(); ++i) all[i] = i;
   build(scene.positions, scene.triangles, all, options);
+  if (!alpha_) alpha_ = AlphaTest::forScene(scene);
 }
 
 void checkBvhLimit(std::string_view where, size_t triangles) {
@@ -271,6 +272,7 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
            "maxLeafSize " + std::to_string(options.maxLeafSize) + " outside [1, 16]");
   PR_CHECK(subset.size() < BvhRef::kMaxTriangles, "too many triangles for one BVH: " + std::to_string(subset.size()));
   stats_ = BvhStats{};
+  alpha_ = options.alpha;
   nodes_.clear();
   triangles_.clear();
   root_ = BvhRef::kEmpty;

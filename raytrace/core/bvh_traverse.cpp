@@ -149,6 +149,7 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
   float bestT = ray.tMax;
   uint32_t bestTriangle = kNoTriangle;
   float bestU = 0.0f, bestV = 0.0f;
+  const AlphaTest* alpha = alpha_.get();
   // Locals, so the compiler need not reload the vectors' data pointers after every store.
   const BvhNode* nodes = nodes_.data();
   const BvhTriangle* triangles = triangles_.data();
@@ -171,7 +172,7 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
         TriangleHit th;
         if (!intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, bestT, th)) continue;
         // th.t <= bestT here; equal t keeps the lower triangle index (Hit::closerThan).
-        if (th.t < bestT || tri->triangle < bestTriangle) {
+        if ((th.t < bestT || tri->triangle < bestTriangle) && (!alpha || alpha->passes(tri->triangle, th.u, th.v, ray))) {
           bestT = th.t;
           bestTriangle = tri->triangle;
           bestU = th.u;
@@ -200,6 +201,7 @@ bool Bvh::occludedK(const Ray& ray) const {
   const RayShear shear = makeRayShear(ray);
   const BoxRay boxRay = makeBoxRay(ray, magnitude_);
   const float tMax = ray.tMax;
+  const AlphaTest* alpha = alpha_.get();
   const BvhNode* nodes = nodes_.data();
   const BvhTriangle* triangles = triangles_.data();
   StackEntry stack[kStackSize];
@@ -218,7 +220,9 @@ bool Bvh::occludedK(const Ray& ray) const {
       const uint32_t count = BvhRef::leafCount(ref);
       for (uint32_t i = 0; i < count; ++i, ++tri) {
         TriangleHit th;
-        if (intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, tMax, th)) return true;
+        if (intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, tMax, th) &&
+            (!alpha || alpha->passes(tri->triangle, th.u, th.v, ray)))
+          return true;
       }
     }
     if (sp == 0) return false;

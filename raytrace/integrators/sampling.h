@@ -11,6 +11,8 @@
 
 #include <glm/glm.hpp>
 
+#include "common/util/hash.h"
+
 namespace pr::rt {
 
 inline constexpr float kPi = 3.14159265358979323846f;
@@ -18,12 +20,7 @@ inline constexpr float kInvPi = 1.0f / kPi;
 // The largest float below 1: a sample in [0, 1) never reaches 1 (24-bit mantissa).
 inline constexpr float kOneMinusEpsilon = 0x1.fffffep-1f;
 
-// SplitMix64 finaliser (Steele et al. 2014): a bijective 64-bit mix with full avalanche.
-inline uint64_t mix64(uint64_t z) {
-  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-  z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-  return z ^ (z >> 31);
-}
+using pr::mix64;  // common/util/hash.h
 
 // Dimensions drawn at one path vertex; each use has its own so no two correlate.
 namespace Dim {

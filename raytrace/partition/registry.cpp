@@ -88,14 +88,16 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
     throw InputError("scene " + job.scene.source.string() + " has no triangles to ray trace");
   checkBvhLimit("scene " + job.scene.source.string(), job.scene.triangles.size());
   std::unique_ptr<Partition> p = makePartition(partition);
-  if (!job.integrator || !job.integrator->hasPrePass()) return p->render(job, rt);
+  // Every BVH a partition builds over this scene tests its alpha-cut surfaces.
+  TraceJob main = job;
+  if (!main.options.bvh.alpha) main.options.bvh.alpha = AlphaTest::forScene(job.scene);
+  if (!job.integrator || !job.integrator->hasPrePass()) return p->render(main, rt);
   // The integrator's pre-pass runs through this same tracer; a world-model tracer builds its
   // BVH once for the pre-pass's programs and the render.
-  TraceJob main = job;
   std::unique_ptr<Bvh> built;
   if (p->holdsWorldModel() && !job.options.worldBvh) {
     rt.runPinned("build", par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
-      built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+      built = std::make_unique<Bvh>(job.scene, main.options.bvh);
     });
     main.options.worldBvh = built.get();
   }

@@ -83,3 +83,60 @@ TEST_CASE("Bsdf: Fresnel and refraction handle total internal reflection") {
   // Normal incidence from air into glass: ((1.5 - 1) / (1.5 + 1))^2 = 0.04.
   CHECK(rt::fresnelDielectric(1.0f, 1.5f) == doctest::Approx(0.04).epsilon(1e-4));
 }
+
+namespace {
+
+// int f cos over the hemisphere by the midpoint rule in (cos theta, phi).
+double albedoByQuadrature(const rt::ShadingMaterial& m, const glm::vec3& wo) {
+  const int nc = 300, np = 300;
+  double sum = 0.0;
+  for (int i = 0; i < nc; ++i) {
+    const float c = (float(i) + 0.5f) / nc, s = std::sqrt(1.0f - c * c);
+    for (int j = 0; j < np; ++j) {
+      const float phi = 2.0f * rt::kPi * (float(j) + 0.5f) / np;
+      sum += double(rt::evalOpaque(m, wo, glm::vec3(s * std::cos(phi), s * std::sin(phi), c)).x) * c;
+    }
+  }
+  return sum * (2.0 * rt::kPi / np) / nc;
+}
+
+}  // namespace
+
+TEST_CASE("Bsdf: KHR_materials_specular 0 leaves a dielectric exactly Lambertian") {
+  rt::ShadingMaterial m = material(0.6f, 0.0f, 0.3f);
+  m.dielectricF0 = glm::vec3(0.0f);
+  m.dielectricF90 = 0.0f;
+  CHECK_FALSE(m.hasSpecular());
+  for (float theta : {0.1f, 0.8f, 1.4f}) {
+    const glm::vec3 wo(std::sin(theta), 0.0f, std::cos(theta));
+    const glm::vec3 wi = glm::normalize(glm::vec3(-0.3f, 0.2f, 0.6f));
+    CHECK(rt::evalOpaque(m, wo, wi).x == 0.6f * rt::kInvPi);
+    CHECK(albedo(m, wo, 200) == doctest::Approx(0.6).epsilon(1e-6));
+  }
+  // The core model's 4 % coat adds a lobe on the same base.
+  const rt::ShadingMaterial coated = material(0.6f, 0.0f, 0.3f);
+  CHECK(rt::evalOpaque(coated, glm::vec3(0, 0, 1), glm::vec3(0, 0, 1)).x > 0.6f * rt::kInvPi * 1.5f);
+}
+
+TEST_CASE("Bsdf: clear coat and sheen sample what they evaluate and create no energy") {
+  rt::ShadingMaterial coat = material(1.0f, 0.0f, 1.0f);  // white Lambertian base
+  coat.clearcoat = 1.0f;
+  coat.clearcoatRoughness = 0.3f;
+  rt::ShadingMaterial sheen = material(1.0f, 0.0f, 1.0f);
+  sheen.sheenColor = glm::vec3(1.0f);
+  sheen.sheenRoughness = 0.5f;
+  for (const rt::ShadingMaterial* m : {&coat, &sheen})
+    for (float theta : {0.2f, 1.0f}) {
+      const glm::vec3 wo(std::sin(theta), 0.0f, std::cos(theta));
+      const double sampled = albedo(*m, wo, 40000), integrated = albedoByQuadrature(*m, wo);
+      CAPTURE(theta);
+      CAPTURE(m == &coat);
+      CHECK(sampled == doctest::Approx(integrated).epsilon(0.03));
+      CHECK(integrated <= 1.01);
+    }
+  // The coat reflects more at grazing angles than at normal incidence (its Fresnel term).
+  const glm::vec3 n(0, 0, 1), grazing = glm::normalize(glm::vec3(0.95f, 0.0f, 0.3f));
+  const glm::vec3 mirror(-grazing.x, 0.0f, grazing.z);
+  CHECK(rt::evalOpaque(coat, grazing, mirror).x > rt::evalOpaque(material(1.0f, 0.0f, 1.0f), grazing, mirror).x * 2.0f);
+  CHECK(rt::evalOpaque(coat, n, n).x > rt::kInvPi);
+}
