@@ -163,10 +163,13 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
 
 // ---- shading ----------------------------------------------------------------------------------
 
-void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const {
+void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& arrived, rt::Emit& out) const {
   const rt::IntegratorContext& ctx = context();
   const State& state = *state_;
   rt::ShadingMaterial m = ctx.material(si, out);
+  // A segment that ran inside an absorbing solid arrives attenuated (KHR_materials_volume).
+  RayMessage msg = arrived;
+  msg.throughput *= rt::volumeTransmittance(m, si, arrived.ray);
 
   if (settings_.view != PhotonView::Full) {
     const bool global = settings_.view == PhotonView::GlobalMap;
@@ -286,7 +289,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     glm::vec3 wt;
     if (fr < 1.0f && rt::refractDirection(si.wo, sf.ns, eta, wt))
       spawn(scene::Effect::Transmission, &rt::TraceStats::transmissionRaysSkipped,
-            ctx.continuation(si, msg, wt, msg.throughput * m.baseColor * (dielectric * (1.0f - fr)), 0.0f));
+            ctx.continuation(si, msg, wt, msg.throughput * m.transmissionTint(si.frontFace) * (dielectric * (1.0f - fr)), 0.0f));
   }
 }
 

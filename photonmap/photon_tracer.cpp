@@ -357,6 +357,8 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   const std::uint64_t seed = s.options->seed;
   if (bounce == 0) power *= scene::rangeWindow(hit.t * glm::length(ray.direction), range);
   rt::ShadingMaterial m = rt::evalMaterial(*s.scene, si, s.options->textures);
+  // A photon that crossed an absorbing solid arrives attenuated (KHR_materials_volume).
+  power *= rt::volumeTransmittance(m, si, ray);
   const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 
   // Storage: the photon's incident flux wherever the surface has a diffuse part.
@@ -395,7 +397,7 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
       factor = glm::vec3(1.0f);
     } else {
       wi = wt;
-      factor = m.baseColor;  // flux is conserved through refraction: no eta^2 (that is radiance)
+      factor = m.transmissionTint(si.frontFace);  // flux is conserved through refraction: no eta^2 (that is radiance)
     }
     specular = true;
   } else {

@@ -81,8 +81,26 @@ ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction
   m.sheenRoughness = r.sheenRoughness;
   m.clearcoat = r.clearcoat;
   m.clearcoatRoughness = r.clearcoatRoughness;
+  if (mat.thicknessFactor > 0.0f) {
+    m.thinWalled = false;
+    const float d = mat.attenuationDistance;
+    if (std::isfinite(d) && d > 0.0f)
+      for (int c = 0; c < 3; ++c)
+        m.attenuation[c] = -std::log(std::clamp(mat.attenuationColor[c], 1.0e-30f, 1.0f)) / d;
+  }
   m.clearcoatNormalWorld = glm::dot(r.clearcoatNormal, si.geometricNormal) > 0.0f ? r.clearcoatNormal : si.shadingNormal;
   return m;
+}
+
+glm::vec3 volumeTransmittance(const ShadingMaterial& m, const SurfaceInteraction& si, const Ray& ray) {
+  if (m.thinWalled || si.frontFace || !(m.transmission > 0.0f)) return glm::vec3(1.0f);
+  const float distance = si.t * glm::length(ray.direction);
+  glm::vec3 t(1.0f);
+  for (int c = 0; c < 3; ++c) {
+    const float optical = m.attenuation[c] * distance;  // both finite and >= 0
+    t[c] = optical > 69.0f ? 0.0f : std::exp(-optical);  // exp(-69) ~ 1e-30
+  }
+  return t;
 }
 
 glm::vec3 emittedRadiance(const ShadingMaterial& m, const SurfaceInteraction& si) {
@@ -239,6 +257,22 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
   s.weight = evalOpaque(m, wo, s.wi) * (s.wi.z / s.pdf);
   s.valid = isFinite(s.weight);
   return s;
+}
+
+glm::vec3 sampleMicrofacetNormal(const ShadingMaterial& m, float u, float v) {
+  // ggxReflection's half vector for wo = +z is that normal: reflect +z about h gives 2 h.z h - z.
+  const float a2 = m.alpha * m.alpha;
+  const float cos2 = (1.0f - u) / (1.0f + (a2 - 1.0f) * u);
+  const float cosH = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
+  const float sinH = std::sqrt(std::max(0.0f, 1.0f - cosH * cosH));
+  const float phi = 2.0f * kPi * v;
+  return {sinH * std::cos(phi), sinH * std::sin(phi), cosH};
+}
+
+float microfacetWeight(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& h) {
+  const float g = ggxG1(m.alpha, std::fabs(wo.z)) * ggxG1(m.alpha, std::fabs(wi.z));
+  const float w = std::fabs(glm::dot(wo, h)) * g / (std::fabs(wo.z) * std::fabs(h.z));
+  return std::isfinite(w) ? w : 0.0f;
 }
 
 }  // namespace pr::rt

@@ -46,6 +46,10 @@ struct ShadingMaterial {
   float clearcoatRoughness = 0.0f;
   glm::vec3 clearcoatNormalWorld{0.0f, 0.0f, 1.0f};
   glm::vec3 clearcoatNormal{0.0f, 0.0f, 1.0f};  // in the local shading frame (set by ShadingFrame)
+  // KHR_materials_volume: a solid (thicknessFactor > 0) absorbs along the path inside it by
+  // Beer-Lambert with this coefficient per unit length, -ln(attenuationColor) / distance.
+  bool thinWalled = true;
+  glm::vec3 attenuation{0.0f};
 
   // Weight of the Lambertian part: the non-metallic, non-transmissive share of baseColor.
   glm::vec3 diffuseColor() const { return (1.0f - metallic) * (1.0f - transmission) * baseColor; }
@@ -70,6 +74,9 @@ struct ShadingMaterial {
   }
   // The specular lobe's Fresnel term at cosine cosTheta (Schlick from F0 to F90).
   glm::vec3 specularFresnel(float cosTheta) const;
+  // The base-colour tint of a refraction through this interface: once per pass through a solid
+  // (on entering it), at every crossing of a thin wall.
+  glm::vec3 transmissionTint(bool frontFace) const { return thinWalled || frontFace ? baseColor : glm::vec3(1.0f); }
   bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
   bool hasClearcoat() const { return clearcoat > 0.0f; }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }
@@ -80,6 +87,12 @@ struct ShadingMaterial {
 // textures = false evaluates the material from its factors alone (the plan's textures off).
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures = true);
 using scene::usesTextures;
+
+// Beer-Lambert transmittance of the path segment that ended at si from inside a solid of this
+// material (the back of an absorbing volume): exp(-attenuation * distance), distance the
+// segment's length; 1 anywhere else. Finite and flushed to 0 below 1e-30 (no denormal
+// throughput), for any distance and attenuation, including an attenuationDistance of 1e-3.
+glm::vec3 volumeTransmittance(const ShadingMaterial& m, const SurfaceInteraction& si, const Ray& ray);
 
 // Radiance emitted towards wo: the material's emission on its front side (both sides when
 // double-sided), zero otherwise.
@@ -110,6 +123,11 @@ struct BsdfSample {
   bool valid = false;
 };
 BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// The dielectric part with roughness (Walter et al. 2007): a GGX microfacet normal for (u, v)
+// in the local frame (z = normal), and the weight of reflecting or refracting wo about it when
+// the choice between the two is made with probability F: |wo.h| G(wo, wi) / (|wo.n| |h.n|).
+glm::vec3 sampleMicrofacetNormal(const ShadingMaterial& m, float u, float v);
+float microfacetWeight(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& h);
 // The rough specular (GGX) lobe alone, for integrators that treat it apart from the diffuse
 // part (the photon map: glossy reflection by Monte Carlo, diffuse by density estimation):
 // f_s(wo, wi) without cos (zero without a rough specular lobe), and a sample of wi from the

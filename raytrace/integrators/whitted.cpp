@@ -14,9 +14,12 @@ namespace {
 constexpr float kMinThroughput = 1.0f / 4096.0f;
 }  // namespace
 
-void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const {
+void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& arrived, Emit& out) const {
   const IntegratorContext& ctx = context();
   ShadingMaterial m = ctx.material(si, out);
+  // A segment that ran inside an absorbing solid arrives attenuated (KHR_materials_volume).
+  RayMessage msg = arrived;
+  msg.throughput *= volumeTransmittance(m, si, arrived.ray);
   // Every ray of a Whitted tracer reaches an emitter only through camera, mirror or
   // refraction paths, which light sampling never covers, so emission counts fully.
   const glm::vec3 le = ctx.emitted(m, si, out);
@@ -39,8 +42,9 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& ms
     }
   }
 
-  // Dielectric: reflect with F, refract with 1 - F tinted by the base colour (thin tint of
-  // KHR_materials_transmission); all of it reflects under total internal reflection.
+  // Dielectric (smooth: Whitted's one ray each way, whatever the roughness): reflect with F,
+  // refract with 1 - F tinted by the base colour once per solid; all of it reflects under
+  // total internal reflection.
   if (dielectric > 0.0f) {
     const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
     const float cosI = glm::dot(sf.ns, si.wo);
@@ -52,7 +56,7 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& ms
                 ctx.continuation(si, msg, glm::normalize(reflected), tr, 0.0f), out);
     glm::vec3 wt;
     if (fr < 1.0f && refractDirection(si.wo, sf.ns, eta, wt)) {
-      const glm::vec3 tt = msg.throughput * m.baseColor * (dielectric * (1.0f - fr));
+      const glm::vec3 tt = msg.throughput * m.transmissionTint(si.frontFace) * (dielectric * (1.0f - fr));
       if (maxComponent(tt) > kMinThroughput)
         ctx.spawn(scene::Effect::Transmission, &TraceStats::transmissionRaysSkipped, ctx.continuation(si, msg, wt, tt, 0.0f), out);
     }

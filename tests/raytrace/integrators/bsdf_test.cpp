@@ -140,3 +140,75 @@ TEST_CASE("Bsdf: clear coat and sheen sample what they evaluate and create no en
   CHECK(rt::evalOpaque(coat, grazing, mirror).x > rt::evalOpaque(material(1.0f, 0.0f, 1.0f), grazing, mirror).x * 2.0f);
   CHECK(rt::evalOpaque(coat, n, n).x > rt::kInvPi);
 }
+
+TEST_CASE("Bsdf: Beer-Lambert inside a solid, once-per-solid tint, robust at tiny distances and long paths") {
+  scene::Scene s;
+  scene::Material glass;
+  glass.transmissionFactor = 1.0f;
+  glass.thicknessFactor = 1.0f;
+  glass.attenuationColor = glm::vec3(0.5f, 1.0f, 0.0f);
+  glass.attenuationDistance = 2.0f;
+  glass.baseColorFactor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  s.materials = {glass};
+  rt::SurfaceInteraction si;
+  si.material = 0;
+  si.frontFace = false;  // leaving the solid: the segment ran inside
+  si.t = 4.0f;
+  const rt::Ray ray{glm::vec3(0.0f), 0.0f, glm::vec3(0, 0, 1), rt::kInfinity};
+  rt::ShadingMaterial m = rt::evalMaterial(s, si);
+  glm::vec3 t = rt::volumeTransmittance(m, si, ray);
+  CHECK(t.x == doctest::Approx(0.25f));  // 0.5^(4 / 2)
+  CHECK(t.y == 1.0f);
+  CHECK(t.z == 0.0f);
+  // The tint applies on entering only.
+  CHECK(m.transmissionTint(true) == glm::vec3(0.8f));
+  CHECK(m.transmissionTint(false) == glm::vec3(1.0f));
+  // Entering (front face) is not attenuated: the segment ran outside.
+  si.frontFace = true;
+  CHECK(rt::volumeTransmittance(m, si, ray) == glm::vec3(1.0f));
+  // attenuationDistance 1e-3 over a long path: exactly 0, never NaN or denormal; zero length: 1.
+  s.materials[0].attenuationDistance = 1e-3f;
+  s.materials[0].attenuationColor = glm::vec3(0.9f);
+  si.frontFace = false;
+  for (float len : {0.0f, 1e-3f, 1.0f, 1e6f}) {
+    si.t = len;
+    m = rt::evalMaterial(s, si);
+    t = rt::volumeTransmittance(m, si, ray);
+    CAPTURE(len);
+    CHECK(std::isfinite(t.x));
+    CHECK((t.x == 0.0f || t.x >= 1e-30f));
+  }
+  // A thin wall (thickness 0) tints at each crossing and never absorbs.
+  s.materials[0].thicknessFactor = 0.0f;
+  m = rt::evalMaterial(s, si);
+  CHECK(m.transmissionTint(false) == glm::vec3(0.8f));
+  CHECK(rt::volumeTransmittance(m, si, ray) == glm::vec3(1.0f));
+}
+
+TEST_CASE("Bsdf: rough glass microfacet weights are near 1 when smooth and never create energy") {
+  for (float roughness : {0.1f, 0.5f, 0.9f}) {
+    rt::ShadingMaterial m = material(1.0f, 0.0f, roughness);
+    m.transmission = 1.0f;
+    const glm::vec3 wo = glm::normalize(glm::vec3(0.3f, 0.0f, 0.9f));
+    double sum = 0.0;
+    const int n = 20000;
+    for (int i = 0; i < n; ++i) {
+      const glm::vec3 h = rt::sampleMicrofacetNormal(m, rt::sample1D(3, uint32_t(i), 0, 0, 0), rt::sample1D(3, uint32_t(i), 0, 0, 1));
+      if (glm::dot(h, wo) <= 0.0f) continue;
+      const float cosI = glm::dot(h, wo);
+      // Reflection and refraction about h weigh the same: the average of either is the albedo.
+      const glm::vec3 wi = 2.0f * cosI * h - wo;
+      glm::vec3 wt;
+      const bool refracts = rt::refractDirection(wo, h, 1.5f, wt);
+      const float fr = rt::fresnelDielectric(cosI, 1.5f);
+      double w = 0.0;
+      if (wi.z > 0.0f) w += fr * rt::microfacetWeight(m, wo, wi, h);
+      if (refracts && wt.z < 0.0f) w += (1.0f - fr) * rt::microfacetWeight(m, wo, wt, h);
+      sum += w;
+    }
+    const double albedo = sum / n;
+    CAPTURE(roughness);
+    CHECK(albedo <= 1.01);
+    if (roughness <= 0.1f) CHECK(albedo > 0.97);
+  }
+}
