@@ -56,6 +56,16 @@ SurfaceInteraction makeInteraction(const scene::Scene& scene, const Ray& ray, co
     // vertices where it changes); interpolating it would only blur the sign.
     si.tangent = glm::vec4(glm::vec3(b0 * t0 + b1 * t1 + b2 * t2), t0.w);
   }
+  if (si.tangent == glm::vec4(0.0f) && scene.materials[tri.material].anisotropyStrength > 0.0f &&
+      scene.uvs.size() == scene.positions.size()) {
+    // An anisotropic lobe needs the uv tangent even without a normal map: dp/du of the triangle.
+    const glm::vec2 t0 = scene.uvs[tri.v[0]], d1 = scene.uvs[tri.v[1]] - t0, d2 = scene.uvs[tri.v[2]] - t0;
+    const float det = d1.x * d2.y - d1.y * d2.x;
+    if (std::fabs(det) > 1.0e-12f) {
+      const glm::vec3 dpdu = ((p1 - p0) * d2.y - (p2 - p0) * d1.y) / det;
+      if (std::isfinite(dpdu.x + dpdu.y + dpdu.z)) si.tangent = glm::vec4(dpdu, 1.0f);
+    }
+  }
   const float dirLen = glm::length(ray.direction);
   si.wo = dirLen > 0.0f ? -ray.direction / dirLen : glm::vec3(0.0f);
   si.material = tri.material;

@@ -19,7 +19,8 @@ struct SurfaceInteraction {
   glm::vec3 shadingNormal{0.0f};    // unit, interpolated vertex normals, on geometricNormal's side
   glm::vec2 uv{0.0f};               // UV set 0 (zero when the scene has none)
   glm::vec4 colour{1.0f};           // COLOR_0 (1 when the scene has none)
-  glm::vec4 tangent{0.0f};          // interpolated tangent, w = handedness; zero = no normal map
+  glm::vec4 tangent{0.0f};          // interpolated tangent (w = handedness), or an anisotropic
+                                    // material's dp/du; zero = neither
   glm::vec3 wo{0.0f};               // unit direction back towards the ray origin
   uint32_t material = 0;
   uint32_t triangle = kNoTriangle;

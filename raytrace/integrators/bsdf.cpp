@@ -49,6 +49,54 @@ glm::vec3 ggxReflection(float alpha, const glm::vec3& wo, float u, float v) {
   return 2.0f * glm::dot(wo, h) * h - wo;
 }
 
+// Anisotropic GGX (Heitz 2014, "Understanding the masking-shadowing function"): roughness ax
+// along the local x axis (the anisotropy direction, ShadingFrame), ay along y.
+float ggxDAniso(float ax, float ay, const glm::vec3& h) {
+  if (h.z <= 0.0f) return 0.0f;
+  const float x = h.x / ax, y = h.y / ay;
+  const float d = x * x + y * y + h.z * h.z;
+  return 1.0f / (kPi * ax * ay * d * d);
+}
+
+float ggxG1Aniso(float ax, float ay, const glm::vec3& w) {
+  if (w.z <= 0.0f) return 0.0f;
+  const float t2 = (ax * ax * w.x * w.x + ay * ay * w.y * w.y) / (w.z * w.z);
+  return 2.0f / (1.0f + std::sqrt(1.0f + t2));
+}
+
+// A microfacet normal with density D(h) h.z: a slope of the alpha = 1 distribution
+// (tan^2 theta = u / (1 - u), phi = 2 pi v) stretched by (ax, ay).
+glm::vec3 ggxNormalAniso(float ax, float ay, float u, float v) {
+  const float tanTheta = std::sqrt(u / std::max(1.0f - u, 1.0e-7f));
+  const float phi = 2.0f * kPi * v;
+  return glm::normalize(glm::vec3(-ax * tanTheta * std::cos(phi), -ay * tanTheta * std::sin(phi), 1.0f));
+}
+
+// The material's glossy lobe: isotropic GGX, or anisotropic when KHR_materials_anisotropy
+// gives it a strength (alpha along the direction = mix(alpha, 1, strength^2), the extension's
+// mapping).
+struct GlossyLobe {
+  float ax, ay;
+  bool anisotropic;
+  explicit GlossyLobe(const ShadingMaterial& m)
+      : ax(m.anisotropy > 0.0f ? m.alpha + (1.0f - m.alpha) * m.anisotropy * m.anisotropy : m.alpha),
+        ay(m.alpha),
+        anisotropic(m.anisotropy > 0.0f) {}
+  float d(const glm::vec3& h) const { return anisotropic ? ggxDAniso(ax, ay, h) : ggxD(ay, h.z); }
+  float g1(const glm::vec3& w) const { return anisotropic ? ggxG1Aniso(ax, ay, w) : ggxG1(ay, w.z); }
+  float pdf(const glm::vec3& wo, const glm::vec3& wi) const {
+    if (!anisotropic) return ggxPdf(ay, wo, wi);
+    const glm::vec3 h = glm::normalize(wo + wi);
+    const float oh = glm::dot(wo, h);
+    return oh > 0.0f ? ggxDAniso(ax, ay, h) * h.z / (4.0f * oh) : 0.0f;
+  }
+  glm::vec3 reflect(const glm::vec3& wo, float u, float v) const {
+    if (!anisotropic) return ggxReflection(ay, wo, u, v);
+    const glm::vec3 h = ggxNormalAniso(ax, ay, u, v);
+    return 2.0f * glm::dot(wo, h) * h - wo;
+  }
+};
+
 }  // namespace
 
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures) {
@@ -146,17 +194,19 @@ float specularProbability(const ShadingMaterial& m, float cosO) {
 glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f || !m.hasSpecular() || m.deltaSpecular()) return glm::vec3(0.0f);
   const glm::vec3 h = glm::normalize(wo + wi);
-  const float d = ggxD(m.alpha, h.z);
-  const float g = ggxG1(m.alpha, wo.z) * ggxG1(m.alpha, wi.z);
+  const GlossyLobe lobe(m);
+  const float d = lobe.d(h);
+  const float g = lobe.g1(wo) * lobe.g1(wi);
   return m.specularFresnel(glm::dot(wo, h)) * (d * g / (4.0f * wo.z * wi.z));
 }
 
 BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v) {
   BsdfSample s;
   if (wo.z <= 0.0f || !m.hasSpecular() || m.deltaSpecular()) return s;
-  s.wi = ggxReflection(m.alpha, wo, u, v);
+  const GlossyLobe lobe(m);
+  s.wi = lobe.reflect(wo, u, v);
   if (s.wi.z <= 0.0f) return s;
-  s.pdf = ggxPdf(m.alpha, wo, s.wi);
+  s.pdf = lobe.pdf(wo, s.wi);
   if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return s;
   s.weight = evalGlossy(m, wo, s.wi) * (s.wi.z / s.pdf);
   s.valid = isFinite(s.weight);
@@ -204,7 +254,7 @@ float coatPdf(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi
 float pdfBase(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   const float ps = specularProbability(m, wo.z);
   float pdf = (1.0f - ps) * wi.z * kInvPi;
-  if (ps > 0.0f && !m.deltaSpecular()) pdf += ps * ggxPdf(m.alpha, wo, wi);
+  if (ps > 0.0f && !m.deltaSpecular()) pdf += ps * GlossyLobe(m).pdf(wo, wi);
   return pdf;
 }
 
@@ -246,7 +296,7 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
         s.valid = isFinite(s.weight);
         return s;
       }
-      s.wi = ggxReflection(m.alpha, wo, u, v);
+      s.wi = GlossyLobe(m).reflect(wo, u, v);
     } else {
       s.wi = cosineHemisphere(u, v);
     }

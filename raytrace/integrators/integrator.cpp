@@ -25,6 +25,23 @@ IntegratorContext::IntegratorContext(const scene::Scene& scene, const scene::Cam
 ShadingFrame::ShadingFrame(const SurfaceInteraction& si) : ShadingFrame(si, si.shadingNormal) {}
 
 ShadingFrame::ShadingFrame(const SurfaceInteraction& si, ShadingMaterial& m) : ShadingFrame(si, m.normal) {
+  if (m.anisotropy > 0.0f) {
+    // The local x axis along the anisotropy direction: the uv tangent turned by it in the
+    // tangent plane, so the BSDF's anisotropic lobe reads (x, y) as (along, across).
+    const glm::vec3 n = frame.n;
+    glm::vec3 t = glm::vec3(si.tangent) - n * glm::dot(n, glm::vec3(si.tangent));
+    if (glm::dot(t, t) > 1.0e-12f) {
+      t = glm::normalize(t);
+      const glm::vec3 b = glm::cross(n, t);
+      const glm::vec3 s = glm::normalize(m.anisotropyDirection.x * t + m.anisotropyDirection.y * b);
+      frame.s = s;
+      frame.t = glm::cross(n, s);
+      woLocal = frame.toLocal(si.wo);
+      woLocal.z = std::max(woLocal.z, 1.0e-6f);
+    } else {
+      m.anisotropy = 0.0f;  // no direction to be anisotropic along
+    }
+  }
   if (!m.hasClearcoat()) return;
   const glm::vec3 coat = si.frontFace ? m.clearcoatNormalWorld : -m.clearcoatNormalWorld;
   m.clearcoatNormal = glm::dot(coat, si.wo) > 1.0e-6f ? frame.toLocal(coat) : glm::vec3(0.0f, 0.0f, 1.0f);
@@ -46,9 +63,11 @@ ShadingFrame::ShadingFrame(const SurfaceInteraction& si, const glm::vec3& shadin
 }
 
 ShadingMaterial IntegratorContext::material(const SurfaceInteraction& si, Emit& out) const {
-  if (simulates(scene::Effect::Textures)) return evalMaterial(*scene_, si);
-  if (usesTextures(scene_->materials[si.material])) ++out.stats().textureEvaluationsSkipped;
-  return evalMaterial(*scene_, si, false);
+  const bool textures = simulates(scene::Effect::Textures);
+  if (!textures && usesTextures(scene_->materials[si.material])) ++out.stats().textureEvaluationsSkipped;
+  ShadingMaterial m = evalMaterial(*scene_, si, textures);
+  if (!simulates(scene::Effect::Anisotropy)) m.anisotropy = 0.0f;  // the plan's isotropic stand-in
+  return m;
 }
 
 glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const {

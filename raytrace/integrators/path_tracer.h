@@ -15,12 +15,8 @@ class PathIntegrator final : public IntegratorBase<PathIntegrator> {
   void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
   // The environment seen by a BSDF-sampled ray, weighted against its light sample (MIS).
   void miss(const RayMessage& msg, Emit& out) const override;
-  // Every effect but anisotropy: the BSDF (bsdf.h) is isotropic.
-  scene::EffectSet simulated() const override {
-    scene::EffectSet s = scene::EffectSet::all();
-    s.set(scene::Effect::Anisotropy, false);
-    return s;
-  }
+  // Every effect (anisotropy by the BSDF's anisotropic GGX lobe, bsdf.h).
+  scene::EffectSet simulated() const override { return scene::EffectSet::all(); }
 };
 
 }  // namespace pr::rt

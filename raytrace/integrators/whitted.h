@@ -13,11 +13,10 @@ class WhittedIntegrator final : public IntegratorBase<WhittedIntegrator> {
   std::string_view name() const override { return "whitted"; }
   void shade(const SurfaceInteraction& si, const RayMessage& msg, Emit& out) const override;
   // Diffuse and glossy surfaces get direct light only: no glossy reflection rays, no indirect
-  // diffuse, hence no caustics; the BSDF is isotropic.
+  // diffuse, hence no caustics (direct light sees the anisotropic lobe).
   scene::EffectSet simulated() const override {
     scene::EffectSet s = scene::EffectSet::all();
-    for (scene::Effect e : {scene::Effect::GlossySpecular, scene::Effect::IndirectDiffuse, scene::Effect::Caustics,
-                            scene::Effect::Anisotropy})
+    for (scene::Effect e : {scene::Effect::GlossySpecular, scene::Effect::IndirectDiffuse, scene::Effect::Caustics})
       s.set(e, false);
     return s;
   }
