@@ -182,6 +182,8 @@ void addGalleryCommand(CLI::App& app) {
   cmd->add_option("--ray-method", a->rayMethod, "ray-tracing method")->capture_default_str();
   cmd->add_option("--raster-method", a->rasterMethod, "rasterization method")->capture_default_str();
   addLightingOptions(*cmd, a->lighting);
+  // The sky shows shapes, normal maps and metals as the screenshots do; --env FILE overrides.
+  a->lighting.env = "sky";
   cmd->callback([a] { run(*a); });
 }
 

@@ -11,7 +11,8 @@
 namespace pr::cli {
 
 void addLightingOptions(CLI::App& command, LightingOptions& o) {
-  command.add_option("--env", o.env, "environment light: an equirectangular .exr or .hdr image (ray tracers)")->check(CLI::ExistingFile);
+  command.add_option("--env", o.env, "environment light: an equirectangular .exr or .hdr image, or 'sky' (a built-in studio sky)")
+      ->check(CLI::Validator([](std::string& v) { return v == "sky" ? std::string() : CLI::ExistingFile(v); }, "FILE|sky"));
   command.add_option("--env-strength", o.strength, "environment radiance scale")->check(CLI::NonNegativeNumber)->capture_default_str();
   command.add_option("--env-rotate", o.rotateDegrees, "environment rotation about +y in degrees")
       ->check(CLI::Range(-360.0f, 360.0f))->capture_default_str();
@@ -38,6 +39,10 @@ bool isLamp(const scene::Material& m) {
 
 std::string applyLighting(scene::Scene& scene, const LightingOptions& o) {
   constexpr float kDegrees = 3.14159265358979323846f / 180.0f;
+  if (o.env == "sky") {
+    scene.environment = std::make_shared<const scene::Environment>(scene::Environment::sky(o.strength, o.rotateDegrees * kDegrees));
+    return "lighting: the scene's lights and the built-in sky environment";
+  }
   if (!o.env.empty()) {
     const image::Image image = image::readImage(o.env);
     scene.environment = std::make_shared<const scene::Environment>(scene::Environment::fromImage(

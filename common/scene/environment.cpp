@@ -32,6 +32,25 @@ Environment Environment::uniform(const glm::vec3& radiance, std::string descript
   return e;
 }
 
+Environment Environment::sky(float strength, float rotation) {
+  constexpr int kW = 512, kH = 256;
+  image::Image img(kW, kH);
+  const glm::vec3 key = glm::normalize(glm::vec3(-0.5f, 0.7f, 0.5f));
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      // The pixel's direction, as fromImage maps it (unrotated).
+      const float phi = 2.0f * kPi * ((float(x) + 0.5f) / kW - 0.5f), theta = kPi * (float(y) + 0.5f) / kH;
+      const glm::vec3 d(std::sin(theta) * std::sin(phi), std::cos(theta), -std::sin(theta) * std::cos(phi));
+      const float up = d.y;
+      glm::vec3 l = up >= 0.0f ? glm::mix(glm::vec3(1.0f), glm::vec3(0.55f, 0.7f, 1.0f), std::sqrt(up))
+                               : glm::mix(glm::vec3(0.45f), glm::vec3(0.25f), std::min(1.0f, -4.0f * up));
+      // The key light: a lobe about 10 degrees wide, carrying about as much light as the dome.
+      l += glm::vec3(60.0f, 57.0f, 52.0f) * std::exp((glm::dot(d, key) - 1.0f) / 0.015f);
+      img.at(x, y) = l;
+    }
+  return fromImage(img, strength, rotation, "sky (built-in studio environment)");
+}
+
 Environment Environment::fromImage(const image::Image& image, float strength, float rotation, std::string description) {
   if (image.empty()) throw InputError("environment " + description + ": the image has no pixels");
   if (!(strength >= 0.0f) || !std::isfinite(strength)) throw InputError("environment strength must be a finite number >= 0");

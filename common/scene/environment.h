@@ -22,6 +22,11 @@ class Environment {
   // centre looks down -z, its top is +y), times strength, turned by `rotation` radians about +y.
   // Throws pr::InputError for an empty image or non-finite or negative radiance.
   static Environment fromImage(const image::Image& image, float strength, float rotation, std::string description);
+  // A built-in studio sky (`--env sky`): a blue-white dome over a grey ground and a soft key
+  // light high in front and to the left of a camera looking down -z, as glTF sample
+  // screenshots are lit - so normal maps, metals and gloss show their shape, which a uniform
+  // environment cannot. Times strength, turned by `rotation` radians about +y.
+  static Environment sky(float strength, float rotation);
 
   bool isUniform() const { return width_ == 0; }
   const std::string& description() const { return description_; }
