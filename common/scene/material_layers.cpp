@@ -6,6 +6,8 @@
 #include <cmath>
 #include <numbers>
 
+#include "common/util/unit_table.h"
+
 namespace pr::scene {
 
 namespace {
@@ -24,15 +26,15 @@ float smithG1(float alpha, float c) {
 
 // E_sheen on a grid of NdotV x roughness, integrated once by the midpoint rule in (cos theta, phi).
 constexpr int kAlbedoSize = 32;
-using AlbedoTable = std::array<float, kAlbedoSize * kAlbedoSize>;
+using AlbedoTable = UnitTable<float, kAlbedoSize>;
 
 AlbedoTable integrateAlbedo() {
   AlbedoTable table{};
   constexpr int kTheta = 96, kPhi = 48;
   for (int r = 0; r < kAlbedoSize; ++r) {
-    const float roughness = float(r) / float(kAlbedoSize - 1);
+    const float roughness = AlbedoTable::coordinate(r);
     for (int v = 0; v < kAlbedoSize; ++v) {
-      const float cosV = std::max(float(v) / float(kAlbedoSize - 1), 1.0e-3f);
+      const float cosV = std::max(AlbedoTable::coordinate(v), 1.0e-3f);
       const float sinV = std::sqrt(1.0f - cosV * cosV);
       double sum = 0.0;
       for (int i = 0; i < kTheta; ++i) {
@@ -46,7 +48,7 @@ AlbedoTable integrateAlbedo() {
           sum += double(sheenLobe(roughness, cosH, cosL, cosV) * cosL);
         }
       }
-      table[size_t(r * kAlbedoSize + v)] = float(sum * (2.0 * kPi / kPhi) / kTheta);
+      table.at(r, v) = float(sum * (2.0 * kPi / kPhi) / kTheta);
     }
   }
   return table;
@@ -65,14 +67,7 @@ float sheenLobe(float roughness, float NdotH, float NdotL, float NdotV) {
 
 float sheenAlbedo(float roughness, float NdotV) {
   static const AlbedoTable table = integrateAlbedo();
-  const float x = std::clamp(NdotV, 0.0f, 1.0f) * float(kAlbedoSize - 1);
-  const float y = std::clamp(roughness, 0.0f, 1.0f) * float(kAlbedoSize - 1);
-  const int x0 = std::min(int(x), kAlbedoSize - 2), y0 = std::min(int(y), kAlbedoSize - 2);
-  const float fx = x - float(x0), fy = y - float(y0);
-  auto at = [&](int r, int v) { return table[size_t(r * kAlbedoSize + v)]; };
-  const float lo = at(y0, x0) * (1.0f - fx) + at(y0, x0 + 1) * fx;
-  const float hi = at(y0 + 1, x0) * (1.0f - fx) + at(y0 + 1, x0 + 1) * fx;
-  return std::clamp(lo * (1.0f - fy) + hi * fy, 0.0f, 1.0f);
+  return std::clamp(table.lookup(NdotV, roughness), 0.0f, 1.0f);
 }
 
 float coatFresnel(float cosTheta) {

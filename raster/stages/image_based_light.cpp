@@ -8,6 +8,8 @@
 #include <mutex>
 #include <numbers>
 
+#include "common/util/unit_table.h"
+
 namespace pr::raster {
 
 namespace {
@@ -66,16 +68,16 @@ std::array<float, 9> shBasis(const glm::vec3& d) {
           1.092548f * d.x * d.z, 0.546274f * (d.x * d.x - d.y * d.y)};
 }
 
-using AlbedoTable = std::array<glm::vec2, kAlbedoSize * kAlbedoSize>;
+using AlbedoTable = UnitTable<glm::vec2, kAlbedoSize>;
 
 AlbedoTable integrateSpecularAlbedo() {
   AlbedoTable table{};
   constexpr int kSamples = 256;
   for (int r = 0; r < kAlbedoSize; ++r) {
-    const float roughness = std::max(float(r) / float(kAlbedoSize - 1), 0.045f);
+    const float roughness = std::max(AlbedoTable::coordinate(r), 0.045f);
     const float alpha = roughness * roughness, k = 0.5f * alpha;
     for (int c = 0; c < kAlbedoSize; ++c) {
-      const float NdotV = std::max(float(c) / float(kAlbedoSize - 1), 1.0e-3f);
+      const float NdotV = std::max(AlbedoTable::coordinate(c), 1.0e-3f);
       const glm::vec3 V(std::sqrt(1.0f - NdotV * NdotV), 0.0f, NdotV);
       glm::vec2 sum(0.0f);
       for (int i = 0; i < kSamples; ++i) {
@@ -89,7 +91,7 @@ AlbedoTable integrateSpecularAlbedo() {
         const float fc = std::pow(1.0f - VdotH, 5.0f);
         sum += glm::vec2((1.0f - fc) * vis, fc * vis);
       }
-      table[size_t(r * kAlbedoSize + c)] = sum / float(kSamples);
+      table.at(r, c) = sum / float(kSamples);
     }
   }
   return table;
@@ -99,12 +101,7 @@ AlbedoTable integrateSpecularAlbedo() {
 
 glm::vec2 specularAlbedo(float NdotV, float roughness) {
   static const AlbedoTable table = integrateSpecularAlbedo();
-  const float x = std::clamp(NdotV, 0.0f, 1.0f) * float(kAlbedoSize - 1);
-  const float y = std::clamp(roughness, 0.0f, 1.0f) * float(kAlbedoSize - 1);
-  const int x0 = std::min(int(x), kAlbedoSize - 2), y0 = std::min(int(y), kAlbedoSize - 2);
-  const float fx = x - float(x0), fy = y - float(y0);
-  auto at = [&](int r, int c) { return table[size_t(r * kAlbedoSize + c)]; };
-  return glm::mix(glm::mix(at(y0, x0), at(y0, x0 + 1), fx), glm::mix(at(y0 + 1, x0), at(y0 + 1, x0 + 1), fx), fy);
+  return table.lookup(NdotV, roughness);
 }
 
 ImageBasedLight::ImageBasedLight(const scene::Environment& env) {
