@@ -96,8 +96,10 @@ image::Image renderWith(const std::string& methodName, const scene::Scene& scene
   return method.make(method.name, request).image;
 }
 
+// The file's path under the gallery folder as a file name (Box/glTF/Box.gltf: Box_glTF_Box), so
+// models that share a file name (variants of one model) keep their own images.
 std::string safeName(const fs::path& p) {
-  std::string s = p.stem().string();
+  std::string s = p.parent_path().empty() ? p.stem().string() : (p.parent_path() / p.stem()).string();
   for (char& c : s)
     if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
   return s;
@@ -120,7 +122,7 @@ void run(const GalleryArgs& a) {
   std::string rows;
   for (size_t i = 0; i < models.size(); ++i) {
     const fs::path& model = models[i];
-    const std::string name = safeName(model);
+    const std::string name = safeName(model.lexically_relative(a.dir));
     std::fprintf(stderr, "[%zu/%zu] %s\n", i + 1, models.size(), model.string().c_str());
     std::vector<image::Image> cells(kColumns);
     std::string note;
@@ -147,7 +149,7 @@ void run(const GalleryArgs& a) {
       for (int y = 0; y < a.size; ++y)
         for (int x = 0; x < a.size; ++x) sheet.at(left + c * a.size + x, top + y) = cell.at(x, y);
     }
-    rows += "<tr><td>" + std::to_string(i + 1) + "</td><td>" + fs::relative(model, a.dir).string() + "</td><td>" +
+    rows += "<tr><td>" + std::to_string(i + 1) + "</td><td>" + model.lexically_relative(a.dir).string() + "</td><td>" +
             (shot.empty() ? "(no screenshot)" : "") + "</td><td><img src=\"" + name + "_" + a.rasterMethod +
             ".png\"></td><td><img src=\"" + name + "_" + a.rayMethod + ".png\"></td><td>" + note + "</td></tr>\n";
   }

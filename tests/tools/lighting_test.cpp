@@ -6,6 +6,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/image/image_io.h"
 #include "test_support.h"
@@ -51,6 +52,37 @@ TEST_CASE("Lighting: a model without lights is lit by the default environment in
   CHECK(info.output.find("direct: on - the environment") != std::string::npos);
   const auto unlit = runParrender(join({"info ", duck(), " --no-default-light"}));
   CHECK(unlit.output.find("direct: off - no light") != std::string::npos);
+}
+
+TEST_CASE("Lighting: every sort point lights a model without lights by image-based lighting, bit-identically") {
+  if (!pr::test::haveSharedScenes()) return;
+  const std::filesystem::path dir = pr::test::scratchDir("lighting_raster");
+  std::vector<pr::image::Image> images;
+  for (const char* method : {"sort-first", "sort-middle", "sort-last"}) {
+    CAPTURE(method);
+    const std::filesystem::path out = dir / (std::string(method) + ".exr");
+    const auto r = runParrender(join({"render ", duck(), " -m ", method, " --threads 2 --width 32 --height 32 -o \"",
+                                      out.string(), "\""}));
+    INFO(r.output);
+    REQUIRE(r.exitStatus == 0);
+    CHECK(r.output.find("the environment by image-based lighting") != std::string::npos);
+    images.push_back(pr::image::readImage(out));
+  }
+  // The duck is lit (not only the white background shows).
+  double duckSum = 0.0;
+  int duckPixels = 0;
+  for (const glm::vec3& p : images[0].pixels)
+    if (p != glm::vec3(1.0f)) duckSum += p.x, ++duckPixels;
+  CHECK(duckPixels > 20);
+  CHECK(duckSum / duckPixels > 0.1);
+  CHECK(images[1].pixels == images[0].pixels);
+  CHECK(images[2].pixels == images[0].pixels);
+  // --headlight: the old light from the eye, black background.
+  const auto h = runParrender(join({"render ", duck(), " -m sort-middle --headlight --width 32 --height 32 -o \"",
+                                    (dir / "headlight.exr").string(), "\""}));
+  REQUIRE(h.exitStatus == 0);
+  CHECK(h.output.find("a headlight") != std::string::npos);
+  CHECK(pr::image::readImage(dir / "headlight.exr").pixels[0] == glm::vec3(0.0f));
 }
 
 TEST_CASE("Lighting: --env lights a scene from an equirectangular image; a missing file exits 2") {
