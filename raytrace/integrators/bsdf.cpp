@@ -97,6 +97,25 @@ struct GlossyLobe {
   }
 };
 
+// A normal map can tilt the normal so far that the mirror direction of wo about it points into
+// the surface (a flat plate mapped to look like a sphere, seen near the sphere's rim), where
+// every reflection would be lost and a metal turns black. The normal is then bent to the half
+// vector of wo and that direction lifted just above the geometric plane (as Unreal's and
+// Falcor's normal-map fixes do). In the geometric front's convention, as makeInteraction's.
+glm::vec3 keepReflectionAbove(const glm::vec3& n, const SurfaceInteraction& si) {
+  constexpr float kLift = 0.01f;
+  const glm::vec3 w = si.frontFace ? si.wo : -si.wo;
+  const glm::vec3& ng = si.geometricNormal;
+  if (!(glm::dot(w, ng) > 0.0f)) return n;
+  const glm::vec3 r = 2.0f * glm::dot(w, n) * n - w;
+  const float above = glm::dot(r, ng);
+  if (above >= kLift) return n;
+  const glm::vec3 lifted = glm::normalize(r + ng * (kLift - above));
+  const glm::vec3 h = w + lifted;
+  const float len = glm::length(h);
+  return len > 1.0e-6f && std::isfinite(len) ? h / len : n;
+}
+
 }  // namespace
 
 ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction& si, bool textures) {
@@ -125,6 +144,7 @@ ShadingMaterial evalMaterial(const scene::Scene& scene, const SurfaceInteraction
   // A normal map may bend the normal below the geometric surface; shading then keeps the
   // interpolated one, as makeInteraction keeps the geometric side.
   m.normal = glm::dot(r.normal, si.geometricNormal) > 0.0f ? r.normal : si.shadingNormal;
+  if (m.normal != si.shadingNormal) m.normal = keepReflectionAbove(m.normal, si);
   m.sheenColor = r.sheenColor;
   m.sheenRoughness = r.sheenRoughness;
   m.clearcoat = r.clearcoat;

@@ -5,6 +5,7 @@
 
 #include <doctest/doctest.h>
 
+#include "common/scene/tangent_frame.h"
 #include "raytrace/integrators/bsdf.h"
 #include "raytrace/integrators/sampling.h"
 
@@ -238,4 +239,34 @@ TEST_CASE("Bsdf: anisotropic GGX (KHR_materials_anisotropy) is reciprocal, sampl
     sy += std::fabs(s.wi.y);
   }
   CHECK(sx > 2.0 * sy);
+}
+
+TEST_CASE("Bsdf: a normal map never sends the mirror direction into the surface") {
+  // A flat plate whose normal map tilts the normal almost into the plate (a sphere's rim).
+  scene::Scene s;
+  scene::Texture t;
+  t.width = t.height = 1;
+  t.rgba8 = {255, 128, 133, 255};  // tangent space (1, 0, 0.04)
+  s.textures = {t};
+  scene::Material metal;
+  metal.metallicFactor = 1.0f;
+  metal.roughnessFactor = 0.0f;
+  metal.normalTexture.texture = 0;
+  s.materials = {metal};
+  rt::SurfaceInteraction si;
+  si.geometricNormal = si.shadingNormal = glm::vec3(0, 0, 1);
+  si.tangent = glm::vec4(1, 0, 0, 1);
+  si.wo = glm::normalize(glm::vec3(1, 0, 1));
+  si.frontFace = true;
+  const rt::ShadingMaterial m = rt::evalMaterial(s, si);
+  const glm::vec3 r = 2.0f * glm::dot(si.wo, m.normal) * m.normal - si.wo;
+  CHECK(r.z > 0.005f);
+  CHECK(m.normal.x > 0.3f);  // still leaning the way the map says
+  // Where the map's reflection stays above the surface the normal is the map's own.
+  s.textures[0].rgba8 = {160, 128, 240, 255};
+  si.wo = glm::vec3(0, 0, 1);
+  const rt::ShadingMaterial kept = rt::evalMaterial(s, si);
+  const glm::vec3 mapped = scene::perturbNormal(si.shadingNormal, si.tangent, glm::vec3(s.textures[0].sample({0.5f, 0.5f}, false)), 1.0f);
+  CHECK(kept.normal.x == doctest::Approx(mapped.x));
+  CHECK(kept.normal.x > 0.2f);
 }
