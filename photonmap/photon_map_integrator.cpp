@@ -163,13 +163,11 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
 
 // ---- shading ----------------------------------------------------------------------------------
 
-void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& arrived, rt::Emit& out) const {
+void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessage& incoming, rt::Emit& out) const {
   const rt::IntegratorContext& ctx = context();
   const State& state = *state_;
   rt::ShadingMaterial m = ctx.material(si, out);
-  // A segment that ran inside an absorbing solid arrives attenuated (KHR_materials_volume).
-  RayMessage msg = arrived;
-  msg.throughput *= rt::volumeTransmittance(m, si, arrived.ray);
+  const RayMessage msg = ctx.arrived(si, m, incoming);
 
   if (settings_.view != PhotonView::Full) {
     const bool global = settings_.view == PhotonView::GlobalMap;
@@ -213,15 +211,14 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (rt::maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= options().maxDepth) return;
-  // An anisotropic material's glossy lobe is Ward's, in the frame of its anisotropy direction.
-  const bool ward = m.anisotropy > 0.0f && m.hasSpecular() && !m.deltaSpecular() && ctx.simulates(scene::Effect::Anisotropy);
+  // An anisotropic material's glossy lobe is Ward's, in the shading frame, which ShadingFrame
+  // turned to the anisotropy direction (m.anisotropy is 0 when the plan has anisotropy off).
+  const bool ward = m.anisotropy > 0.0f && m.hasSpecular() && !m.deltaSpecular();
   const WardLobe lobe = ward ? wardLobe(m) : WardLobe{};
-  const rt::Frame wardFrame = ward ? anisotropyFrame(ctx.scene(), si, sf.ns, m.anisotropyDirection) : sf.frame;
-  const glm::vec3 wardWo = wardFrame.toLocal(si.wo);
   if (ward) {
     const glm::vec3 diffuseF = m.diffuseColor() * rt::kInvPi;
-    const rt::IntegratorContext::OpaqueEval eval = [&](const glm::vec3&, const glm::vec3& wiLocal) {
-      return diffuseF + evalWard(lobe, wardWo, wardFrame.toLocal(sf.frame.toWorld(wiLocal)));
+    const rt::IntegratorContext::OpaqueEval eval = [&](const glm::vec3& woLocal, const glm::vec3& wiLocal) {
+      return diffuseF + evalWard(lobe, woLocal, wiLocal);
     };
     ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_, &eval);
   } else {
@@ -268,9 +265,9 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
       const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
       for (int i = 0; i < n; ++i) {
         const float u = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)), v = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u);
-        const rt::BsdfSample s = ward ? sampleWard(lobe, wardWo, u, v) : rt::sampleGlossy(m, sf.woLocal, u, v);
+        const rt::BsdfSample s = ward ? sampleWard(lobe, sf.woLocal, u, v) : rt::sampleGlossy(m, sf.woLocal, u, v);
         if (!s.valid) continue;
-        const glm::vec3 wi = (ward ? wardFrame : sf.frame).toWorld(s.wi);
+        const glm::vec3 wi = sf.frame.toWorld(s.wi);
         if (glm::dot(wi, sf.ng) <= 0.0f) continue;
         // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
         spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,

@@ -58,30 +58,4 @@ WardLobe wardLobe(const rt::ShadingMaterial& m) {
   return lobe;
 }
 
-rt::Frame anisotropyFrame(const scene::Scene& scene, const rt::SurfaceInteraction& si, const glm::vec3& n,
-                          const glm::vec2& direction) {
-  rt::Frame frame(n);
-  if (si.triangle < scene.triangles.size() && !scene.uvs.empty()) {
-    const scene::Triangle& t = scene.triangles[si.triangle];
-    const glm::vec3 p0 = scene.positions[t.v[0]], p1 = scene.positions[t.v[1]], p2 = scene.positions[t.v[2]];
-    const glm::vec2 t0 = scene.uvs[t.v[0]], t1 = scene.uvs[t.v[1]], t2 = scene.uvs[t.v[2]];
-    const glm::vec3 e1 = p1 - p0, e2 = p2 - p0;
-    const glm::vec2 d1 = t1 - t0, d2 = t2 - t0;
-    const float det = d1.x * d2.y - d1.y * d2.x;
-    if (std::fabs(det) > 1.0e-12f) {
-      const glm::vec3 dpdu = (e1 * d2.y - e2 * d1.y) / det;
-      const glm::vec3 tangent = dpdu - n * glm::dot(n, dpdu);  // Gram-Schmidt onto the shading plane
-      if (glm::dot(tangent, tangent) > 1.0e-12f) {
-        frame.s = glm::normalize(tangent);
-        frame.t = glm::cross(n, frame.s);
-      }
-    }
-  }
-  const glm::vec3 x = direction.x * frame.s + direction.y * frame.t;
-  frame.s = glm::normalize(x);
-  frame.t = glm::cross(n, frame.s);
-  frame.n = n;
-  return frame;
-}
-
 }  // namespace pr::pm

@@ -32,10 +32,4 @@ rt::BsdfSample sampleWard(const WardLobe& lobe, const glm::vec3& wo, float u, fl
 // GGX alpha, at least 1e-3 so the lobe stays finite).
 WardLobe wardLobe(const rt::ShadingMaterial& m);
 
-// The lobe's frame at si: z = n (the shading normal on the side of wo), x = the material's
-// anisotropy direction in the tangent plane of the triangle's uv parameterisation (dp/du,
-// or any tangent when the uvs are degenerate).
-rt::Frame anisotropyFrame(const scene::Scene& scene, const rt::SurfaceInteraction& si, const glm::vec3& n,
-                          const glm::vec2& direction);
-
 }  // namespace pr::pm

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "common/scene/microfacet.h"
 #include "common/util/unit_table.h"
 
 namespace pr::scene {
@@ -17,12 +18,6 @@ constexpr float kPi = std::numbers::pi_v<float>;
 constexpr float kMinSheenAlpha = 0.07f * 0.07f;
 
 float sheenAlpha(float roughness) { return std::max(roughness * roughness, kMinSheenAlpha); }
-
-float smithG1(float alpha, float c) {
-  if (c <= 0.0f) return 0.0f;
-  const float a2 = alpha * alpha;
-  return 2.0f * c / (c + std::sqrt(a2 + (1.0f - a2) * c * c));
-}
 
 // E_sheen on a grid of NdotV x roughness, integrated once by the midpoint rule in (cos theta, phi).
 constexpr int kAlbedoSize = 32;
@@ -81,11 +76,8 @@ float coatAlpha(float roughness) { return std::max(roughness * roughness, 2.0e-3
 float coatLobe(float roughness, float NdotH, float NdotL, float NdotV, float VdotH) {
   if (NdotL <= 0.0f || NdotV <= 0.0f || NdotH <= 0.0f) return 0.0f;
   const float alpha = coatAlpha(roughness);
-  const float a2 = alpha * alpha;
-  const float d = NdotH * NdotH * (a2 - 1.0f) + 1.0f;
-  const float D = a2 / (kPi * d * d);
-  const float G = smithG1(alpha, NdotL) * smithG1(alpha, NdotV);
-  return D * G * coatFresnel(VdotH) / (4.0f * NdotL * NdotV);
+  const float G = ggxG1(alpha, NdotL) * ggxG1(alpha, NdotV);
+  return ggxD(alpha, NdotH) * G * coatFresnel(VdotH) / (4.0f * NdotL * NdotV);
 }
 
 }  // namespace pr::scene

@@ -9,12 +9,11 @@ namespace pr::scene {
 
 namespace {
 
-// A unit vector orthogonal to unit n (Duff et al. 2017, branchless ONB).
+// A unit vector orthogonal to unit n.
 glm::vec3 anyOrthogonal(glm::vec3 n) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float b = n.x * n.y * a;
-  return glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
+  glm::vec3 s, t;
+  orthonormalBasis(n, s, t);
+  return s;
 }
 
 float cornerAngle(glm::vec3 a, glm::vec3 b) {

@@ -8,6 +8,8 @@
 #include <mutex>
 #include <numbers>
 
+#include "common/scene/microfacet.h"
+#include "common/scene/tangent_frame.h"
 #include "common/util/unit_table.h"
 
 namespace pr::raster {
@@ -28,24 +30,6 @@ float radicalInverse(uint32_t bits) {
   bits = ((bits & 0x0F0F0F0Fu) << 4u) | ((bits & 0xF0F0F0F0u) >> 4u);
   bits = ((bits & 0x00FF00FFu) << 8u) | ((bits & 0xFF00FF00u) >> 8u);
   return float(bits) * 2.3283064365386963e-10f;
-}
-
-// A GGX half vector about +z for the point (u, v) (Walter et al. 2007, eq. 35).
-glm::vec3 ggxHalfVector(float alpha, float u, float v) {
-  const float cos2 = (1.0f - u) / (1.0f + (alpha * alpha - 1.0f) * u);
-  const float c = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
-  const float s = std::sqrt(std::max(0.0f, 1.0f - c * c));
-  const float phi = 2.0f * kPi * v;
-  return {s * std::cos(phi), s * std::sin(phi), c};
-}
-
-// An orthonormal basis about unit n (Duff et al. 2017).
-void basis(const glm::vec3& n, glm::vec3& s, glm::vec3& t) {
-  const float sign = std::copysign(1.0f, n.z);
-  const float a = -1.0f / (sign + n.z);
-  const float b = n.x * n.y * a;
-  s = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-  t = glm::vec3(b, sign + n.y * n.y * a, -n.y);
 }
 
 glm::vec3 directionOf(float u, float v) {
@@ -81,7 +65,7 @@ AlbedoTable integrateSpecularAlbedo() {
       const glm::vec3 V(std::sqrt(1.0f - NdotV * NdotV), 0.0f, NdotV);
       glm::vec2 sum(0.0f);
       for (int i = 0; i < kSamples; ++i) {
-        const glm::vec3 H = ggxHalfVector(alpha, (float(i) + 0.5f) / kSamples, radicalInverse(uint32_t(i)));
+        const glm::vec3 H = scene::ggxNormal(alpha, (float(i) + 0.5f) / kSamples, radicalInverse(uint32_t(i)));
         const float VdotH = glm::dot(V, H);
         const glm::vec3 L = 2.0f * VdotH * H - V;
         if (L.z <= 0.0f || VdotH <= 0.0f) continue;
@@ -153,10 +137,10 @@ ImageBasedLight::ImageBasedLight(const scene::Environment& env) {
         }
         const glm::vec3 n = directionOf((float(x) + 0.5f) / float(level.width), (float(y) + 0.5f) / float(level.height));
         glm::vec3 s, t;
-        basis(n, s, t);
+        scene::orthonormalBasis(n, s, t);
         float weight = 0.0f;
         for (int i = 0; i < kPrefilterSamples; ++i) {
-          const glm::vec3 h = ggxHalfVector(alpha, (float(i) + 0.5f) / kPrefilterSamples, radicalInverse(uint32_t(i)));
+          const glm::vec3 h = scene::ggxNormal(alpha, (float(i) + 0.5f) / kPrefilterSamples, radicalInverse(uint32_t(i)));
           const glm::vec3 hw = h.x * s + h.y * t + h.z * n;
           const glm::vec3 l = 2.0f * glm::dot(n, hw) * hw - n;
           const float NdotL = glm::dot(n, l);

@@ -248,24 +248,17 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeC
   }
 
   glm::vec3 V = ctx.view.perspective ? glm::normalize(ctx.view.eye - sp.position) : -ctx.view.forward;
-  const bool layered = r.hasSheen() || r.clearcoat > 0.0f;
   if (ctx.usesHeadlight) {
+    // Without layers, headlightBrdf: the exact operations of the SSE lanes (shadeBatch).
     const float NdotV = glm::dot(r.normal, V);
-    if (layered) radiance += layeredLight(r, V, V) * kHeadlightLux;
+    if (r.hasSheen() || r.clearcoat > 0.0f) radiance += layeredLight(r, V, V) * kHeadlightLux;
     else if (NdotV > 0.0f)
       radiance += headlightBrdf(r.baseColor, r.metallic, r.roughness, r.normal, V, r.dielectricF0()) * (kHeadlightLux * NdotV);
     return radiance;
   }
   for (const scene::PunctualLight& light : ctx.lights) {
     glm::vec3 L, E;
-    if (!incidentLight(light, sp.position, L, E)) continue;
-    if (layered) {
-      radiance += layeredLight(r, V, L) * E;
-      continue;
-    }
-    float NdotL = glm::dot(r.normal, L);
-    if (NdotL <= 0.0f) continue;
-    radiance += brdf(r.baseColor, r.metallic, r.roughness, r.normal, V, L, r.dielectricF0(), r.dielectricF90()) * E * NdotL;
+    if (incidentLight(light, sp.position, L, E)) radiance += layeredLight(r, V, L) * E;
   }
   if (ctx.ibl) radiance += environmentLight(*ctx.ibl, r, V);
   return radiance;

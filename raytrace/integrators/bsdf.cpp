@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "common/scene/material_layers.h"
+#include "common/scene/microfacet.h"
 #include "common/scene/surface_material.h"
 #include "raytrace/integrators/sampling.h"
 
@@ -14,20 +15,8 @@ namespace pr::rt {
 
 namespace {
 
-// Walter et al. eq. 33: the GGX normal distribution, h in the local frame.
-float ggxD(float alpha, float cosH) {
-  if (cosH <= 0.0f) return 0.0f;
-  const float a2 = alpha * alpha;
-  const float d = cosH * cosH * (a2 - 1.0f) + 1.0f;
-  return a2 / (kPi * d * d);
-}
-
-// Walter et al. eq. 34: Smith's masking term for GGX, direction with cosine `c` to the normal.
-float ggxG1(float alpha, float c) {
-  if (c <= 0.0f) return 0.0f;
-  const float a2 = alpha * alpha;
-  return 2.0f * c / (c + std::sqrt(a2 + (1.0f - a2) * c * c));
-}
+using scene::ggxD;
+using scene::ggxG1;
 
 // Pdf of the GGX reflection sample: D(h) cos(h) for h, and dwh/dwi = 1 / (4 wo.h).
 float ggxPdf(float alpha, const glm::vec3& wo, const glm::vec3& wi) {
@@ -37,15 +26,9 @@ float ggxPdf(float alpha, const glm::vec3& wo, const glm::vec3& wi) {
   return ggxD(alpha, h.z) * h.z / (4.0f * oh);
 }
 
-// wo reflected about a GGX half vector: cos^2(theta_h) = (1 - u) / (1 + (alpha^2 - 1) u)
-// (Walter et al. eq. 35), phi_h = 2 pi v.
+// wo reflected about a GGX microfacet normal.
 glm::vec3 ggxReflection(float alpha, const glm::vec3& wo, float u, float v) {
-  const float a2 = alpha * alpha;
-  const float cos2 = (1.0f - u) / (1.0f + (a2 - 1.0f) * u);
-  const float cosH = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
-  const float sinH = std::sqrt(std::max(0.0f, 1.0f - cosH * cosH));
-  const float phi = 2.0f * kPi * v;
-  const glm::vec3 h(sinH * std::cos(phi), sinH * std::sin(phi), cosH);
+  const glm::vec3 h = scene::ggxNormal(alpha, u, v);
   return 2.0f * glm::dot(wo, h) * h - wo;
 }
 
@@ -235,8 +218,6 @@ BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, 
 
 namespace {
 
-float maxComponent3(const glm::vec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
-
 // The base (diffuse + GGX) with the sheen layer over it: the base loses what the sheen's
 // directional albedo takes, so the pair never reflects more than the base alone could.
 glm::vec3 evalBaseAndSheen(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
@@ -244,7 +225,7 @@ glm::vec3 evalBaseAndSheen(const ShadingMaterial& m, const glm::vec3& wo, const 
   if (!m.hasSheen()) return f;
   const glm::vec3 h = glm::normalize(wo + wi);
   const float r = m.sheenRoughness;
-  const float scale = 1.0f - maxComponent3(m.sheenColor) * std::max(scene::sheenAlbedo(r, wo.z), scene::sheenAlbedo(r, wi.z));
+  const float scale = 1.0f - maxComponent(m.sheenColor) * std::max(scene::sheenAlbedo(r, wo.z), scene::sheenAlbedo(r, wi.z));
   return f * scale + m.sheenColor * scene::sheenLobe(r, h.z, wi.z, wo.z);
 }
 
@@ -296,20 +277,27 @@ float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& 
   return pc > 0.0f ? pc * coatPdf(m, wo, wi) + (1.0f - pc) * base : base;
 }
 
+OpaqueLobe opaqueLobe(const ShadingMaterial& m, const glm::vec3& wo, float lobe) {
+  const float pc = coatProbability(m, wo);
+  if (lobe < pc) return OpaqueLobe::Coat;
+  const float rest = pc > 0.0f ? std::min((lobe - pc) / (1.0f - pc), kOneMinusEpsilon) : lobe;
+  return rest < specularProbability(m, wo.z) ? OpaqueLobe::Specular : OpaqueLobe::Diffuse;
+}
+
 BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v) {
   BsdfSample s;
   if (wo.z <= 0.0f) return s;
-  const float pc = coatProbability(m, wo);
-  if (lobe < pc) {
-    // The coat's GGX lobe about its own normal.
-    const Frame coat(m.clearcoatNormal);
-    s.wi = coat.toWorld(ggxReflection(scene::coatAlpha(m.clearcoatRoughness), coat.toLocal(wo), u, v));
-  } else {
-    lobe = pc > 0.0f ? std::min((lobe - pc) / (1.0f - pc), 0.99999994f) : lobe;
-    const float ps = specularProbability(m, wo.z);
-    if (lobe < ps) {
+  switch (opaqueLobe(m, wo, lobe)) {
+    case OpaqueLobe::Coat: {
+      // The coat's GGX lobe about its own normal.
+      const Frame coat(m.clearcoatNormal);
+      s.wi = coat.toWorld(ggxReflection(scene::coatAlpha(m.clearcoatRoughness), coat.toLocal(wo), u, v));
+      break;
+    }
+    case OpaqueLobe::Specular:
       if (m.deltaSpecular()) {
         // Perfect mirror: f cos / pdf = F / (probability of this lobe), under the coat's share.
+        const float pc = coatProbability(m, wo), ps = specularProbability(m, wo.z);
         s.wi = glm::vec3(-wo.x, -wo.y, wo.z);
         s.weight = m.specularFresnel(wo.z) * ((1.0f - coatWeight(m, wo)) / (ps * (1.0f - pc)));
         s.delta = true;
@@ -317,9 +305,8 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
         return s;
       }
       s.wi = GlossyLobe(m).reflect(wo, u, v);
-    } else {
-      s.wi = cosineHemisphere(u, v);
-    }
+      break;
+    case OpaqueLobe::Diffuse: s.wi = cosineHemisphere(u, v); break;
   }
   if (s.wi.z <= 0.0f) return s;
   s.pdf = pdfOpaque(m, wo, s.wi);
@@ -329,15 +316,7 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
   return s;
 }
 
-glm::vec3 sampleMicrofacetNormal(const ShadingMaterial& m, float u, float v) {
-  // ggxReflection's half vector for wo = +z is that normal: reflect +z about h gives 2 h.z h - z.
-  const float a2 = m.alpha * m.alpha;
-  const float cos2 = (1.0f - u) / (1.0f + (a2 - 1.0f) * u);
-  const float cosH = std::sqrt(std::clamp(cos2, 0.0f, 1.0f));
-  const float sinH = std::sqrt(std::max(0.0f, 1.0f - cosH * cosH));
-  const float phi = 2.0f * kPi * v;
-  return {sinH * std::cos(phi), sinH * std::sin(phi), cosH};
-}
+glm::vec3 sampleMicrofacetNormal(const ShadingMaterial& m, float u, float v) { return scene::ggxNormal(m.alpha, u, v); }
 
 float microfacetWeight(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi, const glm::vec3& h) {
   const float g = ggxG1(m.alpha, std::fabs(wo.z)) * ggxG1(m.alpha, std::fabs(wi.z));

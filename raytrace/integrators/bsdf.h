@@ -123,6 +123,11 @@ struct BsdfSample {
   bool valid = false;
 };
 BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// The lobe sampleOpaque takes for `lobe`: the clear coat below coatProbability, then (lobe
+// rescaled to the rest) the specular lobe below specularProbability, else the diffuse one.
+// Integrators that skip a lobe's rays under the plan ask it before sampling.
+enum class OpaqueLobe { Coat, Specular, Diffuse };
+OpaqueLobe opaqueLobe(const ShadingMaterial& m, const glm::vec3& wo, float lobe);
 // The dielectric part with roughness (Walter et al. 2007): a GGX microfacet normal for (u, v)
 // in the local frame (z = normal), and the weight of reflecting or refracting wo about it when
 // the choice between the two is made with probability F: |wo.h| G(wo, wi) / (|wo.n| |h.n|).

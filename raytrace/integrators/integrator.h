@@ -91,6 +91,13 @@ class IntegratorContext {
   bool simulates(scene::Effect e) const { return options_.effects.has(e); }
   // The material at a hit, its textures ignored when the plan turns textures off (counted).
   ShadingMaterial material(const SurfaceInteraction& si, Emit& out) const;
+  // The message as it arrives at si: its throughput attenuated when the segment ran inside an
+  // absorbing solid (KHR_materials_volume, volumeTransmittance). Every integrator shades this.
+  RayMessage arrived(const SurfaceInteraction& si, const ShadingMaterial& m, const RayMessage& msg) const {
+    RayMessage at = msg;
+    at.throughput *= volumeTransmittance(m, si, msg.ray);
+    return at;
+  }
   // The emitted radiance at a hit towards wo; zero (counted) when emission is off.
   glm::vec3 emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const;
   // Next-event estimation at a hit: one shadow ray per punctual light and one area-light

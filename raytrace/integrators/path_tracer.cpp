@@ -19,12 +19,10 @@ constexpr int kRouletteDepth = 3;
 constexpr float kMaxSurvival = 0.95f;
 }  // namespace
 
-void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& arrived, Emit& out) const {
+void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& incoming, Emit& out) const {
   const IntegratorContext& ctx = context();
   ShadingMaterial m = ctx.material(si, out);
-  // A segment that ran inside an absorbing solid arrives attenuated (KHR_materials_volume).
-  RayMessage msg = arrived;
-  msg.throughput *= volumeTransmittance(m, si, arrived.ray);
+  const RayMessage msg = ctx.arrived(si, m, incoming);
 
   // Emission: full weight for camera rays and after delta events; otherwise MIS against the
   // light sample taken at the previous vertex (power heuristic).
@@ -94,19 +92,13 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& arriv
     if (!reflect) throughput *= m.transmissionTint(si.frontFace);
   } else {
     const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, kOneMinusEpsilon);
-    // The lobe sampleOpaque will take for u (its own test): the clear coat below its
-    // probability, then (u rescaled) specular below the specular probability.
-    const float pc = coatProbability(m, sf.woLocal);
-    const float ub = pc > 0.0f ? (u - pc) / (1.0f - pc) : u;
-    if (u < pc) {
+    // The plan may skip the lobe sampleOpaque will take for u.
+    const OpaqueLobe chosen = opaqueLobe(m, sf.woLocal, u);
+    if (chosen == OpaqueLobe::Specular && m.deltaSpecular()) {
+      if (!ctx.simulates(scene::Effect::IdealSpecular)) return skip(&TraceStats::specularRaysSkipped);
+      if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
+    } else if (chosen != OpaqueLobe::Diffuse) {
       if (!ctx.simulates(scene::Effect::GlossySpecular)) return skip(&TraceStats::glossyRaysSkipped);
-    } else if (ub < ps) {
-      if (m.deltaSpecular()) {
-        if (!ctx.simulates(scene::Effect::IdealSpecular)) return skip(&TraceStats::specularRaysSkipped);
-        if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
-      } else if (!ctx.simulates(scene::Effect::GlossySpecular)) {
-        return skip(&TraceStats::glossyRaysSkipped);
-      }
     } else if (!ctx.simulates(scene::Effect::IndirectDiffuse)) {
       return skip(&TraceStats::indirectRaysSkipped);
     }

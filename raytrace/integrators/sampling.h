@@ -11,6 +11,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/scene/tangent_frame.h"
 #include "common/util/hash.h"
 
 namespace pr::rt {
@@ -64,13 +65,7 @@ inline glm::vec2 stratifiedPixelSample(int s, int spp, float u, float v) {
 // An orthonormal basis around unit n (Duff et al. 2017, "Building an orthonormal basis, revisited").
 struct Frame {
   glm::vec3 s, t, n;
-  explicit Frame(const glm::vec3& normal) : n(normal) {
-    const float sign = std::copysign(1.0f, n.z);
-    const float a = -1.0f / (sign + n.z);
-    const float b = n.x * n.y * a;
-    s = glm::vec3(1.0f + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    t = glm::vec3(b, sign + n.y * n.y * a, -n.y);
-  }
+  explicit Frame(const glm::vec3& normal) : n(normal) { scene::orthonormalBasis(n, s, t); }
   glm::vec3 toWorld(const glm::vec3& v) const { return v.x * s + v.y * t + v.z * n; }
   glm::vec3 toLocal(const glm::vec3& v) const { return {glm::dot(v, s), glm::dot(v, t), glm::dot(v, n)}; }
 };

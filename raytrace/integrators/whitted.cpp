@@ -14,12 +14,10 @@ namespace {
 constexpr float kMinThroughput = 1.0f / 4096.0f;
 }  // namespace
 
-void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& arrived, Emit& out) const {
+void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& incoming, Emit& out) const {
   const IntegratorContext& ctx = context();
   ShadingMaterial m = ctx.material(si, out);
-  // A segment that ran inside an absorbing solid arrives attenuated (KHR_materials_volume).
-  RayMessage msg = arrived;
-  msg.throughput *= volumeTransmittance(m, si, arrived.ray);
+  const RayMessage msg = ctx.arrived(si, m, incoming);
   // Every ray of a Whitted tracer reaches an emitter only through camera, mirror or
   // refraction paths, which light sampling never covers, so emission counts fully.
   const glm::vec3 le = ctx.emitted(m, si, out);
