@@ -6,6 +6,8 @@
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
+#include "raster/stages/background.h"
+#include "raster/stages/shade.h"
 #include "raytrace/integrators/integrator.h"
 #include "raytrace/partition/partition.h"
 #include "tools/integrators.h"
@@ -125,13 +127,14 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   for (const char* c : {"Plan/texture_evaluations_skipped", "Plan/emission_skipped", "Plan/light_samples_skipped"})
     if (const uint64_t n = counterTotal(record, c); n > 0)
       skipped += (skipped.empty() ? "" : ", ") + std::string(c + 5) + " " + std::to_string(n);
+  const bool environment = raster::showsEnvironment(r.scene, o.headlight);
   out.effects = std::string("rasterization simulates direct light (") +
-                (r.scene.lights.empty() && (o.headlight || !r.scene.environment)
+                (raster::litByHeadlight(r.scene, o.headlight)
                      ? "a headlight"
                      : std::string(r.scene.lights.empty() ? "" : "punctual lights") +
-                           (r.scene.environment ? std::string(r.scene.lights.empty() ? "" : ", ") +
-                                                      "the environment by image-based lighting"
-                                                : "")) +
+                           (environment ? std::string(r.scene.lights.empty() ? "" : ", ") +
+                                              "the environment by image-based lighting"
+                                        : "")) +
                 ", no shadows), emission and textures" +
                 (missing.empty() ? std::string() : "; not simulated: " + missing) +
                 "; skipped work: " + (skipped.empty() ? "none" : skipped);

@@ -9,11 +9,16 @@
 
 namespace pr::scene {
 
-glm::vec3 SurfaceMaterial::dielectricF0() const {
-  // In double, so that ior 1.5 gives exactly 0.04f, the constant of glTF's core model.
+namespace {
+
+// ((ior - 1) / (ior + 1))^2 specularColor, at most 1, times specular; in double, so that
+// ior 1.5 gives exactly 0.04f, the constant of glTF's core model.
+glm::vec3 dielectricF0(float ior, glm::vec3 specularColor, float specular) {
   const double r = (double(ior) - 1.0) / (double(ior) + 1.0);
   return glm::min(glm::vec3(float(r * r)) * specularColor, glm::vec3(1.0f)) * specular;
 }
+
+}  // namespace
 
 bool usesTextures(const Material& m) {
   return m.baseColorTexture.present() || m.metallicRoughnessTexture.present() || m.normalTexture.present() ||
@@ -73,6 +78,7 @@ SurfaceMaterial resolveMaterial(const Scene& scene, uint32_t material, const Sur
   m.specularColor = glm::max(mat.specularColorFactor * glm::vec3(slot(mat.specularColorTexture, true)), glm::vec3(0.0f));
   m.transmission = std::clamp(mat.transmissionFactor * slot(mat.transmissionTexture, false).x, 0.0f, 1.0f);
   m.ior = std::isfinite(mat.ior) && mat.ior >= 1.0f ? mat.ior : 1.5f;
+  m.f0 = dielectricF0(m.ior, m.specularColor, m.specular);
   if (mat.isEmissive()) m.emission = glm::max(mat.emission() * glm::vec3(slot(mat.emissiveTexture, true)), glm::vec3(0.0f));
   m.normal = mapped(mat.normalTexture, mat.normalScale);
   if (mat.hasClearcoat()) {

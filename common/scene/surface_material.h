@@ -45,8 +45,10 @@ struct SurfaceMaterial {
   glm::vec3 normal{0.0f, 0.0f, 1.0f};  // the shading normal, normal map applied
 
   // F0 and F90 of the dielectric (non-metal) Fresnel term, KHR_materials_specular:
-  // F0 = min(((ior - 1) / (ior + 1))^2 specularColor, 1) specular, F90 = specular.
-  glm::vec3 dielectricF0() const;
+  // F0 = min(((ior - 1) / (ior + 1))^2 specularColor, 1) specular, F90 = specular. F0 is
+  // computed once by resolveMaterial (shading reads it per light).
+  glm::vec3 f0{0.04f};
+  glm::vec3 dielectricF0() const { return f0; }
   float dielectricF90() const { return specular; }
   bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
 };

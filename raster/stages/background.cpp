@@ -5,10 +5,12 @@
 
 #include <glm/gtc/matrix_inverse.hpp>
 
+#include "raster/stages/shade.h"
+
 namespace pr::raster {
 
 bool showsEnvironment(const scene::Scene& scene, bool headlight) {
-  return scene.environment && !(scene.lights.empty() && headlight);
+  return scene.environment && !litByHeadlight(scene, headlight);
 }
 
 void fillBackground(const FrameView& view, const scene::Environment& environment, RegionFramebuffer& fb) {

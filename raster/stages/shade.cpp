@@ -88,13 +88,17 @@ SurfacePoint surfaceAt(const scene::Scene& scene, const ScreenTriangle& tri, glm
   return sp;
 }
 
+bool litByHeadlight(const scene::Scene& scene, bool headlight) {
+  return scene.lights.empty() && (headlight || !scene.environment);
+}
+
 ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view, scene::EffectSet effects,
                                   bool headlight) {
   ShadingContext ctx;
   ctx.scene = &scene;
   ctx.view = view;
   ctx.lights = scene.lights;
-  ctx.usesHeadlight = ctx.lights.empty() && (headlight || !scene.environment);
+  ctx.usesHeadlight = litByHeadlight(scene, headlight);
   if (!ctx.usesHeadlight) ctx.ibl = ImageBasedLight::of(scene.environment);
   ctx.alphaTested = std::any_of(scene.materials.begin(), scene.materials.end(),
                                 [](const scene::Material& m) { return scene::alphaCuts(m); });

@@ -61,6 +61,10 @@ struct ShadingContext {
   bool textures = true, emission = true, direct = true;
 };
 
+// Whether the rasterizer lights this scene by its headlight: it has no punctual lights, and
+// no environment or --headlight asked for.
+bool litByHeadlight(const scene::Scene& scene, bool headlight);
+
 ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& view,
                                   scene::EffectSet effects = scene::EffectSet::all(), bool headlight = false);
 
