@@ -6,6 +6,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/util/error.h"
+#include "common/util/memory_limit.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
@@ -13,6 +14,25 @@ int main(int argc, char** argv) {
                "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "parrender 0.1.0");
+  // Global, and accepted after the subcommand too (fallthrough); applied as soon as it is
+  // parsed, so it is in force before the subcommand's callback loads anything.
+  app.fallthrough();
+  app.add_option_function<std::string>(
+         "--max-memory", [](const std::string& v) { pr::setMemoryLimit(pr::parseByteSize(v)); },
+         "memory a run may take, e.g. 512M or 8G; a file or request needing more is refused before allocating "
+         "(default: 3/4 of this machine's " + pr::formatBytes(pr::physicalMemoryBytes()) + ", " +
+             pr::formatBytes(pr::defaultMemoryLimit()) + ")")
+      ->check(CLI::Validator(
+          [](std::string& v) {
+            try {
+              pr::parseByteSize(v);
+              return std::string();
+            } catch (const pr::InputError& e) {
+              return std::string(e.what());
+            }
+          },
+          "SIZE"))
+      ->trigger_on_parse();
   // One line per subcommand (tools/commands.h).
   pr::cli::addGalleryCommand(app);
   pr::cli::addGenerateCommand(app);

@@ -145,6 +145,8 @@ std::vector<double> AccessorReader::decode(int index, const std::string& what, i
                     std::to_string(kMaxSparseOnlyCount));
     }
   }
+  // Decoded as doubles, then kept as floats or 32-bit indices.
+  context_.charge(saturatingMul(saturatingMul(acc.count, size_t(comps)), sizeof(double) + sizeof(float)), where);
   std::vector<double> out(acc.count * size_t(comps), 0.0);
   if (acc.bufferView >= 0) {
     for (size_t i = 0; i < acc.count; ++i) {

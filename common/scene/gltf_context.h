@@ -11,6 +11,7 @@
 #include "common/scene/scene.h"
 #include "common/util/error.h"
 #include "common/util/log.h"
+#include "common/util/memory_limit.h"
 
 namespace pr::scene::gltf {
 
@@ -18,11 +19,21 @@ struct Context {
   const tinygltf::Model& model;
   std::string file;  // as given by the user, so messages name what they typed
   Scene& scene;
+  MemoryBudget& budget;          // every large allocation of the load is charged here first
   std::set<std::string> warned;  // each distinct warning once, however many instances repeat it
   int variant = -1;              // KHR_materials_variants index applied, -1 = default materials
 
   // Bad input: one message naming the file, the element and the problem.
   [[noreturn]] void fail(const std::string& what) const { throw InputError(file + ": " + what); }
+
+  // Charges `bytes` for `what` to the budget; an input error naming the file when over.
+  void charge(uint64_t bytes, const std::string& what) const {
+    try {
+      budget.charge(bytes, what);
+    } catch (const InputError& e) {
+      fail(e.what());
+    }
+  }
 
   // Optional content skipped or ignored: printed once and kept in Scene::warnings.
   void warn(const std::string& what) {

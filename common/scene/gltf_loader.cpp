@@ -7,8 +7,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <fstream>
+#include <limits>
 #include <span>
+
+#include <stb/stb_image.h>
 
 #include <glm/gtc/quaternion.hpp>
 #include <glm/gtc/type_ptr.hpp>
@@ -18,6 +22,7 @@
 #include "common/scene/gltf_material.h"
 #include "common/scene/tangent_frame.h"
 #include "common/util/limits.h"
+#include "common/util/memory_limit.h"
 
 namespace pr::scene {
 
@@ -50,25 +55,139 @@ glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
   return len > 0.0f && std::isfinite(len) ? v / len : fallback;
 }
 
-// Parses the file with tinygltf; anything it rejects is one InputError naming the file.
-tinygltf::Model parse(const std::filesystem::path& path, std::vector<std::string>& tinyWarnings) {
-  const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw InputError(file + ": cannot read the file (" +
-                     (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") + ")");
+// External files (buffers, images) the file refers to, read through tinygltf's file-system
+// callbacks so that every one is confined to the model's folder and charged to the budget.
+struct FileAccess {
+  std::filesystem::path folder;  // empty: no external files at all (loading from memory)
+  MemoryBudget* budget = nullptr;
+  std::string refusal;  // the first refused reference; reported as the load's error
+
+  // The path relative to the folder, or "" when it is outside (or there is no folder).
+  std::filesystem::path inside(const std::string& path) const {
+    if (folder.empty()) return {};
+    const std::filesystem::path rel = std::filesystem::path(path).lexically_normal().lexically_relative(folder);
+    if (rel.empty() || rel.is_absolute() || *rel.begin() == "..") return {};
+    return rel;
   }
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(file + ": cannot read the file (permission denied or unreadable)");
+
+  bool allowed(const std::string& path) {
+    if (!inside(path).empty()) return true;
+    // tinygltf also probes the working directory ("./uri"): never read, and not the reference's
+    // fault; only a path under the folder it was given can be a reference that escapes.
+    const bool underFolder = !folder.empty() && path.rfind(folder.string(), 0) == 0;
+    if (refusal.empty() && (underFolder || folder.empty()) && !path.empty()) {
+      const std::string uri = folder.empty() ? path : std::filesystem::path(path).lexically_relative(folder).string();
+      refusal = folder.empty() ? "refers to the external file '" + uri + "', but a model loaded from memory has no folder"
+                               : "refers to '" + uri + "', outside the model's folder; refused";
+    }
+    return false;
+  }
+
+  // tinygltf URI-decodes with form rules, '+' becoming a space; a file whose name has a real
+  // '+' is found under its spaces turned back into '+'.
+  std::string resolve(const std::string& path) const {
+    std::error_code ec;
+    std::string uri = inside(path).string();
+    if (std::filesystem::is_regular_file(path, ec) || uri.find(' ') == std::string::npos) return path;
+    std::replace(uri.begin(), uri.end(), ' ', '+');
+    const std::filesystem::path plus = folder / uri;
+    return std::filesystem::is_regular_file(plus, ec) ? plus.string() : path;
+  }
+
+  static bool exists(const std::string& path, void* self) {
+    auto& access = *static_cast<FileAccess*>(self);
+    std::error_code ec;
+    return access.allowed(path) && std::filesystem::is_regular_file(access.resolve(path), ec);
+  }
+  static std::string expand(const std::string& path, void*) { return path; }  // no ~ or $VAR
+  static bool read(std::vector<unsigned char>* out, std::string* err, const std::string& uriPath, void* self) {
+    auto& access = *static_cast<FileAccess*>(self);
+    if (!access.allowed(uriPath)) return false;
+    const std::string path = access.resolve(uriPath);
+    std::error_code ec;
+    const uintmax_t size = std::filesystem::file_size(path, ec);
+    std::ifstream in(path, std::ios::binary);
+    if (ec || !in) {
+      if (err) *err = "unreadable";
+      return false;
+    }
+    try {
+      access.budget->charge(size, "file '" + access.inside(path).string() + "'");
+    } catch (const InputError& e) {
+      if (access.refusal.empty()) access.refusal = e.what();
+      return false;
+    }
+    out->resize(size_t(size));
+    if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
+      if (err) *err = "read failed";
+      return false;
+    }
+    // A GLB's header (magic, version 2, its own length) where raw bytes were expected: the
+    // accessors would read the container's header and JSON as vertex data.
+    uint32_t header[3] = {};
+    if (out->size() >= 12) std::memcpy(header, out->data(), 12);
+    if (out->size() >= 12 && std::memcmp(out->data(), "glTF", 4) == 0 && header[1] == 2 && header[2] == out->size()) {
+      if (access.refusal.empty()) {
+        access.refusal = "'" + access.inside(path).string() + "' is a binary glTF (.glb), not a raw buffer or image; load the .glb itself";
+      }
+      return false;
+    }
+    return true;
+  }
+  static bool write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+    if (err) *err = "the loader never writes";
+    return false;
+  }
+
+  // tinygltf's decoder after a look at the header: an image whose decoded pixels would exceed
+  // the budget is refused before stb_image allocates them.
+  static bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int width,
+                          int height, const unsigned char* bytes, int size, void* self) {
+    auto& access = *static_cast<FileAccess*>(self);
+    int w = 0, h = 0, channels = 0;
+    if (!stbi_info_from_memory(bytes, size, &w, &h, &channels)) {
+      // stb_image tries every format it knows, so its last reason is rarely the one that counts.
+      if (err) {
+        *err += "image " + std::to_string(index) +
+                " cannot be decoded (corrupt, not PNG or JPEG, or over stb_image's 2^30-byte limit)\n";
+      }
+      return false;
+    }
+    {
+      const uint64_t texel = stbi_is_16_bit_from_memory(bytes, size) ? 8 : 4;  // decoded as RGBA
+      try {
+        // Twice: tinygltf's decoded copy, and the scene's 8-bit RGBA texture made from it.
+        access.budget->charge(saturatingMul(saturatingMul(uint64_t(w), uint64_t(h)), texel + 4),
+                              "image " + std::to_string(index) + " (" + std::to_string(w) + " x " +
+                                  std::to_string(h) + " pixels)");
+      } catch (const InputError& e) {
+        if (access.refusal.empty()) access.refusal = e.what();
+        if (err) *err += e.what();
+        return false;
+      }
+    }
+    return tinygltf::LoadImageData(image, index, err, warn, width, height, bytes, size, nullptr);
+  }
+};
+
+// Parses the bytes with tinygltf; anything it rejects is one InputError naming the file.
+tinygltf::Model parse(std::span<const uint8_t> bytes, const std::string& file, FileAccess& access,
+                      std::vector<std::string>& tinyWarnings) {
   // A .glb starts with the magic "glTF" (spec 4.4.2); anything else is parsed as JSON.
-  char magic[4] = {};
-  const bool binary = in.read(magic, 4) && std::string_view(magic, 4) == "glTF";
+  const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
+  if (bytes.size() > size_t(std::numeric_limits<unsigned int>::max()))
+    throw InputError(file + ": " + std::to_string(bytes.size()) + " bytes is larger than glTF's 4 GiB limit");
 
   tinygltf::TinyGLTF parser;
+  parser.SetFsCallbacks({&FileAccess::exists, &FileAccess::expand, &FileAccess::read, &FileAccess::write, &access});
+  parser.SetImageLoader(&FileAccess::decodeImage, &access);
   tinygltf::Model model;
   std::string err, warn;
-  bool ok = binary ? parser.LoadBinaryFromFile(&model, &err, &warn, file)
-                   : parser.LoadASCIIFromFile(&model, &err, &warn, file);
+  const std::string folder = access.folder.empty() ? std::string() : access.folder.string();
+  bool ok = binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), folder)
+                   : parser.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(bytes.data()),
+                                                unsigned(bytes.size()), folder);
+  if (!access.refusal.empty()) throw InputError(file + ": " + access.refusal);
   if (!ok) {
     // tinygltf reports several lines; the first names the actual problem.
     std::string reason = err.empty() ? "unknown parse error" : err.substr(0, err.find('\n'));
@@ -86,6 +205,24 @@ tinygltf::Model parse(const std::filesystem::path& path, std::vector<std::string
     start = end + 1;
   }
   return model;
+}
+
+// The whole file, charged to the budget before it is read.
+std::vector<uint8_t> readFile(const std::filesystem::path& path, MemoryBudget& budget) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw InputError(file + ": cannot read the file (" +
+                     (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") + ")");
+  }
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  std::ifstream in(path, std::ios::binary);
+  if (ec || !in) throw InputError(file + ": cannot read the file (permission denied or unreadable)");
+  budget.charge(size, file);
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+    throw InputError(file + ": cannot read the file (read failed)");
+  return bytes;
 }
 
 // Local transform of a node: its matrix, or T * R * S (spec 3.5.3).
@@ -204,6 +341,7 @@ class Flattener {
                                                   uint64_t(ctx_.scene.triangles.size()) + triangles, kMaxTriangles,
                                                   "triangle indices are 32 bits");
     if (!problem.empty()) ctx_.fail(problem);
+    ctx_.charge(saturatingMul(declared, sizeof(uint32_t)) + saturatingMul(triangles, sizeof(uint32_t) * 3), where + " triangle list");
     if (prim.indices >= 0) {
       seq = accessors_.indices(prim.indices, where + " indices");
       for (uint32_t i : seq) {
@@ -323,6 +461,11 @@ class Flattener {
 
     std::vector<uint32_t> local = triangleList(prim, count, where);
     if (local.empty()) return;
+    // Every drawn instance is a copy in world space: positions, normals, uvs, colours,
+    // tangents, the generated-normal scratch and the triangles.
+    constexpr uint64_t kVertexBytes = 2 * sizeof(glm::vec3) + sizeof(glm::vec2) + 2 * sizeof(glm::vec4) + sizeof(glm::vec3);
+    ctx_.charge(saturatingMul(count, kVertexBytes) + saturatingMul(local.size() / 3, sizeof(Triangle)),
+                describe("node", nodeIndex, node.name) + " " + where);
 
     // World-space vertices. A mirroring transform (det < 0) reverses the apparent winding, so
     // triangles are re-wound below; normals transform by the inverse transpose (spec 3.5.2).
@@ -492,6 +635,44 @@ class Flattener {
   bool anyTangents_ = false;
 };
 
+// glTF nodes form disjoint strict trees (spec 3.5.1) and a scene lists each root once: so a
+// walk from the roots visits every node at most once. A node with two parents (a DAG that
+// would multiply the visits exponentially) or a scene root that is someone's child is refused.
+void checkNodeForest(const Context& ctx) {
+  const auto& nodes = ctx.model.nodes;
+  std::vector<int> parent(nodes.size(), -1);
+  for (size_t p = 0; p < nodes.size(); ++p) {
+    for (int child : nodes[p].children) {
+      if (child < 0 || size_t(child) >= nodes.size()) {
+        ctx.fail(describe("node", int(p), nodes[p].name) + ": child " + std::to_string(child) +
+                 " is out of range (the file has " + std::to_string(nodes.size()) + " nodes)");
+      }
+      if (parent[size_t(child)] >= 0) {
+        ctx.fail(describe("node", child, nodes[size_t(child)].name) + " is a child of both node " +
+                 std::to_string(parent[size_t(child)]) + " and node " + std::to_string(p) +
+                 " (glTF nodes form trees: one parent each)");
+      }
+      parent[size_t(child)] = int(p);
+    }
+  }
+  for (size_t s = 0; s < ctx.model.scenes.size(); ++s) {
+    std::vector<bool> listed(nodes.size(), false);
+    for (int root : ctx.model.scenes[s].nodes) {
+      const std::string where = describe("scene", int(s), ctx.model.scenes[s].name);
+      if (root < 0 || size_t(root) >= nodes.size()) {
+        ctx.fail(where + ": node " + std::to_string(root) + " is out of range (the file has " +
+                 std::to_string(nodes.size()) + " nodes)");
+      }
+      if (listed[size_t(root)]) ctx.fail(where + " lists node " + std::to_string(root) + " twice");
+      if (parent[size_t(root)] >= 0) {
+        ctx.fail(where + ": node " + std::to_string(root) + " is a scene root but also a child of node " +
+                 std::to_string(parent[size_t(root)]));
+      }
+      listed[size_t(root)] = true;
+    }
+  }
+}
+
 // KHR_materials_variants: the names the file defines, and the index of the one asked for.
 void selectVariant(Context& ctx, const std::string& name) {
   auto it = ctx.model.extensions.find("KHR_materials_variants");
@@ -517,12 +698,15 @@ void selectVariant(Context& ctx, const std::string& name) {
 
 }  // namespace
 
-Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
+namespace {
+
+Scene load(std::span<const uint8_t> bytes, const std::string& file, const std::filesystem::path& folder,
+           const LoadOptions& options, MemoryBudget& budget) {
   Scene scene;
-  scene.source = path;
   std::vector<std::string> tinyWarnings;
-  tinygltf::Model model = parse(path, tinyWarnings);
-  Context ctx{model, path.string(), scene, {}};
+  FileAccess access{folder, &budget, {}};
+  tinygltf::Model model = parse(bytes, file, access, tinyWarnings);
+  Context ctx{model, file, scene, budget, {}};
   selectVariant(ctx, options.variant);
 
   // A required extension we cannot honour makes the file unrenderable; an optional one is
@@ -547,6 +731,7 @@ Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
 
   // The default scene: `scene` when given, else scene 0 (spec 3.4); with no scenes at all,
   // nothing is drawn, which is reported as an empty scene below.
+  checkNodeForest(ctx);
   Flattener flattener(ctx);
   if (!model.scenes.empty()) {
     int sceneIndex = model.defaultScene >= 0 ? model.defaultScene : 0;
@@ -559,6 +744,23 @@ Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
   flattener.finish();
   if (scene.triangles.empty()) ctx.fail("the default scene contains no triangles (nothing to render)");
   return scene;
+}
+
+}  // namespace
+
+Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
+  MemoryBudget budget(options.maxMemoryBytes);
+  const std::vector<uint8_t> bytes = readFile(path, budget);
+  // Relative URIs resolve against the file's folder (spec 3.6.1); "." for a bare file name.
+  const std::filesystem::path folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
+  Scene scene = load(bytes, path.string(), folder.lexically_normal(), options, budget);
+  scene.source = path;
+  return scene;
+}
+
+Scene loadGltfFromMemory(std::span<const uint8_t> bytes, const std::string& name, const LoadOptions& options) {
+  MemoryBudget budget(options.maxMemoryBytes);
+  return load(bytes, name, {}, options, budget);
 }
 
 }  // namespace pr::scene

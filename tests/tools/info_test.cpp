@@ -77,7 +77,8 @@ TEST_CASE("Info: every bad input exits 2 with the loader's message") {
   auto dir = pr::test::scratchDir("info_bad_inputs");
   for (const auto& bad : pr::test::writeBadInputs(dir)) {
     SUBCASE(bad.name.c_str()) {
-      auto result = pr::test::runParrender("info \"" + bad.path.string() + "\"");
+      const std::string limit = bad.maxMemory ? " --max-memory " + std::to_string(bad.maxMemory) : "";
+      auto result = pr::test::runParrender("info \"" + bad.path.string() + "\"" + limit);
       INFO(result.output);
       CHECK(result.exitStatus == 2);
       CHECK(result.output.find("parrender: error: " + bad.path.string()) != std::string::npos);

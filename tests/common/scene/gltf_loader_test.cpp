@@ -399,7 +399,10 @@ TEST_CASE("GltfLoader: every bad input throws one InputError naming the file and
     SUBCASE(bad.name.c_str()) {
       std::string message;
       try {
-        loadQuiet(bad.path);
+        pr::scene::LoadOptions options;
+        if (bad.maxMemory) options.maxMemoryBytes = bad.maxMemory;
+        pr::setQuiet(true);
+        pr::scene::loadGltf(bad.path, options);
       } catch (const pr::InputError& e) {
         message = e.what();
       }

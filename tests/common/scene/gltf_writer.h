@@ -177,7 +177,49 @@ struct BadInput {
   std::string name;
   std::filesystem::path path;
   std::string expected;
+  uint64_t maxMemory = 0;  // the memory limit to load under (bytes); 0 = the default
 };
+
+// A GLB container (spec 4.4): the header, then each chunk (type, bytes) padded to 4 bytes.
+inline std::vector<uint8_t> glbContainer(const std::vector<std::pair<uint32_t, std::string>>& chunks) {
+  std::vector<uint8_t> out = {'g', 'l', 'T', 'F', 2, 0, 0, 0, 0, 0, 0, 0};
+  auto le32 = [&](uint32_t v) {
+    for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+  };
+  for (const auto& [type, body] : chunks) {
+    std::string padded = body;
+    while (padded.size() % 4) padded += type == 0x4E4F534Au ? ' ' : '\0';
+    le32(uint32_t(padded.size()));
+    le32(type);
+    out.insert(out.end(), padded.begin(), padded.end());
+  }
+  const uint32_t total = uint32_t(out.size());
+  for (int i = 0; i < 4; ++i) out[8 + size_t(i)] = uint8_t(total >> (8 * i));
+  return out;
+}
+inline constexpr uint32_t kGlbJson = 0x4E4F534Au, kGlbBin = 0x004E4942u;
+
+// The one-triangle file as a GLB: its buffer 0 becomes the BIN chunk.
+inline std::vector<uint8_t> oneTriangleGlb(std::vector<std::pair<uint32_t, std::string>> extraChunks = {},
+                                           bool withBin = true) {
+  nlohmann::json doc = {{"asset", {{"version", "2.0"}}},
+                        {"buffers", {{{"byteLength", 36}}}},
+                        {"bufferViews", {{{"buffer", 0}, {"byteLength", 36}}}},
+                        {"accessors", {{{"bufferView", 0}, {"componentType", 5126}, {"count", 3}, {"type", "VEC3"}}}},
+                        {"meshes", {{{"primitives", {{{"attributes", {{"POSITION", 0}}}}}}}}},
+                        {"nodes", {{{"mesh", 0}}}},
+                        {"scenes", {{{"nodes", {0}}}}}};
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::vector<std::pair<uint32_t, std::string>> chunks = {{kGlbJson, doc.dump()}};
+  if (withBin) chunks.push_back({kGlbBin, std::string(reinterpret_cast<const char*>(positions), sizeof positions)});
+  chunks.insert(chunks.end(), extraChunks.begin(), extraChunks.end());
+  return glbContainer(chunks);
+}
+
+inline std::filesystem::path writeBytes(const std::filesystem::path& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream(path, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  return path;
+}
 
 // Writes one file per kind of bad input the loader must reject with an InputError.
 inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
@@ -263,6 +305,93 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
     w.doc["nodes"][0].erase("mesh");  // a scene whose only node draws nothing
     bad.push_back({"empty scene", w.write(dir, "empty_scene.gltf"), "contains no triangles"});
   }
+  // Hostile files: each would read outside the model's folder, take time exponential in its
+  // size, or allocate far more than it holds.
+  {
+    GltfWriter w = oneTriangle();
+    auto path = w.write(dir, "escape.gltf");
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+    doc["buffers"][0]["uri"] = "../../../../../../etc/passwd";
+    std::ofstream(path) << doc.dump(1);
+    bad.push_back({"buffer URI escaping the folder", path, "refers to '../../../../../../etc/passwd', outside the model's folder; refused"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["images"] = {{{"uri", "..%2F..%2Fsecret.png"}}};  // percent-encoded "../../secret.png"
+    w.doc["textures"] = {{{"source", 0}}};
+    bad.push_back({"percent-encoded image URI escaping the folder", w.write(dir, "escape_encoded.gltf"),
+                   "outside the model's folder; refused"});
+  }
+  {
+    // Node i has node i+1 as its child twice over (through two parents): 2^40 paths to the
+    // last node if it were walked as a graph.
+    GltfWriter w = oneTriangle();
+    for (int i = 1; i <= 80; i += 2) {
+      w.doc["nodes"][size_t(i - 1)]["children"] = {i, i + 1};
+      w.addNode({{"children", {i + 1}}});
+      w.addNode({{"mesh", 0}});
+    }
+    bad.push_back({"node with two parents", w.write(dir, "node_dag.gltf"), "one parent each"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["scenes"][0]["nodes"] = {0, 0};
+    bad.push_back({"scene root listed twice", w.write(dir, "root_twice.gltf"), "lists node 0 twice"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.addNode({{"children", {0}}});
+    w.doc["scenes"][0]["nodes"] = {0, 1};
+    bad.push_back({"scene root that is a child", w.write(dir, "root_child.gltf"), "is a scene root but also a child of node 1"});
+  }
+  {
+    // A sparse accessor without a bufferView: 16 million zero vectors from a few bytes.
+    GltfWriter w = oneTriangle();
+    const uint32_t index = 0;
+    const float value[3] = {0, 0, 0};
+    int indexView = w.addView(&index, 4), valueView = w.addView(value, 12);
+    w.doc["accessors"][0] = {{"componentType", 5126}, {"count", 1 << 24}, {"type", "VEC3"},
+                             {"sparse", {{"count", 1}, {"indices", {{"bufferView", indexView}, {"componentType", 5125}}},
+                                         {"values", {{"bufferView", valueView}}}}}};
+    bad.push_back({"accessor over the memory limit", w.write(dir, "sparse_huge.gltf"),
+                   "accessor 0 needs 576.0 MiB", uint64_t(64) << 20});
+  }
+  {
+    // PNG headers claiming 8192 x 8192 pixels (under stb_image's own 2^30-byte cap, so refused
+    // by the memory limit) and 65535 x 65535 (over it): refused from the header, never decoded.
+    for (int edge : {8192, 65535}) {
+      GltfWriter w = oneTriangle();
+      std::vector<uint8_t> png = encodePng(1, 1, {255, 255, 255, 255});
+      for (size_t offset : {16, 20}) png[offset + 2] = uint8_t(edge >> 8), png[offset + 3] = uint8_t(edge);
+      w.doc["images"] = {{{"uri", "data:image/png;base64," + base64(png)}}};
+      w.doc["textures"] = {{{"source", 0}}};
+      if (edge == 8192) {
+        bad.push_back({"image over the memory limit", w.write(dir, "image_huge.gltf"),
+                       "image 0 (8192 x 8192 pixels) needs 512.0 MiB", uint64_t(64) << 20});
+      } else {
+        bad.push_back({"image over stb_image's limit", w.write(dir, "image_enormous.gltf"), "image 0 cannot be decoded (corrupt, not PNG or JPEG, or over stb_image's 2^30-byte limit)"});
+      }
+    }
+  }
+  {
+    GltfWriter w = oneTriangle();
+    auto path = w.write(dir, "bad_base64.gltf");
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@@@not*base64";
+    std::ofstream(path) << doc.dump(1);
+    bad.push_back({"data URI with bad base64", path, "not a valid glTF file"});
+  }
+  {
+    // A .gltf whose buffer file is itself a GLB: a different file, not raw buffer bytes.
+    writeBytes(dir / "inner.glb", oneTriangleGlb());
+    GltfWriter w = oneTriangle();
+    auto path = w.write(dir, "buffer_is_glb.gltf");
+    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+    doc["buffers"][0]["uri"] = "inner.glb";
+    std::ofstream(path) << doc.dump(1);
+    bad.push_back({"buffer file that is a GLB", path, "'inner.glb' is a binary glTF (.glb), not a raw buffer"});
+  }
+  bad.push_back({"GLB without its BIN chunk", writeBytes(dir / "no_bin.glb", oneTriangleGlb({}, false)), "not a valid glTF binary"});
   return bad;
 }
 

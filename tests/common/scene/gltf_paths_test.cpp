@@ -1,0 +1,108 @@
+// File names and URIs as users' files have them (unicode, spaces, percent-encoding, '+',
+// folders) load; GLB containers with chunks the spec says to skip load. The refusals (URIs
+// escaping the folder, bad base64, a .glb as a buffer, a GLB without BIN) are in the bad-input
+// catalogue (gltf_writer.h).
+#include <doctest/doctest.h>
+
+#include <fstream>
+
+#include "common/scene/gltf_loader.h"
+#include "common/util/log.h"
+#include "tests/common/scene/gltf_writer.h"
+#include "tests/test_support.h"
+
+namespace {
+
+using pr::scene::Scene;
+
+// Writes the one-triangle file with its buffer in `bufferFile` (referred to by `uri`).
+std::filesystem::path writeWithExternalBuffer(const std::filesystem::path& gltf, const std::filesystem::path& bufferFile,
+                                              const std::string& uri) {
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::filesystem::create_directories(bufferFile.parent_path());
+  std::filesystem::create_directories(gltf.parent_path());
+  std::ofstream(bufferFile, std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof positions);
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  auto path = w.write(gltf.parent_path(), gltf.filename().string());
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+  doc["buffers"][0]["uri"] = uri;
+  std::ofstream(path) << doc.dump(1);
+  return path;
+}
+
+Scene loadQuiet(const std::filesystem::path& path) {
+  pr::setQuiet(true);
+  Scene scene = pr::scene::loadGltf(path);
+  pr::setQuiet(false);
+  return scene;
+}
+
+}  // namespace
+
+TEST_CASE("GltfPaths: unicode, spaces, percent-encoding and '+' in file names and URIs load") {
+  auto dir = pr::test::scratchDir("gltf_paths") / "モデル folder";
+  struct Case {
+    const char* name;
+    const char* gltf;
+    const char* bufferFile;
+    const char* uri;
+  };
+  const Case cases[] = {
+      {"percent-encoded UTF-8 and spaces", "données ü.gltf", "données ü.bin", "donn%C3%A9es%20%C3%BC.bin"},
+      {"raw UTF-8 and spaces", "raw.gltf", "ràw naмe.bin", "ràw naмe.bin"},
+      {"a literal '+'", "plus.gltf", "a+b.bin", "a+b.bin"},
+      {"a subfolder and a '..' that stays inside", "sub.gltf", "bin/x.bin", "bin/../bin/x.bin"},
+  };
+  for (const Case& c : cases) {
+    SUBCASE(c.name) {
+      auto path = writeWithExternalBuffer(dir / c.gltf, dir / c.bufferFile, c.uri);
+      Scene s = loadQuiet(path);
+      CHECK(s.triangles.size() == 1);
+      CHECK(s.positions.at(1) == glm::vec3(1, 0, 0));
+    }
+  }
+  SUBCASE("a model in the working directory, named without a folder") {
+    auto path = writeWithExternalBuffer(dir / "here.gltf", dir / "here.bin", "here.bin");
+    const auto previous = std::filesystem::current_path();
+    std::filesystem::current_path(dir);
+    Scene s = loadQuiet("here.gltf");
+    std::filesystem::current_path(previous);
+    CHECK(s.triangles.size() == 1);
+  }
+}
+
+TEST_CASE("GltfPaths: a buffer in the working directory but not beside the model is not found") {
+  // tinygltf also probes "./uri"; the loader never reads from the working directory.
+  auto dir = pr::test::scratchDir("gltf_paths_cwd");
+  auto path = writeWithExternalBuffer(dir / "model" / "m.gltf", dir / "elsewhere.bin", "elsewhere.bin");
+  const auto previous = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  std::string message;
+  try {
+    loadQuiet(path);
+  } catch (const pr::InputError& e) {
+    message = e.what();
+  }
+  std::filesystem::current_path(previous);
+  CHECK(message.find("buffer file 'elsewhere.bin' is missing") != std::string::npos);
+}
+
+TEST_CASE("GltfPaths: a GLB with extra chunks of unknown type loads (spec 4.4.3.1: skipped)") {
+  auto dir = pr::test::scratchDir("gltf_glb_chunks");
+  auto path = pr::test::writeBytes(dir / "extra.glb", pr::test::oneTriangleGlb({{0x12345678u, "unknown chunk"}, {0x12345679u, ""}}));
+  Scene s = loadQuiet(path);
+  CHECK(s.triangles.size() == 1);
+}
+
+TEST_CASE("GltfPaths: the same bytes load from memory, and an external reference from memory is refused") {
+  const std::vector<uint8_t> glb = pr::test::oneTriangleGlb();
+  Scene s = pr::scene::loadGltfFromMemory(glb, "memory.glb");
+  CHECK(s.triangles.size() == 1);
+  auto dir = pr::test::scratchDir("gltf_memory_external");
+  auto path = writeWithExternalBuffer(dir / "m.gltf", dir / "m.bin", "m.bin");
+  std::ifstream in(path, std::ios::binary);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK_THROWS_WITH_AS(pr::scene::loadGltfFromMemory(std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()), "memory.gltf"),
+                       doctest::Contains("memory.gltf: refers to the external file 'm.bin', but a model loaded from memory has no folder"),
+                       pr::InputError);
+}
