@@ -4,13 +4,16 @@
 #   tools/setup.sh          build and test dependencies
 #   tools/setup.sh --bench  also the benchmark anchors: Intel Embree 3, Mesa llvmpipe over EGL,
 #                           nanoflann (kd-tree, header-only)
+#   tools/setup.sh --fuzz   also clang and its libFuzzer runtime (tools/fuzz.sh)
 set -euo pipefail
 
 bench=0
+fuzz=0
 for arg in "$@"; do
   case "$arg" in
     --bench) bench=1 ;;
-    *) echo "setup: unknown option '$arg' (expected --bench)" >&2; exit 2 ;;
+    --fuzz) fuzz=1 ;;
+    *) echo "setup: unknown option '$arg' (expected --bench or --fuzz)" >&2; exit 2 ;;
   esac
 done
 
@@ -28,6 +31,9 @@ if [ "$bench" -eq 1 ]; then
     libegl-dev libgles-dev libegl-mesa0 libgl1-mesa-dri  # llvmpipe raster anchor (EGL surfaceless)
     libnanoflann-dev                               # nanoflann kd-tree anchor (bench_photonmap)
   )
+fi
+if [ "$fuzz" -eq 1 ]; then
+  packages+=(clang libclang-rt-dev)                # libFuzzer, ASan, UBSan runtimes for clang
 fi
 
 missing=()

@@ -40,9 +40,13 @@ MaterialTraits traitsOf(const Material& m) {
     const float hi = std::clamp(factor, 0.0f, 1.0f);
     return std::pair<float, float>(tex.present() ? 0.0f : hi, hi);
   };
-  const auto [metallicMin, metallicMax] = range(m.metallicFactor, m.metallicRoughnessTexture);
-  const auto [roughnessMin, roughnessMax] = range(m.roughnessFactor, m.metallicRoughnessTexture);
-  const auto [transmissionMin, transmissionMax] = range(m.transmissionFactor, m.transmissionTexture);
+  // Plain variables, not structured bindings: the lambda below captures them (clang 14).
+  const std::pair<float, float> metallic = range(m.metallicFactor, m.metallicRoughnessTexture);
+  const std::pair<float, float> roughness = range(m.roughnessFactor, m.metallicRoughnessTexture);
+  const std::pair<float, float> transmission = range(m.transmissionFactor, m.transmissionTexture);
+  const float metallicMin = metallic.first, metallicMax = metallic.second;
+  const float roughnessMin = roughness.first, roughnessMax = roughness.second;
+  const float transmissionMin = transmission.first, transmissionMax = transmission.second;
   const bool base = glm::any(glm::greaterThan(glm::vec3(m.baseColorFactor), glm::vec3(0.0f)));
   t.emissive = m.isEmissive();
   t.dielectric = transmissionMax > 0.0f && metallicMin < 1.0f;

@@ -50,10 +50,18 @@ std::string supportedList() {
 }
 
 // Unit vector, or `fallback` for a zero / non-finite one (degenerate triangle, zero scale).
+// Divided by its largest component first, so that neither a denormal nor a huge vector loses
+// its length to underflow or overflow in the squares.
 glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
-  float len = glm::length(v);
-  return len > 0.0f && std::isfinite(len) ? v / len : fallback;
+  const float largest = std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
+  if (!(largest > 0.0f) || !std::isfinite(largest)) return fallback;
+  v /= largest;
+  return v / glm::length(v);
 }
+
+// World coordinates beyond this are refused: the tracers and rasterizers square distances in
+// float, which overflows past about 1.8e19; 1e18 keeps a factor of 10 in hand for sums.
+constexpr double kMaxCoordinate = 1e18;
 
 // External files (buffers, images) the file refers to, read through tinygltf's file-system
 // callbacks so that every one is confined to the model's folder and charged to the budget.
@@ -61,6 +69,7 @@ struct FileAccess {
   std::filesystem::path folder;  // empty: no external files at all (loading from memory)
   MemoryBudget* budget = nullptr;
   std::string refusal;  // the first refused reference; reported as the load's error
+  const tinygltf::Model* model = nullptr;  // being parsed: its buffers are read when images are
 
   // The path relative to the folder, or "" when it is outside (or there is no folder).
   std::filesystem::path inside(const std::string& path) const {
@@ -144,6 +153,20 @@ struct FileAccess {
   static bool decodeImage(tinygltf::Image* image, const int index, std::string* err, std::string* warn, int width,
                           int height, const unsigned char* bytes, int size, void* self) {
     auto& access = *static_cast<FileAccess*>(self);
+    // tinygltf checks an image's bufferView and buffer indices but not that the view lies in
+    // its buffer: `bytes` may point past the end. Checked here before anything is read.
+    if (image->bufferView >= 0) {
+      const tinygltf::BufferView& view = access.model->bufferViews[size_t(image->bufferView)];
+      const size_t length = access.model->buffers[size_t(view.buffer)].data.size();
+      if (view.byteOffset > length || view.byteLength > length - view.byteOffset) {
+        if (err) {
+          *err += "image " + std::to_string(index) + ": bufferView " + std::to_string(image->bufferView) + " (bytes " +
+                  std::to_string(view.byteOffset) + ".." + std::to_string(view.byteOffset + view.byteLength) +
+                  ") exceeds buffer " + std::to_string(view.buffer) + " of " + std::to_string(length) + " bytes\n";
+        }
+        return false;
+      }
+    }
     int w = 0, h = 0, channels = 0;
     if (!stbi_info_from_memory(bytes, size, &w, &h, &channels)) {
       // stb_image tries every format it knows, so its last reason is rarely the one that counts.
@@ -182,6 +205,7 @@ tinygltf::Model parse(std::span<const uint8_t> bytes, const std::string& file, F
   parser.SetFsCallbacks({&FileAccess::exists, &FileAccess::expand, &FileAccess::read, &FileAccess::write, &access});
   parser.SetImageLoader(&FileAccess::decodeImage, &access);
   tinygltf::Model model;
+  access.model = &model;
   std::string err, warn;
   const std::string folder = access.folder.empty() ? std::string() : access.folder.string();
   bool ok = binary ? parser.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), unsigned(bytes.size()), folder)
@@ -476,7 +500,13 @@ class Flattener {
     PR_CHECK(s.positions.size() + count <= kMaxVertices, "scene exceeds kMaxVertices (checked above)");
     for (size_t i = 0; i < count; ++i) {
       const float* p = pos.element(i);
-      s.positions.push_back(glm::vec3(world * glm::dvec4(p[0], p[1], p[2], 1.0)));
+      const glm::dvec3 q(world * glm::dvec4(p[0], p[1], p[2], 1.0));
+      if (!(std::max(std::abs(q.x), std::max(std::abs(q.y), std::abs(q.z))) <= kMaxCoordinate)) {
+        ctx_.fail(describe("node", nodeIndex, node.name) + " " + where + ": vertex " + std::to_string(i) +
+                  " lies beyond +-1e18 in world space (or is not finite after the node transforms); "
+                  "squared distances would overflow float");
+      }
+      s.positions.push_back(glm::vec3(q));
       s.uvs.push_back(uv ? glm::vec2(uv->element(i)[0], uv->element(i)[1]) : glm::vec2(0.0f));
       if (color) {
         const float* c = color->element(i);

@@ -116,8 +116,10 @@ class Builder {
     float cost = kInfinity;
   };
 
+  // Clamped before the cast: a NaN or out-of-range float converted to int is undefined.
   int binIndex(float c, float lo, float scale) const {
-    return std::clamp(static_cast<int>((c - lo) * scale), 0, bins_ - 1);
+    const float t = (c - lo) * scale;
+    return t >= 0.0f ? (t < float(bins_ - 1) ? static_cast<int>(t) : bins_ - 1) : 0;
   }
 
   // SAH cost of a split into L and R (Goldsmith & Salmon 1987; MacDonald & Booth 1990):
@@ -295,7 +297,7 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
     ref.box.extend(prepared[i].p0);
     ref.box.extend(prepared[i].p1);
     ref.box.extend(prepared[i].p2);
-    ref.centroid = 0.5f * (ref.box.lo + ref.box.hi);
+    ref.centroid = 0.5f * ref.box.lo + 0.5f * ref.box.hi;  // halved first: no overflow near FLT_MAX
     ref.slot = static_cast<uint32_t>(i);
     const glm::vec3 m = glm::max(glm::abs(ref.box.lo), glm::abs(ref.box.hi));
     magnitude_ = std::max({magnitude_, m.x, m.y, m.z});
