@@ -27,6 +27,7 @@
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
 #include "common/scene/gltf_loader.h"
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 #include "raytrace/integrators/sampling.h"
 #include "tools/commands.h"
@@ -300,13 +301,13 @@ void run(SweepArgs& a) {
   std::printf("\n");
 
   if (!a.csv.empty()) {
-    std::ofstream out(a.csv);
+    std::ostringstream out;
     out << "integrator,setting,value,cpu_seconds,wall_seconds,rmse,relative_mse,max_error,caustic_rmse\n";
     for (const Row& r : rows)
       out << r.integrator << "," << r.setting << "," << format(r.value) << "," << format(r.timed.cpuSeconds) << ","
           << format(r.timed.wallSeconds) << "," << format(r.error.rmse) << "," << format(r.error.relativeMse) << ","
           << format(r.error.maxError) << "," << format(r.error.maskedRmse) << "\n";
-    if (!out) throw InputError("cannot write " + a.csv);
+    writeFileAtomically(a.csv, out.str(), "CSV file");
   }
   if (!a.json.empty()) {
     nlohmann::json j = {{"scene", a.scene}, {"method", a.method}, {"threads", a.threads}, {"width", a.width},
@@ -321,9 +322,7 @@ void run(SweepArgs& a) {
                       {"relativeMse", r.error.relativeMse}, {"maxError", r.error.maxError},
                       {"causticRmse", r.error.maskedRmse}});
     j["rows"] = list;
-    std::ofstream out(a.json);
-    out << j.dump(2) << "\n";
-    if (!out) throw InputError("cannot write " + a.json);
+    writeFileAtomically(a.json, j.dump(2) + "\n", "JSON file");
   }
 }
 

@@ -6,10 +6,12 @@
 #include <CLI/CLI.hpp>
 
 #include "common/util/error.h"
+#include "common/util/interrupt.h"
 #include "common/util/memory_limit.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
+  pr::installInterruptHandler();
   CLI::App app{"parrender: a parallel software renderer (sort-first/middle/last rasterizers, "
                "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};
   app.require_subcommand(1);
@@ -25,7 +27,7 @@ int main(int argc, char** argv) {
       ->check(CLI::Validator(
           [](std::string& v) {
             try {
-              pr::parseByteSize(v);
+              pr::parseByteSize(v, "");
               return std::string();
             } catch (const pr::InputError& e) {
               return std::string(e.what());

@@ -4,6 +4,7 @@
 
 #include "common/parallel/metrics.h"
 #include "common/util/error.h"
+#include "common/util/memory_limit.h"
 #include "raster/composite/compositor.h"
 #include "raster/parallel_pipeline.h"
 #include "raster/stages/background.h"
@@ -262,6 +263,28 @@ void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions
                       MethodFamily::Raster);
   family.emplace_back(command.add_flag("--orbit", r.orbit, "rasterization: the camera circles the scene centre over the frames"),
                       MethodFamily::Raster);
+}
+
+// Bytes per pixel and per (pixel, sample, PE), from peak RSS of `parrender render
+// scenes/cornell.gltf -m M --threads P --width 1024|2048 --spp 1|4 --max-depth 1|4` at P = 1,
+// 2, 4, 8, rounded up: 64 per pixel for every method; sort-last 48 per pixel per PE; from
+// P = 2, object-space about 175 per sample per PE and object 1000 + 150 per PE per sample.
+uint64_t estimatedRenderBytes(const RenderMethod& method, int width, int height, int pes, int spp) {
+  const uint64_t pixels = uint64_t(width) * uint64_t(height), p = uint64_t(pes);
+  const uint64_t samples = saturatingMul(pixels, uint64_t(method.properties.family == MethodFamily::Ray ? spp : 1));
+  uint64_t bytes = saturatingMul(pixels, 64);
+  auto add = [&](uint64_t more) { bytes = more > UINT64_MAX - bytes ? UINT64_MAX : bytes + more; };
+  if (method.name == "sort-last") add(saturatingMul(saturatingMul(pixels, 48), p));
+  if (pes > 1 && method.name == "object-space") add(saturatingMul(samples, 180 * p));
+  if (pes > 1 && method.name == "object") add(saturatingMul(samples, 1000 + 150 * p));
+  return bytes;
+}
+
+void checkRenderMemory(const RenderMethod& method, int width, int height, int pes, int spp) {
+  std::string what = "a " + std::to_string(width) + " x " + std::to_string(height) + " render with " + method.name +
+                     " at P = " + std::to_string(pes);
+  if (method.properties.family == MethodFamily::Ray) what += ", " + std::to_string(spp) + " spp,";
+  MemoryBudget(memoryLimit()).charge(estimatedRenderBytes(method, width, height, pes, spp), what);
 }
 
 void checkFamilyOptions(const RenderMethod& method, const FamilyOptions& family) {

@@ -93,6 +93,14 @@ const RenderMethod& findRenderMethod(std::string_view name);
 // "name (family): description" lines for --help.
 std::string describeRenderMethods();
 
+// Peak memory of a render, an upper estimate from its size alone (no scene): the frame
+// (image, framebuffer, 8-bit output), a full framebuffer per PE for sort-last, and the rays
+// in flight of the partitioned tracers, which hold every sample's camera ray at once. Checked
+// against --max-memory before anything is loaded, so an absurd request fails at once.
+uint64_t estimatedRenderBytes(const RenderMethod& method, int width, int height, int pes, int spp);
+// Throws pr::InputError naming the request when its estimate exceeds the memory limit.
+void checkRenderMemory(const RenderMethod& method, int width, int height, int pes, int spp);
+
 // Family-specific options as registered on the command: checked after parsing.
 using FamilyOptions = std::vector<std::pair<CLI::Option*, MethodFamily>>;
 void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family);

@@ -2,6 +2,8 @@
 // Called once per render on the main thread after the PEs have finished, and by `compare`.
 #include "common/image/image_io.h"
 
+#include "common/util/atomic_file.h"
+
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
@@ -32,17 +34,6 @@ Format formatOf(const fs::path& path) {
                    "' (expected .exr or .png)");
 }
 
-// Removes the temporary file unless the write got as far as the rename.
-struct TempFile {
-  fs::path path;
-  bool keep = false;
-  ~TempFile() {
-    if (keep) return;
-    std::error_code ignored;
-    fs::remove(path, ignored);
-  }
-};
-
 }  // namespace
 
 void writeImage(const fs::path& path, const Image& image, const WriteOptions& options) {
@@ -52,16 +43,9 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
   PR_CHECK(image.pixels.size() == static_cast<size_t>(image.width) * static_cast<size_t>(image.height),
            "pixel count does not match width * height");
 
-  // The temporary name keeps the directory (so the rename is atomic) but not the extension,
-  // so the format is named explicitly below rather than guessed from the file name.
-  fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  if (!fs::is_directory(dir))
-    throw InputError("cannot write image file '" + path.string() + "': directory '" + dir.string() + "' does not exist");
-  std::string tempName = path.filename().string();
-  tempName.insert(tempName.begin(), '.');
-  tempName += ".tmp";
-  tempName += std::to_string(::getpid());
-  TempFile temp{dir / tempName};
+  // The temporary keeps the directory (so the rename is atomic) but not the extension, so the
+  // format is named explicitly below rather than guessed from the file name.
+  TempFile temp(path, "image file");
 
   const char* formatName = format == Format::Exr ? "openexr" : "png";
   auto out = OIIO::ImageOutput::create(formatName);
@@ -74,7 +58,7 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
     spec.attribute("compression", "zip");
     // glm::vec3 is three packed floats, so the pixel array is the interleaved RGB buffer.
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-    ok = out->open(temp.path.string(), spec) &&
+    ok = out->open(temp.path().string(), spec) &&
          out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) && out->close();
   } else {
     std::vector<uint8_t> bytes(count * 3);
@@ -82,7 +66,7 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
       for (int c = 0; c < 3; ++c) bytes[3 * i + c] = toDisplay8(image.pixels[i][c], options.display);
     OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
     spec.attribute("oiio:ColorSpace", "sRGB");
-    ok = out->open(temp.path.string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) &&
+    ok = out->open(temp.path().string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) &&
          out->close();
   }
   if (!ok) {
@@ -92,10 +76,7 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
   }
   out.reset();
 
-  std::error_code ec;
-  fs::rename(temp.path, path, ec);
-  if (ec) throw InputError("cannot write image file '" + path.string() + "': " + ec.message());
-  temp.keep = true;
+  temp.commit();
 }
 
 Image readImage(const fs::path& path) {

@@ -10,6 +10,7 @@
 
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace pr::par {
@@ -119,10 +120,7 @@ json toJson(const RunRecord& record) {
 }
 
 void writeText(const std::string& text, const std::filesystem::path& file, const char* what) {
-  std::ofstream out(file);
-  if (!out) throw InputError(std::string("cannot write ") + what + " file '" + file.string() + "'");
-  out << text;
-  if (!out) throw InputError(std::string("error writing ") + what + " file '" + file.string() + "'");
+  writeFileAtomically(file, text, std::string(what) + " file");
 }
 
 // Reads key from object j, or throws InputError naming origin, where and key.

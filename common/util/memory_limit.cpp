@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <charconv>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -27,18 +28,15 @@ uint64_t defaultMemoryLimit() {
 
 uint64_t parseByteSize(std::string_view text, std::string_view option) {
   auto bad = [&] {
-    return InputError(std::string(option) + ": '" + std::string(text) +
+    return InputError((option.empty() ? std::string() : std::string(option) + ": ") + "'" + std::string(text) +
                       "' is not a size (expected a positive number of bytes with an optional K, M, G or T suffix, e.g. 512M or 2G)");
   };
   size_t end = 0;
   while (end < text.size() && (std::isdigit(static_cast<unsigned char>(text[end])) || text[end] == '.')) ++end;
   if (end == 0) throw bad();
   double value = 0.0;
-  try {
-    value = std::stod(std::string(text.substr(0, end)));
-  } catch (const std::exception&) {
-    throw bad();
-  }
+  const auto [parsed, error] = std::from_chars(text.data(), text.data() + end, value, std::chars_format::fixed);
+  if (error != std::errc() || parsed != text.data() + end) throw bad();  // "1.2.3"
   std::string suffix(text.substr(end));
   for (char& c : suffix) c = char(std::toupper(static_cast<unsigned char>(c)));
   if (suffix.size() > 1 && suffix.back() == 'B') suffix.pop_back();  // "GB", "GIB" -> "G", "GI"

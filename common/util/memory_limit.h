@@ -16,8 +16,8 @@ uint64_t physicalMemoryBytes();
 // processes; 4 GiB when physical memory is unknown.
 uint64_t defaultMemoryLimit();
 
-// "512M", "2G", "1.5GiB", "1000000" (bytes) -> bytes; throws InputError naming `option` on
-// anything else or on zero.
+// "512M", "2G", "1.5GiB", "1000000" (bytes) -> bytes; throws InputError (naming `option`
+// when not empty) on anything else or on zero.
 uint64_t parseByteSize(std::string_view text, std::string_view option = "--max-memory");
 
 // "1.5 GiB", "512 MiB", "900 KiB", "17 bytes" for messages.

@@ -12,6 +12,7 @@
 #include <system_error>
 #include <unistd.h>
 
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace pr::scenegen {
@@ -223,30 +224,7 @@ std::string GltfBuilder::serialize(bool binary) const {
 }
 
 void writeFileAtomically(const fs::path& path, const std::string& bytes) {
-  const fs::path dir = path.parent_path().empty() ? fs::path(".") : path.parent_path();
-  if (!fs::is_directory(dir))
-    throw InputError("cannot write scene file '" + path.string() + "': directory '" + dir.string() + "' does not exist");
-  std::string tempName = path.filename().string();
-  tempName.insert(tempName.begin(), '.');
-  tempName += ".tmp";
-  tempName += std::to_string(::getpid());
-  const fs::path temp = dir / tempName;
-  {
-    std::ofstream file(temp, std::ios::binary | std::ios::trunc);
-    if (file) file.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-    if (!file || !file.flush()) {
-      std::error_code ignored;
-      fs::remove(temp, ignored);
-      throw InputError("cannot write scene file '" + path.string() + "'");
-    }
-  }
-  std::error_code ec;
-  fs::rename(temp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(temp, ignored);
-    throw InputError("cannot write scene file '" + path.string() + "': " + ec.message());
-  }
+  pr::writeFileAtomically(path, bytes, "scene file");
 }
 
 }  // namespace pr::scenegen

@@ -9,6 +9,7 @@
 #include <fstream>
 
 #include "common/image/image_io.h"
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace pr::cli {
@@ -44,9 +45,7 @@ std::filesystem::path ReferenceCache::store(const nlohmann::json& settings, cons
   const std::filesystem::path base = stem(settings);
   const std::filesystem::path exr = base.string() + ".exr";
   image::writeImage(exr, image);
-  std::ofstream out(base.string() + ".json");
-  out << settings.dump(2) << "\n";
-  if (!out) throw InputError("reference cache " + dir_.string() + ": cannot write " + base.string() + ".json");
+  writeFileAtomically(base.string() + ".json", settings.dump(2) + "\n", "reference cache file");
   return exr;
 }
 

@@ -1,0 +1,19 @@
+// Ctrl-C (SIGINT) and SIGTERM stop parrender at once: there is nothing worth finishing in a
+// half-done render, and every output is written to a temporary name and renamed into place
+// (atomic_file.h), so the handler only removes the temporaries in flight and exits with 130.
+// No output file is ever left half written, and an earlier good one is never replaced.
+#pragma once
+
+namespace pr {
+
+// Installs the handler for SIGINT and SIGTERM (the program calls it once, first thing).
+void installInterruptHandler();
+
+// The temporaries the handler removes: at most kMaxTemporaries at once, paths up to 4095
+// bytes; registerTemporary returns a slot (or -1 when none is free or the path is too long:
+// the file is then only removed by its owner).
+inline constexpr int kMaxTemporaries = 16;
+int registerTemporary(const char* path);
+void unregisterTemporary(int slot);
+
+}  // namespace pr

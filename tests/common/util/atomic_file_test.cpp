@@ -1,0 +1,61 @@
+#include <doctest/doctest.h>
+
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <iterator>
+
+#include "common/util/atomic_file.h"
+#include "common/util/error.h"
+#include "common/util/interrupt.h"
+#include "tests/test_support.h"
+
+namespace {
+std::string contents(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+size_t filesIn(const std::filesystem::path& dir) {
+  return size_t(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+}  // namespace
+
+TEST_CASE("AtomicFile: the target appears whole on commit; a failed write leaves the old file") {
+  auto dir = pr::test::scratchDir("atomic_file");
+  const auto target = dir / "out.txt";
+  pr::writeFileAtomically(target, "first");
+  CHECK(contents(target) == "first");
+  {
+    pr::TempFile temp(target, "test file");
+    std::ofstream(temp.path()) << "half";
+    CHECK(std::filesystem::exists(temp.path()));
+    // destroyed without commit: as if the write had thrown
+  }
+  CHECK(contents(target) == "first");
+  CHECK(filesIn(dir) == 1);
+  CHECK_THROWS_WITH_AS(pr::writeFileAtomically(dir / "no_such_dir" / "x.txt", "x", "test file"),
+                       doctest::Contains("cannot write test file"), pr::InputError);
+}
+
+TEST_CASE("AtomicFile: SIGINT while a temporary is in flight removes it, keeps the old file, exits 130") {
+  auto dir = pr::test::scratchDir("atomic_file_interrupt");
+  const auto target = dir / "out.png";
+  pr::writeFileAtomically(target, "earlier good output");
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    pr::installInterruptHandler();
+    pr::TempFile temp(target, "image file");
+    std::ofstream(temp.path()) << "half written";
+    ::raise(SIGINT);
+    ::_exit(0);  // not reached: the handler exits
+  }
+  int status = 0;
+  REQUIRE(waitpid(child, &status, 0) == child);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(contents(target) == "earlier good output");
+  CHECK(filesIn(dir) == 1);  // the temporary is gone
+}

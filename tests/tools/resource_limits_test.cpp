@@ -1,0 +1,76 @@
+// Absurd requests fail at once with a message and exit 2; --max-memory bounds a load; Ctrl-C
+// stops a render at once and leaves no output file (an earlier one stays as it was).
+#include <doctest/doctest.h>
+
+#include <fstream>
+
+#include "tests/test_support.h"
+
+namespace {
+const std::string kCornell = pr::test::quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf");
+}
+
+TEST_CASE("ResourceLimits: absurd render requests are refused with exit 2 and a message") {
+  auto dir = pr::test::scratchDir("resource_limits");
+  const std::string out = " -o " + pr::test::quoted(dir / "out.png");
+  struct Case {
+    const char* args;
+    const char* expected;
+  };
+  const Case cases[] = {
+      {"--width 1000000", "--width: Value 1000000 not in range 1 to 16384"},
+      {"--spp 1000000000", "--spp: Value 1000000000 not in range 1 to 65535"},
+      {"--threads 100000", "--threads: Value 100000 not in range 1 to 4096"},
+      {"-m sort-last --width 16384 --height 16384 --threads 64",
+       "a 16384 x 16384 render with sort-last at P = 64 needs 784.0 GiB, which exceeds the memory limit"},
+      {"-m object --width 4096 --height 4096 --threads 8 --spp 64", "exceeds the memory limit"},
+      {"--max-memory 1G -m image-space --width 8192 --height 8192",
+       "a 8192 x 8192 render with image-space at P = 1, 4 spp, needs 4.0 GiB, which exceeds the memory limit of 1.0 GiB"},
+      {"--max-memory 12Q", "'12Q' is not a size"},
+  };
+  for (const Case& c : cases) {
+    SUBCASE(c.args) {
+      auto result = pr::test::runParrender("render " + kCornell + " " + c.args + out);
+      INFO(result.output);
+      CHECK(result.exitStatus == 2);
+      CHECK(result.output.find(c.expected) != std::string::npos);
+      CHECK(!std::filesystem::exists(dir / "out.png"));
+    }
+  }
+}
+
+TEST_CASE("ResourceLimits: --max-memory refuses a load that needs more, before or after the subcommand") {
+  for (const char* order : {"--max-memory 64K info ", "info --max-memory 64K "}) {
+    auto result = pr::test::runParrender(std::string(order) + kCornell);
+    INFO(result.output);
+    CHECK(result.exitStatus == 2);
+    CHECK(result.output.find("cornell.gltf needs ") != std::string::npos);
+    CHECK(result.output.find("KiB, which exceeds the memory limit of 64.0 KiB (--max-memory)") != std::string::npos);
+  }
+  auto fits = pr::test::runParrender("--max-memory 64M info " + kCornell);
+  CHECK(fits.exitStatus == 0);
+}
+
+TEST_CASE("ResourceLimits: SIGINT stops a long render promptly with exit 130 and no output file") {
+  auto dir = pr::test::scratchDir("resource_limits_sigint");
+  const auto out = dir / "render.png";
+  std::ofstream(out) << "earlier output";
+  // A render of minutes, interrupted after 1 s; the shell reports the status and the seconds
+  // from the signal to the exit.
+  const std::string command = std::string("sh -c '\"") + PARRENDER_EXE + "\" render " + kCornell +
+                              " --spp 4096 --width 256 --height 256 --quiet -o " + pr::test::quoted(out) +
+                              " >/dev/null 2>&1 & pid=$!; sleep 1; t0=$(date +%s.%N); kill -INT $pid; wait $pid; "
+                              "rc=$?; t1=$(date +%s.%N); echo $rc $t0 $t1 | awk \"{print \\$1, \\$3 - \\$2}\"'";
+  FILE* pipe = popen(command.c_str(), "r");
+  REQUIRE(pipe);
+  int status = -1;
+  double seconds = -1.0;
+  REQUIRE(std::fscanf(pipe, "%d %lf", &status, &seconds) == 2);
+  pclose(pipe);
+  CHECK(status == 130);
+  CHECK(seconds < 5.0);  // promptly: the handler exits at once (bound generous for loaded machines)
+  std::ifstream in(out);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  CHECK(text == "earlier output");
+  CHECK(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()) == 1);
+}
