@@ -63,7 +63,7 @@ void runGenerate(const GenerateOptions& options) {
 
 void addGenerateCommand(CLI::App& app) {
   auto options = std::make_shared<GenerateOptions>();
-  CLI::App* cmd = app.add_subcommand("generate", "write a bundled scene (cornell, cornell-diffuse, landscape, hotspot) as glTF");
+  CLI::App* cmd = app.add_subcommand("generate", "write a bundled scene (cornell, cornell-diffuse, landscape, hotspot, stress-*) as glTF");
   cmd->footer(sceneListHelp());
   cmd->add_option("scene", options->scene, "scene name (listed below)")->required();
   cmd->add_option("-o,--output", options->output, "output file, .gltf (embedded buffer) or .glb (binary)")->required();

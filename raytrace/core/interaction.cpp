@@ -85,9 +85,12 @@ Ray spawnRay(const SurfaceInteraction& si, const glm::vec3& dir) {
   return Ray{spawnOrigin(si, dir), 0.0f, dir, kInfinity};
 }
 
+// The ray stops 1e-4 of the way short of a point target: a point light lying exactly on a
+// surface (stress-light-on-surface) is not shadowed by the surface it lies on.
 Ray spawnRayTo(const SurfaceInteraction& si, const glm::vec3& target) {
+  constexpr float kShortOfTarget = 1.0f - 1e-4f;
   const glm::vec3 origin = spawnOrigin(si, target - si.position);
-  return Ray{origin, 0.0f, target - origin, 1.0f};
+  return Ray{origin, 0.0f, target - origin, kShortOfTarget};
 }
 
 Ray spawnRayTo(const SurfaceInteraction& from, const SurfaceInteraction& to) {

@@ -57,6 +57,12 @@ void GltfBuilder::useExtension(const std::string& name) {
   model_.extensionsUsed.push_back(name);
 }
 
+namespace {
+tinygltf::Value::Array toValues(glm::vec3 v) {
+  return {tinygltf::Value(clean(v.x)), tinygltf::Value(clean(v.y)), tinygltf::Value(clean(v.z))};
+}
+}  // namespace
+
 int GltfBuilder::addMaterial(const MaterialDesc& desc) {
   tinygltf::Material m;
   m.name = desc.name;
@@ -77,6 +83,14 @@ int GltfBuilder::addMaterial(const MaterialDesc& desc) {
     useExtension("KHR_materials_transmission");
     useExtension("KHR_materials_ior");
   }
+  if (desc.attenuationDistance > 0.0f) {
+    tinygltf::Value::Object volume{{"attenuationDistance", tinygltf::Value(clean(desc.attenuationDistance))},
+                                   {"attenuationColor", tinygltf::Value(toValues(desc.attenuationColor))},
+                                   {"thicknessFactor", tinygltf::Value(clean(desc.thickness))}};
+    m.extensions["KHR_materials_volume"] = tinygltf::Value(volume);
+    useExtension("KHR_materials_volume");
+  }
+  m.doubleSided = desc.doubleSided;
   model_.materials.push_back(std::move(m));
   return static_cast<int>(model_.materials.size()) - 1;
 }

@@ -27,6 +27,11 @@ struct MaterialDesc {
   float emissiveStrength = 0.0f;  // KHR_materials_emissive_strength (> 1 for bright lights)
   float transmission = 0.0f;      // KHR_materials_transmission
   float ior = 1.5f;               // KHR_materials_ior
+  bool doubleSided = false;
+  // KHR_materials_volume, written when attenuationDistance > 0 (with transmission).
+  float attenuationDistance = 0.0f;
+  glm::vec3 attenuationColor{1.0f};
+  float thickness = 0.0f;
 };
 
 // Node placement: translation, rotation (unit quaternion), uniform scale.

@@ -6,6 +6,10 @@
 
 namespace pr::scenegen {
 
+namespace {
+constexpr SceneProperties kStress{"sphere segments around (rings = half)", 24, 8, 128, false, 0};
+}
+
 const SceneRegistry& sceneRegistry() {
   static const SceneRegistry kScenes(
       "scene",
@@ -18,6 +22,19 @@ const SceneRegistry& sceneRegistry() {
            buildLandscape, {"terrain grid cells per side (2 * size^2 triangles)", 708, 1, 2048, true, 1}},
           {"hotspot", "load-balancing study: a dense cluster of spheres in the top-left corner of a plain room",
            buildHotspot, {"segments around each sphere (rings = half)", 48, 8, 256, true, 1}},
+          // Hard cases for the numerics (stress.cpp); behaviour documented in scenes/README.md.
+          {"stress-scale-small", "the stress stage (floor, wall, sphere, point light) at scale 1e-6", buildStressScaleSmall, kStress},
+          {"stress-scale-large", "the same stage at scale 1e6", buildStressScaleLarge, kStress},
+          {"stress-degenerate", "the stage with a grid whose triangles are half degenerate (repeated, collinear, point)", buildStressDegenerate, kStress},
+          {"stress-zfight", "two coincident quads of different colours (z-fighting) and one 1e-7 in front", buildStressZFight, kStress},
+          {"stress-camera-inside", "the camera inside a closed double-sided sphere lit from inside", buildStressCameraInside, kStress},
+          {"stress-light-inside", "the only light inside a closed box", buildStressLightInside, kStress},
+          {"stress-light-on-surface", "the only light exactly on the floor", buildStressLightOnSurface, kStress},
+          {"stress-thin-glass", "a glass slab with attenuation distance 1e-3 (transmittance exp(-100))", buildStressThinGlass, kStress},
+          {"stress-dielectrics", "nested (water in glass) and touching (two glass cubes) dielectrics", buildStressDielectrics, kStress},
+          {"stress-fireflies", "the only light a 1 cm square of radiance 1e6", buildStressFireflies, kStress},
+          {"stress-huge-triangle", "one ground triangle about 1e7 pixels across", buildStressHugeTriangle, kStress},
+          {"stress-total-reflection", "the camera inside a cube of ior 2.4: total internal reflection to the depth limit", buildStressTotalReflection, kStress},
       });
   return kScenes;
 }

@@ -45,5 +45,18 @@ void buildCornell(GltfBuilder& builder, const SceneParams& params);
 void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params);
 void buildLandscape(GltfBuilder& builder, const SceneParams& params);
 void buildHotspot(GltfBuilder& builder, const SceneParams& params);
+// stress.cpp: the scenes that stress the numerics.
+void buildStressScaleSmall(GltfBuilder& builder, const SceneParams& params);
+void buildStressScaleLarge(GltfBuilder& builder, const SceneParams& params);
+void buildStressDegenerate(GltfBuilder& builder, const SceneParams& params);
+void buildStressZFight(GltfBuilder& builder, const SceneParams& params);
+void buildStressCameraInside(GltfBuilder& builder, const SceneParams& params);
+void buildStressLightInside(GltfBuilder& builder, const SceneParams& params);
+void buildStressLightOnSurface(GltfBuilder& builder, const SceneParams& params);
+void buildStressThinGlass(GltfBuilder& builder, const SceneParams& params);
+void buildStressDielectrics(GltfBuilder& builder, const SceneParams& params);
+void buildStressFireflies(GltfBuilder& builder, const SceneParams& params);
+void buildStressHugeTriangle(GltfBuilder& builder, const SceneParams& params);
+void buildStressTotalReflection(GltfBuilder& builder, const SceneParams& params);
 
 }  // namespace pr::scenegen

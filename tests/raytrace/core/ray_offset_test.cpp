@@ -1,6 +1,7 @@
 // Tests of robust secondary-ray origins (raytrace/core/ray_offset.h, spawn* in interaction.cpp):
 // rays leaving a surface never hit it again (no acne) and never slip through a closed box
-// (no leaks), at scene scales from 1e-4 to 1e5 and far from the coordinate origin.
+// (no leaks), at scene scales from 1e-4 to 1e5 and far from the coordinate origin, and 1000
+// bounces of total internal reflection stay inside a glass box at scales 1e-6 to 1e6.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -11,6 +12,7 @@
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/core/interaction.h"
 #include "raytrace/core/ray_offset.h"
+#include "raytrace/integrators/bsdf.h"
 
 using pr::rt::Bvh;
 using pr::rt::Hit;
@@ -116,5 +118,42 @@ TEST_CASE("RayOffset: the offset point lies on the requested side and close to t
       // 256 ulps of a coordinate, or 2^-16 of the magnitude near zero: below 1e-4 relative.
       CHECK(glm::length(up - p) < 1e-4f * magnitude);
     }
+  }
+}
+
+TEST_CASE("RayOffset: 1000 bounces of total internal reflection stay inside a glass box, finite, at scales 1e-6 to 1e6") {
+  // Inside a box of ior 2.4 (critical angle 24.6 degrees), a direction whose components are all
+  // well above sin(24.6) keeps them under mirror reflection: every hit reflects totally, with
+  // Fresnel reflectance exactly 1. Each bounce must hit the box from inside again (no leak, no
+  // re-hit of the same face), at a finite positive distance, with the throughput still 1.
+  constexpr float kIor = 2.4f;
+  for (float scale : {1e-6f, 1e-3f, 1.0f, 1e3f, 1e6f}) {
+    CAPTURE(scale);
+    const glm::vec3 lo = scale * glm::vec3(-1.0f, -0.7f, -1.3f), hi = scale * glm::vec3(1.1f, 0.9f, 0.8f);
+    const auto box = pr::test::closedBox(lo, hi, kCells);
+    const Bvh bvh(box);
+    Ray ray{0.5f * (lo + hi), 0.0f, glm::normalize(glm::vec3(0.55f, 0.6f, -0.58f)), pr::rt::kInfinity};
+    float throughput = 1.0f;
+    int bounces = 0, previousFace = -1;
+    for (; bounces < 1000; ++bounces) {
+      Hit hit;
+      if (!bvh.intersect(ray, hit)) break;
+      if (!(hit.t > 0.0f) || !std::isfinite(hit.t)) break;
+      const SurfaceInteraction si = pr::rt::makeInteraction(box, ray, hit);
+      if (si.frontFace || faceOf(hit.triangle) == previousFace) break;  // leaked out, or re-hit
+      previousFace = faceOf(hit.triangle);
+      const glm::vec3 n = -si.geometricNormal;  // into the glass
+      const float cosI = glm::dot(-ray.direction, n);
+      // Leaving glass into air: eta = 1 / ior; above the critical angle the reflectance is 1.
+      throughput *= pr::rt::fresnelDielectric(cosI, 1.0f / kIor);
+      const glm::vec3 reflected = glm::normalize(ray.direction + 2.0f * cosI * n);
+      if (!std::isfinite(throughput) || !std::isfinite(reflected.x + reflected.y + reflected.z)) break;
+      ray = pr::rt::spawnRay(si, reflected);
+    }
+    CHECK(bounces == 1000);
+    CHECK(throughput == 1.0f);
+    const glm::vec3 p = ray.origin;
+    CHECK(glm::all(glm::greaterThanEqual(p, lo - 1e-3f * scale)));
+    CHECK(glm::all(glm::lessThanEqual(p, hi + 1e-3f * scale)));
   }
 }
