@@ -106,3 +106,17 @@ TEST_CASE("GltfPaths: the same bytes load from memory, and an external reference
                        doctest::Contains("memory.gltf: refers to the external file 'm.bin', but a model loaded from memory has no folder"),
                        pr::InputError);
 }
+
+TEST_CASE("GltfPaths: a node hierarchy 1000 levels deep loads (the limit; one more is refused)") {
+  auto dir = pr::test::scratchDir("gltf_deep_hierarchy");
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  w.doc["nodes"][0].erase("mesh");
+  for (int i = 1; i <= 1000; ++i) {
+    w.doc["nodes"][size_t(i - 1)]["children"] = {i};
+    w.addNode(i == 1000 ? nlohmann::json{{"mesh", 0}, {"translation", {0.001, 0, 0}}}
+                        : nlohmann::json{{"translation", {0.001, 0, 0}}});
+  }
+  Scene s = loadQuiet(w.write(dir, "deep.gltf"));
+  REQUIRE(s.triangles.size() == 1);
+  CHECK(s.positions[0].x == doctest::Approx(1.0f).epsilon(1e-4));  // 1000 translations of 0.001
+}

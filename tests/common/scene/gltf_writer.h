@@ -334,6 +334,16 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
     bad.push_back({"node with two parents", w.write(dir, "node_dag.gltf"), "one parent each"});
   }
   {
+    // A chain of 1002 nodes (root at depth 0): one level past the 1000 the loader walks.
+    GltfWriter w = oneTriangle();
+    w.doc["nodes"][0].erase("mesh");
+    for (int i = 1; i <= 1001; ++i) {
+      w.doc["nodes"][size_t(i - 1)]["children"] = {i};
+      w.addNode(i == 1001 ? nlohmann::json{{"mesh", 0}} : nlohmann::json::object());
+    }
+    bad.push_back({"node hierarchy too deep", w.write(dir, "deep.gltf"), "hierarchy deeper than 1000 levels"});
+  }
+  {
     GltfWriter w = oneTriangle();
     w.doc["scenes"][0]["nodes"] = {0, 0};
     bad.push_back({"scene root listed twice", w.write(dir, "root_twice.gltf"), "lists node 0 twice"});
