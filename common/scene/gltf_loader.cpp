@@ -215,6 +215,9 @@ tinygltf::Model parse(std::span<const uint8_t> bytes, const std::string& file, F
   if (!ok) {
     // tinygltf reports several lines; the first names the actual problem.
     std::string reason = err.empty() ? "unknown parse error" : err.substr(0, err.find('\n'));
+    // tinygltf quotes the offending value, which may be a multi-megabyte data URI.
+    constexpr size_t kMaxReason = 240;
+    if (reason.size() > kMaxReason) reason = reason.substr(0, kMaxReason) + "... (" + std::to_string(reason.size()) + " characters)";
     const std::string kNotFound = "File not found : ";
     if (reason.rfind(kNotFound, 0) == 0) {
       throw InputError(file + ": buffer file '" + reason.substr(kNotFound.size()) +

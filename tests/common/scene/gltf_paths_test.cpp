@@ -120,3 +120,22 @@ TEST_CASE("GltfPaths: a node hierarchy 1000 levels deep loads (the limit; one mo
   REQUIRE(s.triangles.size() == 1);
   CHECK(s.positions[0].x == doctest::Approx(1.0f).epsilon(1e-4));  // 1000 translations of 0.001
 }
+
+TEST_CASE("GltfPaths: a long bad data URI is quoted in part, so the message stays one short line") {
+  auto dir = pr::test::scratchDir("gltf_long_bad_uri");
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  auto path = w.write(dir, "long.gltf");
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+  doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + std::string(100000, '*');
+  std::ofstream(path) << doc.dump();
+  std::string message;
+  try {
+    loadQuiet(path);
+  } catch (const pr::InputError& e) {
+    message = e.what();
+  }
+  CHECK(message.find("Failed to decode 'uri'") != std::string::npos);
+  CHECK(message.find("characters)") != std::string::npos);
+  CHECK(message.size() < 600);
+  CHECK(message.find('\n') == std::string::npos);
+}
