@@ -22,12 +22,7 @@ std::filesystem::path writeWithExternalBuffer(const std::filesystem::path& gltf,
   std::filesystem::create_directories(bufferFile.parent_path());
   std::filesystem::create_directories(gltf.parent_path());
   std::ofstream(bufferFile, std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof positions);
-  pr::test::GltfWriter w = pr::test::oneTriangle();
-  auto path = w.write(gltf.parent_path(), gltf.filename().string());
-  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-  doc["buffers"][0]["uri"] = uri;
-  std::ofstream(path) << doc.dump(1);
-  return path;
+  return pr::test::oneTriangleWithBufferUri(gltf.parent_path(), gltf.filename().string(), uri);
 }
 
 Scene loadQuiet(const std::filesystem::path& path) {
@@ -123,11 +118,7 @@ TEST_CASE("GltfPaths: a node hierarchy 1000 levels deep loads (the limit; one mo
 
 TEST_CASE("GltfPaths: a long bad data URI is quoted in part, so the message stays one short line") {
   auto dir = pr::test::scratchDir("gltf_long_bad_uri");
-  pr::test::GltfWriter w = pr::test::oneTriangle();
-  auto path = w.write(dir, "long.gltf");
-  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-  doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + std::string(100000, '*');
-  std::ofstream(path) << doc.dump();
+  auto path = pr::test::oneTriangleWithBufferUri(dir, "long.gltf", "data:application/octet-stream;base64," + std::string(100000, '*'));
   std::string message;
   try {
     loadQuiet(path);

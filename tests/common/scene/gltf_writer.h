@@ -172,6 +172,17 @@ inline GltfWriter oneTriangle() {
   return w;
 }
 
+// The one-triangle file written as `name` with buffer 0's URI replaced by `uri` (the writer
+// itself always embeds the buffer as a data URI).
+inline std::filesystem::path oneTriangleWithBufferUri(const std::filesystem::path& dir, const std::string& name,
+                                                      const std::string& uri) {
+  auto path = oneTriangle().write(dir, name);
+  nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
+  doc["buffers"][0]["uri"] = uri;
+  std::ofstream(path) << doc.dump(1);
+  return path;
+}
+
 // A bad input file and the words its error message must contain (besides the file name).
 struct BadInput {
   std::string name;
@@ -236,11 +247,7 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
     bad.push_back({"truncated glb", path, "not a valid glTF binary"});
   }
   {
-    GltfWriter w = oneTriangle();
-    auto path = w.write(dir, "missing_buffer.gltf");
-    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-    doc["buffers"][0]["uri"] = "missing_buffer.bin";
-    std::ofstream(path) << doc.dump(1);
+    auto path = oneTriangleWithBufferUri(dir, "missing_buffer.gltf", "missing_buffer.bin");
     bad.push_back({"missing buffer file", path, "buffer file 'missing_buffer.bin' is missing"});
   }
   {
@@ -308,11 +315,7 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
   // Hostile files: each would read outside the model's folder, take time exponential in its
   // size, or allocate far more than it holds.
   {
-    GltfWriter w = oneTriangle();
-    auto path = w.write(dir, "escape.gltf");
-    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-    doc["buffers"][0]["uri"] = "../../../../../../etc/passwd";
-    std::ofstream(path) << doc.dump(1);
+    auto path = oneTriangleWithBufferUri(dir, "escape.gltf", "../../../../../../etc/passwd");
     bad.push_back({"buffer URI escaping the folder", path, "refers to '../../../../../../etc/passwd', outside the model's folder; refused"});
   }
   {
@@ -384,21 +387,13 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
     }
   }
   {
-    GltfWriter w = oneTriangle();
-    auto path = w.write(dir, "bad_base64.gltf");
-    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64,@@@@not*base64";
-    std::ofstream(path) << doc.dump(1);
+    auto path = oneTriangleWithBufferUri(dir, "bad_base64.gltf", "data:application/octet-stream;base64,@@@@not*base64");
     bad.push_back({"data URI with bad base64", path, "not a valid glTF file"});
   }
   {
     // A .gltf whose buffer file is itself a GLB: a different file, not raw buffer bytes.
     writeBytes(dir / "inner.glb", oneTriangleGlb());
-    GltfWriter w = oneTriangle();
-    auto path = w.write(dir, "buffer_is_glb.gltf");
-    nlohmann::json doc = nlohmann::json::parse(std::ifstream(path));
-    doc["buffers"][0]["uri"] = "inner.glb";
-    std::ofstream(path) << doc.dump(1);
+    auto path = oneTriangleWithBufferUri(dir, "buffer_is_glb.gltf", "inner.glb");
     bad.push_back({"buffer file that is a GLB", path, "'inner.glb' is a binary glTF (.glb), not a raw buffer"});
   }
   bad.push_back({"GLB without its BIN chunk", writeBytes(dir / "no_bin.glb", oneTriangleGlb({}, false)), "not a valid glTF binary"});
