@@ -164,8 +164,13 @@ void run(const GalleryArgs& a) {
        << rows << "</table>\n";
   html.close();
   if (!html) throw InputError((temp / "index.html").string() + ": cannot write");
-  fs::remove_all(out);
+  // The earlier gallery is moved aside, then replaced, then removed: at no point is the new
+  // one incomplete under OUT.
+  const fs::path previous = fs::path(a.output + ".previous");
+  fs::remove_all(previous);
+  if (fs::exists(out)) fs::rename(out, previous);
   fs::rename(temp, out);
+  fs::remove_all(previous);
   std::printf("gallery of %zu models -> %s (contact_sheet.png, index.html)\n", models.size(), out.string().c_str());
 }
 

@@ -27,10 +27,12 @@ struct GenerateOptions {
 
 std::string sceneListHelp() {
   std::string text = "Writes a bundled scene as glTF 2.0 (.gltf with the buffer embedded, or .glb).\nScenes:";
+  size_t column = 0;  // the names' width, so that the descriptions line up
+  for (const scenegen::SceneEntry& entry : scenegen::sceneRegistry()) column = std::max(column, entry.name.size() + 2);
   for (const scenegen::SceneEntry& entry : scenegen::sceneRegistry()) {
     const scenegen::SceneProperties& scene = entry.properties;
-    text += "\n  " + entry.name + std::string(entry.name.size() < 16 ? 16 - entry.name.size() : 1, ' ') +
-            entry.description + "\n" + std::string(18, ' ') + "--size: " + std::string(scene.sizeMeaning) +
+    text += "\n  " + entry.name + std::string(column - entry.name.size(), ' ') + entry.description + "\n" +
+            std::string(column + 2, ' ') + "--size: " + std::string(scene.sizeMeaning) +
             " (default " + std::to_string(scene.defaultSize) + ", " + std::to_string(scene.minSize) + " to " +
             std::to_string(scene.maxSize) + ")" + (scene.usesSeed ? "; --seed default " + std::to_string(scene.defaultSeed) : "");
   }

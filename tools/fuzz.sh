@@ -2,8 +2,8 @@
 # Builds the libFuzzer targets (tests/fuzz: clang, coverage, AddressSanitizer + UBSan) in
 # build-fuzz and runs each for a bounded time or number of executions, then prints one line
 # per target: executions, coverage, corpus, and the crashes, hangs, out-of-memory and leak
-# reports found (their inputs are kept under build-fuzz/artifacts/TARGET/). Exit status 1
-# when any target found one.
+# reports found (their inputs are kept under build-fuzz/artifacts/TARGET/, the previous run's
+# under TARGET.previous/). Exit status 1 when any target found one.
 #   tools/fuzz.sh                        every target for 60 s (the CI job)
 #   tools/fuzz.sh --seconds 600 render   one target for 10 minutes
 #   tools/fuzz.sh --runs 10000000 gltf_loader   a campaign of 10 million executions
@@ -45,6 +45,10 @@ fi
 status=0
 for target in "${targets[@]}"; do
   corpus="$build/corpus/$target" artifacts="$build/artifacts/$target"
+  # Each run reports its own findings: an earlier run's are moved aside, not counted again.
+  if [ -d "$artifacts" ] && [ -n "$(ls -A "$artifacts")" ]; then
+    rm -rf "$artifacts.previous" && mv "$artifacts" "$artifacts.previous"
+  fi
   mkdir -p "$corpus" "$artifacts"
   inputs=("$corpus")
   case "$target" in

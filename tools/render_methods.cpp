@@ -268,7 +268,8 @@ void addRasterOptions(CLI::App& command, RenderSettings& settings, FamilyOptions
 // Bytes per pixel and per (pixel, sample, PE), from peak RSS of `parrender render
 // scenes/cornell.gltf -m M --threads P --width 1024|2048 --spp 1|4 --max-depth 1|4` at P = 1,
 // 2, 4, 8, rounded up: 64 per pixel for every method; sort-last 48 per pixel per PE; from
-// P = 2, object-space about 175 per sample per PE and object 1000 + 150 per PE per sample.
+// P = 2, object-space about 175 per sample per PE (180 below) and object 1000 + 150 per PE
+// per sample.
 uint64_t estimatedRenderBytes(const RenderMethod& method, int width, int height, int pes, int spp) {
   const uint64_t pixels = uint64_t(width) * uint64_t(height), p = uint64_t(pes);
   const uint64_t samples = saturatingMul(pixels, uint64_t(method.properties.family == MethodFamily::Ray ? spp : 1));

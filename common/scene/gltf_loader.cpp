@@ -53,8 +53,9 @@ std::string supportedList() {
 // Divided by its largest component first, so that neither a denormal nor a huge vector loses
 // its length to underflow or overflow in the squares.
 glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
+  if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z)) return fallback;  // max() would drop a NaN
   const float largest = std::max(std::abs(v.x), std::max(std::abs(v.y), std::abs(v.z)));
-  if (!(largest > 0.0f) || !std::isfinite(largest)) return fallback;
+  if (!(largest > 0.0f)) return fallback;
   v /= largest;
   return v / glm::length(v);
 }
@@ -62,6 +63,11 @@ glm::vec3 safeNormalize(glm::vec3 v, glm::vec3 fallback) {
 // World coordinates beyond this are refused: the tracers and rasterizers square distances in
 // float, which overflows past about 1.8e19; 1e18 keeps a factor of 10 in hand for sums.
 constexpr double kMaxCoordinate = 1e18;
+
+// Finite and within kMaxCoordinate on every axis (each compared: max() would drop a NaN).
+bool withinRange(const glm::dvec3& q) {
+  return std::abs(q.x) <= kMaxCoordinate && std::abs(q.y) <= kMaxCoordinate && std::abs(q.z) <= kMaxCoordinate;
+}
 
 // External files (buffers, images) the file refers to, read through tinygltf's file-system
 // callbacks so that every one is confined to the model's folder and charged to the budget.
@@ -71,23 +77,38 @@ struct FileAccess {
   std::string refusal;  // the first refused reference; reported as the load's error
   const tinygltf::Model* model = nullptr;  // being parsed: its buffers are read when images are
 
-  // The path relative to the folder, or "" when it is outside (or there is no folder).
+  // What tinygltf joins every URI to (folder + "/"). Its second probe of the working directory
+  // ("./uri") has another prefix unless the folder is ".", so it is never answered.
+  std::string prefix() const {
+    std::string p = folder.string();
+    if (!p.empty() && p.back() != '/') p += '/';
+    return p;
+  }
+
+  // The URI part of a joined path, lexically normalised, or "" when the path is not a join of
+  // the folder, or leads outside it: by "..", as an absolute URI, or through a symlink (the
+  // file the kernel would open must lie under the folder's real path too).
   std::filesystem::path inside(const std::string& path) const {
-    if (folder.empty()) return {};
-    const std::filesystem::path rel = std::filesystem::path(path).lexically_normal().lexically_relative(folder);
+    namespace fs = std::filesystem;
+    if (folder.empty() || path.rfind(prefix(), 0) != 0) return {};
+    const fs::path rel = fs::path(path.substr(prefix().size())).lexically_normal();
     if (rel.empty() || rel.is_absolute() || *rel.begin() == "..") return {};
+    std::error_code e1, e2;
+    const fs::path real = fs::weakly_canonical(path, e1), root = fs::weakly_canonical(folder, e2);
+    if (e1 || e2) return {};
+    const fs::path fromRoot = real.lexically_relative(root);
+    if (fromRoot.empty() || *fromRoot.begin() == "..") return {};
     return rel;
   }
 
   bool allowed(const std::string& path) {
     if (!inside(path).empty()) return true;
-    // tinygltf also probes the working directory ("./uri"): never read, and not the reference's
-    // fault; only a path under the folder it was given can be a reference that escapes.
-    const bool underFolder = !folder.empty() && path.rfind(folder.string(), 0) == 0;
-    if (refusal.empty() && (underFolder || folder.empty()) && !path.empty()) {
-      const std::string uri = folder.empty() ? path : std::filesystem::path(path).lexically_relative(folder).string();
+    // Only a join of the folder is the file's own reference; tinygltf's other probes are not.
+    const bool joined = !folder.empty() && path.rfind(prefix(), 0) == 0;
+    if (refusal.empty() && (joined || folder.empty()) && !path.empty()) {
+      const std::string uri = folder.empty() ? path : path.substr(prefix().size());
       refusal = folder.empty() ? "refers to the external file '" + uri + "', but a model loaded from memory has no folder"
-                               : "refers to '" + uri + "', outside the model's folder; refused";
+                               : "refers to '" + uri + "', outside the model's folder (or through a link out of it); refused";
     }
     return false;
   }
@@ -504,7 +525,7 @@ class Flattener {
     for (size_t i = 0; i < count; ++i) {
       const float* p = pos.element(i);
       const glm::dvec3 q(world * glm::dvec4(p[0], p[1], p[2], 1.0));
-      if (!(std::max(std::abs(q.x), std::max(std::abs(q.y), std::abs(q.z))) <= kMaxCoordinate)) {
+      if (!withinRange(q)) {
         ctx_.fail(describe("node", nodeIndex, node.name) + " " + where + ": vertex " + std::to_string(i) +
                   " lies beyond +-1e18 in world space (or is not finite after the node transforms); "
                   "squared distances would overflow float");
@@ -622,6 +643,7 @@ class Flattener {
     }
     // Cameras are rigid (spec 3.10.1): strip any scale inherited from parents (Duck's camera
     // sits under a 0.01-scaled node) so view() is a pure rotation and translation.
+    if (!withinRange(glm::dvec3(world[3]))) ctx_.fail(where + ": the camera lies beyond +-1e18 in world space (or is not finite)");
     glm::mat4 m(world);
     for (int axis = 0; axis < 3; ++axis) {
       glm::vec3 col = safeNormalize(glm::vec3(m[axis]), glm::vec3(axis == 0, axis == 1, axis == 2));
@@ -656,6 +678,7 @@ class Flattener {
     l.intensity = float(gl.intensity);
     if (gl.range > 0.0) l.range = float(gl.range);
     // The light sits at the node origin and shines down the node's -Z (extension spec).
+    if (!withinRange(glm::dvec3(world[3]))) ctx_.fail(where + ": the light lies beyond +-1e18 in world space (or is not finite)");
     l.position = glm::vec3(world * glm::dvec4(0.0, 0.0, 0.0, 1.0));
     l.direction = safeNormalize(glm::vec3(world * glm::dvec4(0.0, 0.0, -1.0, 0.0)), glm::vec3(0.0f, 0.0f, -1.0f));
     ctx_.scene.lights.push_back(std::move(l));
@@ -680,6 +703,8 @@ void checkNodeForest(const Context& ctx) {
         ctx.fail(describe("node", int(p), nodes[p].name) + ": child " + std::to_string(child) +
                  " is out of range (the file has " + std::to_string(nodes.size()) + " nodes)");
       }
+      if (parent[size_t(child)] == int(p))
+        ctx.fail(describe("node", int(p), nodes[p].name) + " lists child " + std::to_string(child) + " twice");
       if (parent[size_t(child)] >= 0) {
         ctx.fail(describe("node", child, nodes[size_t(child)].name) + " is a child of both node " +
                  std::to_string(parent[size_t(child)]) + " and node " + std::to_string(p) +
@@ -738,6 +763,12 @@ Scene load(std::span<const uint8_t> bytes, const std::string& file, const std::f
   Scene scene;
   std::vector<std::string> tinyWarnings;
   FileAccess access{folder, &budget, {}};
+  // tinygltf copies a GLB's BIN chunk and decodes data URIs into buffers: about the file again.
+  try {
+    budget.charge(bytes.size(), "parsing (the copy of its buffers)");
+  } catch (const InputError& e) {
+    throw InputError(file + ": " + e.what());
+  }
   tinygltf::Model model = parse(bytes, file, access, tinyWarnings);
   Context ctx{model, file, scene, budget, {}};
   selectVariant(ctx, options.variant);

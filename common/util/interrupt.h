@@ -1,6 +1,8 @@
 // Ctrl-C (SIGINT) and SIGTERM stop parrender at once: there is nothing worth finishing in a
 // half-done render, and every output is written to a temporary name and renamed into place
-// (atomic_file.h), so the handler only removes the temporaries in flight and exits with 130.
+// (atomic_file.h), so the handler only removes the temporaries in flight and exits with
+// 128 + the signal (130 for SIGINT, 143 for SIGTERM). A signal the process inherited as
+// ignored (nohup, a non-interactive shell's background job) stays ignored.
 // No output file is ever left half written, and an earlier good one is never replaced.
 #pragma once
 

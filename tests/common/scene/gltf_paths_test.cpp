@@ -130,3 +130,39 @@ TEST_CASE("GltfPaths: a long bad data URI is quoted in part, so the message stay
   CHECK(message.size() < 600);
   CHECK(message.find('\n') == std::string::npos);
 }
+
+TEST_CASE("GltfPaths: a link inside the folder that leads out of it is refused") {
+  auto dir = pr::test::scratchDir("gltf_symlink_escape");
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::filesystem::create_directories(dir / "outside");
+  std::ofstream(dir / "outside" / "secret.bin", std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof positions);
+  std::filesystem::create_directories(dir / "model");
+  std::filesystem::create_directory_symlink(dir / "outside", dir / "model" / "linked");
+  std::filesystem::create_symlink(dir / "outside" / "secret.bin", dir / "model" / "file_link.bin");
+  for (const char* uri : {"linked/secret.bin", "file_link.bin"}) {
+    CAPTURE(uri);
+    auto path = pr::test::oneTriangleWithBufferUri(dir / "model", "m.gltf", uri);
+    CHECK_THROWS_WITH_AS(loadQuiet(path), doctest::Contains("outside the model's folder (or through a link out of it); refused"),
+                         pr::InputError);
+  }
+}
+
+TEST_CASE("GltfPaths: with a relative folder, tinygltf's working-directory probe is not answered either") {
+  // Model m/x.gltf referring to "m/b.bin": only m/m/b.bin is its buffer; ./m/b.bin (which
+  // exists) is the working-directory probe and must not be read.
+  auto dir = pr::test::scratchDir("gltf_relative_probe");
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::filesystem::create_directories(dir / "m");
+  std::ofstream(dir / "m" / "b.bin", std::ios::binary).write(reinterpret_cast<const char*>(positions), sizeof positions);
+  pr::test::oneTriangleWithBufferUri(dir / "m", "x.gltf", "m/b.bin");
+  const auto previous = std::filesystem::current_path();
+  std::filesystem::current_path(dir);
+  std::string message;
+  try {
+    loadQuiet("m/x.gltf");
+  } catch (const pr::InputError& e) {
+    message = e.what();
+  }
+  std::filesystem::current_path(previous);
+  CHECK(message.find("buffer file 'm/b.bin' is missing") != std::string::npos);
+}

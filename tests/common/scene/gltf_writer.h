@@ -316,14 +316,14 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
   // size, or allocate far more than it holds.
   {
     auto path = oneTriangleWithBufferUri(dir, "escape.gltf", "../../../../../../etc/passwd");
-    bad.push_back({"buffer URI escaping the folder", path, "refers to '../../../../../../etc/passwd', outside the model's folder; refused"});
+    bad.push_back({"buffer URI escaping the folder", path, "refers to '../../../../../../etc/passwd', outside the model's folder"});
   }
   {
     GltfWriter w = oneTriangle();
     w.doc["images"] = {{{"uri", "..%2F..%2Fsecret.png"}}};  // percent-encoded "../../secret.png"
     w.doc["textures"] = {{{"source", 0}}};
     bad.push_back({"percent-encoded image URI escaping the folder", w.write(dir, "escape_encoded.gltf"),
-                   "outside the model's folder; refused"});
+                   "refers to '../../secret.png', outside the model's folder"});
   }
   {
     // Node i has node i+1 as its child twice over (through two parents): 2^40 paths to the
@@ -345,6 +345,31 @@ inline std::vector<BadInput> writeBadInputs(const std::filesystem::path& dir) {
       w.addNode(i == 1001 ? nlohmann::json{{"mesh", 0}} : nlohmann::json::object());
     }
     bad.push_back({"node hierarchy too deep", w.write(dir, "deep.gltf"), "hierarchy deeper than 1000 levels"});
+  }
+  {
+    // Two nested scales of 1e200: the world matrix holds inf, and inf * 0 makes a NaN vertex.
+    GltfWriter w = oneTriangle();
+    w.doc["nodes"][0].erase("mesh");
+    w.doc["nodes"][0]["scale"] = {1, 1e200, 1};
+    w.doc["nodes"][0]["children"] = {1};
+    w.addNode({{"mesh", 0}, {"scale", {1, 1e200, 1}}});
+    bad.push_back({"transform overflowing to NaN", w.write(dir, "nan_transform.gltf"), "or is not finite after the node transforms"});
+  }
+  {
+    GltfWriter w = oneTriangle();
+    w.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    w.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}, {"intensity", 1}}};
+    w.addNode({{"translation", {0, 3e18, 0}}, {"extensions", {{"KHR_lights_punctual", {{"light", 0}}}}}});
+    w.doc["scenes"][0]["nodes"] = {0, 1};
+    bad.push_back({"light beyond the coordinate range", w.write(dir, "far_light.gltf"), "the light lies beyond +-1e18"});
+  }
+  bad.push_back({"absolute buffer URI", oneTriangleWithBufferUri(dir, "absolute_uri.gltf", "/etc/passwd"),
+                 "refers to '/etc/passwd', outside the model's folder"});
+  {
+    GltfWriter w = oneTriangle();
+    w.addNode({{"mesh", 0}});
+    w.doc["nodes"][0]["children"] = {1, 1};
+    bad.push_back({"child listed twice", w.write(dir, "child_twice.gltf"), "node 0 lists child 1 twice"});
   }
   {
     GltfWriter w = oneTriangle();
