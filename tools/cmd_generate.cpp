@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
 #include "tools/scenegen/scene_registry.h"
@@ -56,7 +57,7 @@ void runGenerate(const GenerateOptions& options) {
   params.seed = options.seedOption->count() > 0 ? options.seed : scene.defaultSeed;
   const scenegen::GltfBuilder builder = scenegen::generateScene(entry, params);
   const std::string bytes = builder.serialize(ext == ".glb");
-  scenegen::writeFileAtomically(options.output, bytes);
+  writeFileAtomically(options.output, bytes, "scene file");
   std::printf("wrote %s: scene %s, %zu triangles, %zu bytes\n", options.output.c_str(), entry.name.c_str(),
               builder.triangleCount(), bytes.size());
 }

@@ -69,6 +69,25 @@ bool withinRange(const glm::dvec3& q) {
   return std::abs(q.x) <= kMaxCoordinate && std::abs(q.y) <= kMaxCoordinate && std::abs(q.z) <= kMaxCoordinate;
 }
 
+// The whole file, charged to the budget (as `what`) before it is read: the model itself, and
+// each buffer or image file it refers to.
+std::vector<uint8_t> readFile(const std::filesystem::path& path, MemoryBudget& budget, const std::string& what) {
+  const std::string file = path.string();
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) {
+    throw InputError(file + ": cannot read the file (" +
+                     (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") + ")");
+  }
+  const uintmax_t size = std::filesystem::file_size(path, ec);
+  std::ifstream in(path, std::ios::binary);
+  if (ec || !in) throw InputError(file + ": cannot read the file (permission denied or unreadable)");
+  budget.charge(size, what);
+  std::vector<uint8_t> bytes(static_cast<size_t>(size));
+  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+    throw InputError(file + ": cannot read the file (read failed)");
+  return bytes;
+}
+
 // External files (buffers, images) the file refers to, read through tinygltf's file-system
 // callbacks so that every one is confined to the model's folder and charged to the budget.
 struct FileAccess {
@@ -130,26 +149,14 @@ struct FileAccess {
     return access.allowed(path) && std::filesystem::is_regular_file(access.resolve(path), ec);
   }
   static std::string expand(const std::string& path, void*) { return path; }  // no ~ or $VAR
-  static bool read(std::vector<unsigned char>* out, std::string* err, const std::string& uriPath, void* self) {
+  static bool read(std::vector<unsigned char>* out, std::string* /*err: reported as the refusal*/, const std::string& uriPath, void* self) {
     auto& access = *static_cast<FileAccess*>(self);
     if (!access.allowed(uriPath)) return false;
     const std::string path = access.resolve(uriPath);
-    std::error_code ec;
-    const uintmax_t size = std::filesystem::file_size(path, ec);
-    std::ifstream in(path, std::ios::binary);
-    if (ec || !in) {
-      if (err) *err = "unreadable";
-      return false;
-    }
     try {
-      access.budget->charge(size, "file '" + access.inside(path).string() + "'");
+      *out = readFile(path, *access.budget, "file '" + access.inside(path).string() + "'");
     } catch (const InputError& e) {
       if (access.refusal.empty()) access.refusal = e.what();
-      return false;
-    }
-    out->resize(size_t(size));
-    if (size > 0 && !in.read(reinterpret_cast<char*>(out->data()), std::streamsize(size))) {
-      if (err) *err = "read failed";
       return false;
     }
     // A GLB's header (magic, version 2, its own length) where raw bytes were expected: the
@@ -255,23 +262,6 @@ tinygltf::Model parse(std::span<const uint8_t> bytes, const std::string& file, F
   return model;
 }
 
-// The whole file, charged to the budget before it is read.
-std::vector<uint8_t> readFile(const std::filesystem::path& path, MemoryBudget& budget) {
-  const std::string file = path.string();
-  std::error_code ec;
-  if (!std::filesystem::is_regular_file(path, ec)) {
-    throw InputError(file + ": cannot read the file (" +
-                     (std::filesystem::exists(path, ec) ? "not a regular file" : "no such file") + ")");
-  }
-  const uintmax_t size = std::filesystem::file_size(path, ec);
-  std::ifstream in(path, std::ios::binary);
-  if (ec || !in) throw InputError(file + ": cannot read the file (permission denied or unreadable)");
-  budget.charge(size, file);
-  std::vector<uint8_t> bytes(static_cast<size_t>(size));
-  if (size > 0 && !in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
-    throw InputError(file + ": cannot read the file (read failed)");
-  return bytes;
-}
 
 // Local transform of a node: its matrix, or T * R * S (spec 3.5.3).
 glm::dmat4 localTransform(const Context& ctx, const tinygltf::Node& node, int index) {
@@ -814,7 +804,7 @@ Scene load(std::span<const uint8_t> bytes, const std::string& file, const std::f
 
 Scene loadGltf(const std::filesystem::path& path, const LoadOptions& options) {
   MemoryBudget budget(options.maxMemoryBytes);
-  const std::vector<uint8_t> bytes = readFile(path, budget);
+  const std::vector<uint8_t> bytes = readFile(path, budget, path.string());
   // Relative URIs resolve against the file's folder (spec 3.6.1); "." for a bare file name.
   const std::filesystem::path folder = path.parent_path().empty() ? std::filesystem::path(".") : path.parent_path();
   Scene scene = load(bytes, path.string(), folder.lexically_normal(), options, budget);

@@ -12,7 +12,6 @@
 #include <system_error>
 #include <unistd.h>
 
-#include "common/util/atomic_file.h"
 #include "common/util/error.h"
 
 namespace pr::scenegen {
@@ -237,8 +236,5 @@ std::string GltfBuilder::serialize(bool binary) const {
   return out.str();
 }
 
-void writeFileAtomically(const fs::path& path, const std::string& bytes) {
-  pr::writeFileAtomically(path, bytes, "scene file");
-}
 
 }  // namespace pr::scenegen

@@ -76,8 +76,4 @@ class GltfBuilder {
   size_t triangles_ = 0;
 };
 
-// Writes `bytes` to `path` through a temporary file in the same directory renamed into place,
-// so a failed write leaves nothing behind. pr::InputError naming the path when it cannot.
-void writeFileAtomically(const std::filesystem::path& path, const std::string& bytes);
-
 }  // namespace pr::scenegen
