@@ -33,6 +33,7 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   options.integrator.seed = r.settings.ray.seed;
   options.tileSizePx = r.settings.ray.tileSizePx;
   options.adaptive = r.settings.ray.adaptive;
+  options.rayBatch = r.settings.ray.rayBatch;
   options.progress = r.progress;
   rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
   const bool photonmap = r.settings.ray.integrator == "photonmap";
@@ -215,6 +216,10 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
                           ->capture_default_str(),
                       MethodFamily::Ray);
   family.emplace_back(command.add_flag("--adaptive", ray.adaptive, "image-space: split tiles estimated at over twice the mean cost"),
+                      MethodFamily::Ray);
+  family.emplace_back(command.add_option("--ray-batch", ray.rayBatch, "object-space, object: rays per message to one PE (a partial batch goes when its PE runs dry)")
+                          ->check(CLI::Range(1, rt::kMaxRayBatch))
+                          ->capture_default_str(),
                       MethodFamily::Ray);
   // The photon map's own settings (photonmap/photon_map_integrator.h PhotonMapSettings).
   pm::PhotonMapSettings& pm = ray.photonmap;

@@ -1,7 +1,7 @@
 // The render methods of `parrender render -m NAME`: a registry (name -> family -> description
 // -> function) over both families, the ray tracers (one method per raytrace Partition) and the
 // rasterization pipelines. Family-specific options (ray: --integrator --spp --max-depth --seed
-// --tile-size --adaptive; raster: --tile --regions --compositor ...) are registered with their
+// --tile-size --adaptive --ray-batch; raster: --tile --regions --compositor ...) are registered with their
 // family, with --integrator and --compositor checked against and described by their registries, so giving one to a method of the
 // other family is an input error naming the option. Used by cmd_render.cpp.
 #pragma once
@@ -22,6 +22,7 @@
 #include "common/scene/scene.h"
 #include "common/util/registry.h"
 #include "photonmap/photon_map_integrator.h"
+#include "raytrace/partition/partition.h"
 
 namespace pr::cli {
 
@@ -36,6 +37,7 @@ struct RayOptions {
   uint64_t seed = 1;
   int tileSizePx = 16;
   bool adaptive = false;
+  int rayBatch = rt::kDefaultRayBatch;
   // --integrator photonmap's settings (--photons, --gather, --view, ...), and the options
   // that set them: giving one with another integrator is an input error.
   pm::PhotonMapSettings photonmap;

@@ -1,7 +1,7 @@
 // Object partitioning's data split: scene objects cut into pieces of bounded size by spatial
-// median splits, pieces dealt to PEs largest first to the least loaded PE, and the test that
-// decides which owners a ray must visit. Built once per frame by the controlling thread,
-// before the trace stage (object_partition.cpp); read-only afterwards.
+// median splits, and pieces dealt to PEs in runs of equal triangle count along a Morton curve.
+// Built once per frame by the controlling thread, before the trace stage
+// (object_partition.cpp); read-only afterwards.
 #include "raytrace/partition/object_assignment.h"
 
 #include <algorithm>
@@ -62,6 +62,28 @@ void splitPiece(const scene::Scene& s, uint32_t object, std::vector<uint32_t> tr
   splitPiece(s, object, std::move(upper), maxTriangles, out);
 }
 
+// 21 bits per axis of the point's place in the cube around the box, interleaved (a cube, so
+// that a long, flat scene is cut across its length first).
+uint64_t mortonKey(glm::vec3 p, const scene::Bounds& box) {
+  auto spread = [](uint64_t v) {
+    v &= 0x1fffff;
+    v = (v | v << 32) & 0x1f00000000ffffull;
+    v = (v | v << 16) & 0x1f0000ff0000ffull;
+    v = (v | v << 8) & 0x100f00f00f00f00full;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ull;
+    v = (v | v << 2) & 0x1249249249249249ull;
+    return v;
+  };
+  const glm::vec3 size = box.max - box.min;
+  const float extent = std::max(size.x, std::max(size.y, size.z));
+  uint64_t key = 0;
+  for (int a = 0; a < 3; ++a) {
+    const float f = extent > 0.0f ? std::clamp((p[a] - box.min[a]) / extent, 0.0f, 1.0f) : 0.0f;
+    key |= spread(uint64_t(f * float(0x1fffff))) << a;
+  }
+  return key;
+}
+
 }  // namespace
 
 ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignmentOptions& options)
@@ -92,17 +114,24 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
     if (!covered[t]) rest.push_back(t);
   if (!rest.empty()) splitPiece(s, static_cast<uint32_t>(s.objects.size()), std::move(rest), maxPiece, pieces_);
 
-  // Longest processing time first: largest piece to the least loaded PE (ties: lower piece,
-  // lower PE), within 4/3 of the optimal makespan (Graham 1969).
+  // Pieces in the order of a Morton curve through their centres, cut into P runs of about
+  // equal triangle count: each PE owns a compact region of the scene, so a ray is answered by
+  // few owners (often by its originator's own pieces alone) and an owner's part of the
+  // directory is one subtree the walk skips whole (owner_directory.h).
+  scene::Bounds all;
+  for (const ObjectPiece& p : pieces_) all.extend(p.bounds);
+  std::vector<uint64_t> key(pieces_.size());
+  for (size_t p = 0; p < pieces_.size(); ++p) key[p] = mortonKey(pieces_[p].bounds.center(), all);
   std::vector<uint32_t> order(pieces_.size());
   std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](uint32_t x, uint32_t y) { return pieces_[x].triangles.size() > pieces_[y].triangles.size(); });
-  std::vector<size_t> load(pes, 0);
+  std::stable_sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return key[x] < key[y]; });
+  uint64_t before = 0;  // triangles of the pieces before this one on the curve
   for (uint32_t p : order) {
-    const int pe = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
-    pieces_[p].owner = pe;
-    load[pe] += pieces_[p].triangles.size();
+    const uint64_t n = pieces_[p].triangles.size();
+    // The PE whose share of the curve holds the piece's middle triangle.
+    const uint64_t middle = before + n / 2;
+    pieces_[p].owner = int(std::min<uint64_t>(uint64_t(pes) - 1, middle * uint64_t(pes) / std::max<uint64_t>(1, total)));
+    before += n;
   }
 
   perPe_.assign(pes, {});
@@ -113,40 +142,6 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
     perPe_[piece.owner].insert(perPe_[piece.owner].end(), piece.triangles.begin(), piece.triangles.end());
   }
   for (auto& tris : perPe_) std::sort(tris.begin(), tris.end());
-}
-
-void ObjectAssignment::ownersAlong(const Ray& ray, std::vector<int>& owners) const {
-  owners.clear();
-  for (int pe = 0; pe < pes(); ++pe)
-    for (uint32_t p : piecesOf_[pe])
-      if (rayReachesBox(ray, pieces_[p].bounds, margin_)) {
-        owners.push_back(pe);
-        break;
-      }
-}
-
-bool rayReachesBox(const Ray& ray, const scene::Bounds& box, float margin) {
-  if (box.empty()) return false;
-  // Rounding of (b - o) / d is below gamma(3) relative (Ize 2013); widening the far distance by
-  // 1 + 2 gamma(3) keeps every box the ray touches.
-  constexpr float kUlp = 0x1p-24f;
-  constexpr float kFarScale = 1.0f + 2.0f * (3.0f * kUlp) / (1.0f - 3.0f * kUlp);
-  float t0 = ray.tMin, t1 = ray.tMax;
-  for (int a = 0; a < 3; ++a) {
-    const float lo = box.min[a] - margin, hi = box.max[a] + margin;
-    const float o = ray.origin[a], d = ray.direction[a];
-    if (d == 0.0f) {
-      if (o < lo || o > hi) return false;
-      continue;
-    }
-    float tNear = (lo - o) / d, tFar = (hi - o) / d;
-    if (tNear > tFar) std::swap(tNear, tFar);
-    tFar *= kFarScale;
-    t0 = tNear > t0 ? tNear : t0;
-    t1 = tFar < t1 ? tFar : t1;
-    if (!(t0 <= t1)) return false;
-  }
-  return true;
 }
 
 }  // namespace pr::rt

@@ -1,8 +1,9 @@
 // ObjectAssignment: the data split of object partitioning (seed section 5.1.2). Objects are the
 // scene's glTF mesh primitives (Scene::objects), split further by spatial median when large;
-// the pieces are assigned to PEs balanced by triangle count (longest processing time first).
-// object_partition.cpp builds each PE's BVH over its own triangles and sends a ray only to the
-// owners whose piece bounds it can reach (ownersAlong).
+// the pieces are assigned to PEs in runs of about equal triangle count along a Morton curve
+// through their centres, so each PE owns a compact region. object_partition.cpp builds each
+// PE's BVH over its own triangles and asks only the owners whose bounds a ray can reach
+// (owner_directory.h).
 #pragma once
 
 #include <cstdint>
@@ -48,20 +49,11 @@ class ObjectAssignment {
   // Bytes of the directory every PE keeps to route rays: each piece's bounds and owner.
   size_t directoryBytes() const { return pieces_.size() * (sizeof(scene::Bounds) + sizeof(int)); }
 
-  // The owners of pieces whose grown bounds the ray can reach for t in [tMin, tMax],
-  // ascending, each once (cleared first). A pure function of the ray.
-  void ownersAlong(const Ray& ray, std::vector<int>& owners) const;
-
  private:
   std::vector<ObjectPiece> pieces_;
   std::vector<std::vector<uint32_t>> perPe_;
   std::vector<std::vector<uint32_t>> piecesOf_;
   float margin_ = 0.0f;
 };
-
-// True when the ray meets the box (grown by margin) for some t in [tMin, tMax]. Conservative:
-// the far distance is widened by the rounding bound of the slab test (Ize 2013); a direction
-// component of zero is handled without 0 * inf.
-bool rayReachesBox(const Ray& ray, const scene::Bounds& box, float margin);
 
 }  // namespace pr::rt

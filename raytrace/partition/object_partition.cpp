@@ -1,27 +1,31 @@
 // The object-partitioning tracer. Stage "build": each owner builds one BVH over its pieces'
 // triangles. Stage "trace": image tiles are tasks that make camera rays on their PE, which
-// becomes the rays' originator. The originator keeps a pending record per ray, sends a
-// RayQuery to each owner whose piece bounds the ray can reach ("queries" Channel; its own
-// pieces it answers itself), and merges the HitReply messages ("hits" Channel) in the
-// deterministic order of Hit::closerThan, so the result does not depend on arrival order. A
-// hit reply carries the SurfaceInteraction the owner made from its own geometry; the
-// originator shades with it and originates the spawned rays. Shadow queries return one bit.
+// becomes the rays' originator. The originator looks up, in the replicated owner directory
+// (owner_directory.h), the owners the ray can reach and where, and asks them one at a time,
+// nearest first: each RayQuery carries the closest hit so far as its tMax, and the ray is
+// resolved once no owner is left whose entry is no farther than that hit (its own pieces it
+// answers itself, without a message). Queries and HitReply answers travel in batches per
+// destination ("queries" and "hits" BatchedChannels). Replies are folded in the deterministic
+// order of Hit::closerThan, so the image does not depend on arrival order. A hit reply carries
+// the SurfaceInteraction the owner made from its own geometry; the originator shades with it
+// and originates the spawned rays. A shadow ray stops at the first owner with an occluder.
 #include "raytrace/partition/object_partition.h"
 
 #include <atomic>
 #include <memory>
 #include <vector>
 
-#include "common/parallel/channel.h"
+#include "common/parallel/batched_channel.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/owner_directory.h"
 #include "raytrace/partition/partition_margin.h"
 
 namespace pr::rt {
 namespace {
 
-// To an owner: the ray (not its path state, which stays with the originator) and where the
-// answer goes.
+// To an owner: the ray (not its path state, which stays with the originator; tMax is the
+// closest hit so far) and where the answer goes.
 struct RayQuery {
   Ray ray;
   uint32_t slot = 0;    // the originator's pending record
@@ -38,6 +42,8 @@ struct HitReply {
   SurfaceInteraction si;
 };
 constexpr size_t kReplyHeaderBytes = 8;
+using QueryBatch = std::vector<RayQuery>;
+using ReplyBatch = std::vector<HitReply>;
 
 class ObjectFrame {
  public:
@@ -45,6 +51,7 @@ class ObjectFrame {
       : job_(job),
         rt_(rt),
         assignment_(job.scene, {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position())}),
+        directory_(assignment_),
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
@@ -63,22 +70,30 @@ class ObjectFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};
-    par::Channel<RayQuery> queries(rt_, "queries", par::MessageKind::Rays, [this](par::Pe& pe, RayQuery&& q) { answerRemote(pe, q); });
-    par::Channel<HitReply> hits(rt_, "hits", par::MessageKind::Rays, [this](par::Pe& pe, HitReply&& r) {
-      merge(pe, r);
-      drain(pe);
+    const auto batch = size_t(job_.options.rayBatch);
+    par::BatchedChannel<RayQuery> queries(rt_, "queries", par::MessageKind::Rays, batch, [this](par::Pe& pe, QueryBatch&& b) {
+      for (const RayQuery& q : b) answerRemote(pe, q);
+      par::flushIfDry(pe, *queries_, *hits_);
+    });
+    par::BatchedChannel<HitReply> hits(rt_, "hits", par::MessageKind::Rays, batch, [this](par::Pe& pe, ReplyBatch&& b) {
+      for (const HitReply& r : b) {
+        fold(pe, r);
+        drain(pe);
+      }
+      par::flushIfDry(pe, *queries_, *hits_);
     });
     queries_ = &queries;
     hits_ = &hits;
-    // Materials, textures, lights and the directory of piece bounds and owners are replicated
-    // on every PE, and so are the emitters (area-light sampling); other geometry is not.
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), assignment_.directoryBytes());
+    // Materials, textures, lights and the owner directory are replicated on every PE, and so
+    // are the emitters (area-light sampling); other geometry is not.
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
     rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
       integrator_->cameraRays(tiles[size_t(id)], st.start);
       countStartRays(st.stats, std::span<const RayMessage>(st.start).subspan(before));
       drain(pe);
+      par::flushIfDry(pe, *queries_, *hits_);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
     });
@@ -117,22 +132,24 @@ class ObjectFrame {
  private:
   struct Pending {
     RayMessage message;
-    uint32_t remaining = 0;  // replies still to come
-    HitReply best;           // closest hit so far (found = false: none yet)
+    std::vector<OwnerEntry> owners;  // to ask, nearest first
+    uint32_t next = 0;               // owners[next] is the next to ask
+    bool waiting = false;            // a query is out
+    HitReply best;                   // closest hit so far (found = false: none yet)
   };
   // Padded to a cache line: each PE writes only its own.
   struct alignas(64) PeState {
     std::vector<RayMessage> start;  // rays this PE originates, not yet sent
-    std::vector<Pending> pending;
+    std::vector<Pending> pending;   // records are reused, keeping their owner lists' storage
     std::vector<uint32_t> freeSlots;
-    std::vector<int> owners;
     std::vector<RayMessage> spawned;
+    std::vector<OwnerDirectory::NodeEntry> heap;  // the owner directory's walk
     TraceStats stats;
     uint64_t queriesSent = 0, repliesSent = 0;
     size_t live = 0;  // pending records in use
   };
 
-  // On the originator: sends every ray waiting in its start list to the owners it can reach.
+  // On the originator: starts every ray waiting in its start list.
   void drain(par::Pe& pe) {
     PeState& st = state_[pe.id()];
     while (!st.start.empty()) {
@@ -143,12 +160,6 @@ class ObjectFrame {
   }
 
   void launch(par::Pe& pe, PeState& st, const RayMessage& m) {
-    assignment_.ownersAlong(m.ray, st.owners);
-    if (st.owners.empty()) {
-      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
-      integrator_->miss(m, emit);  // reaches no object: nothing to ask
-      return;
-    }
     uint32_t slot;
     if (!st.freeSlots.empty()) {
       slot = st.freeSlots.back();
@@ -158,20 +169,38 @@ class ObjectFrame {
       st.pending.emplace_back();
     }
     ++st.live;
-    st.pending[slot] = Pending{m, uint32_t(st.owners.size()), HitReply{}};
-    const bool shadow = m.kind == RayKind::Shadow;
-    bool local = false;
-    for (int owner : st.owners) {
-      if (owner == pe.id()) {
-        local = true;
+    Pending& p = st.pending[slot];
+    p.message = m;
+    p.waiting = false;
+    p.best = HitReply{};
+    p.best.slot = slot;
+    directory_.ownersNearestFirst(m.ray, -1, p.owners, st.heap);
+    p.next = 0;
+    ask(pe, st, slot);
+  }
+
+  // On the originator: asks the owners the ray reaches nearest first, its own pieces at once
+  // and another owner by a query, each bounded by the closest hit so far, until one is found
+  // nearer than the next owner's entry (or an occluder); then resolves the ray.
+  void ask(par::Pe& pe, PeState& st, uint32_t slot) {
+    Pending& p = st.pending[slot];
+    const bool shadow = p.message.kind == RayKind::Shadow;
+    while (p.next < p.owners.size() && !(shadow && p.best.found)) {
+      const OwnerEntry e = p.owners[p.next];
+      if (p.best.found && e.t > p.best.hit.t) break;  // every owner left starts farther
+      ++p.next;
+      Ray ray = p.message.ray;
+      if (p.best.found) ray.tMax = p.best.hit.t;  // inclusive: an equal t with a lower triangle still wins
+      if (e.owner == pe.id()) {
+        merge(p, answer(pe.id(), ray, slot, shadow));
         continue;
       }
-      queries_->send(pe, owner, RayQuery{m.ray, slot, uint16_t(pe.id()), shadow});
+      queries_->send(pe, e.owner, RayQuery{ray, slot, uint16_t(pe.id()), shadow});
       ++st.queriesSent;
+      p.waiting = true;
+      return;
     }
-    // The own pieces last: their answer may complete the record, which must not be reused
-    // while queries naming it are still being sent.
-    if (local) merge(pe, answer(pe.id(), m.ray, slot, shadow));
+    resolve(pe, st, slot);
   }
 
   // On an owner: the nearest hit among its own triangles (or whether any occludes).
@@ -196,43 +225,48 @@ class ObjectFrame {
     ++st.repliesSent;
   }
 
-  // On the originator: folds one reply into the pending record; the last one resolves it.
-  void merge(par::Pe& pe, const HitReply& r) {
+  static void merge(Pending& p, const HitReply& r) {
+    if (r.found && (!p.best.found || r.hit.closerThan(p.best.hit))) p.best = r;
+  }
+
+  // On the originator: folds a reply into its record and asks on.
+  void fold(par::Pe& pe, const HitReply& r) {
     PeState& st = state_[pe.id()];
     Pending& p = st.pending[r.slot];
-    PR_CHECK(p.remaining > 0, "object partitioning: reply for a ray that expects none");
-    if (r.found && (!p.best.found || r.hit.closerThan(p.best.hit))) p.best = r;
-    if (--p.remaining > 0) return;
-    const Pending done = p;
-    st.freeSlots.push_back(r.slot);
-    --st.live;
+    PR_CHECK(p.waiting, "object partitioning: reply for a ray that expects none");
+    p.waiting = false;
+    merge(p, r);
+    ask(pe, st, r.slot);
+  }
+
+  // On the originator: shades the ray's closest hit (or its miss) and frees its record.
+  void resolve(par::Pe& pe, PeState& st, uint32_t slot) {
+    const Pending& p = st.pending[slot];
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
-    if (done.message.kind == RayKind::Shadow) {
-      if (!done.best.found) integrator_->miss(done.message, emit);
-      return;
-    }
-    if (!done.best.found) {
-      integrator_->miss(done.message, emit);
-      return;
-    }
-    integrator_->shade(done.best.si, done.message, emit);
+    if (!p.best.found)
+      integrator_->miss(p.message, emit);  // unoccluded, or reaches no triangle
+    else if (p.message.kind != RayKind::Shadow)
+      integrator_->shade(p.best.si, p.message, emit);
     for (const RayMessage& s : st.spawned) {
       ++(s.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
       st.start.push_back(s);
     }
     st.spawned.clear();
+    st.freeSlots.push_back(slot);
+    --st.live;
   }
 
   const TraceJob& job_;
   par::Runtime& rt_;
   ObjectAssignment assignment_;
+  OwnerDirectory directory_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
   SceneViews views_;
   std::vector<PeState> state_;
-  par::Channel<RayQuery>* queries_ = nullptr;
-  par::Channel<HitReply>* hits_ = nullptr;
+  par::BatchedChannel<RayQuery>* queries_ = nullptr;
+  par::BatchedChannel<HitReply>* hits_ = nullptr;
 };
 
 }  // namespace

@@ -1,7 +1,8 @@
 // The object-space tracer. Stage "build": each owner's voxels get a BVH over the triangles
 // they hold. Stage "trace": image tiles are tasks that make camera rays; a ray is traced on
-// the PE owning the voxel it is in, and sent (a TravellingRay message on the "rays" Channel)
-// to the owner of the next voxel along it when it leaves without a hit. A voxel accepts only a
+// the PE owning the voxel it is in, and sent (a TravellingRay in a batch on the "rays"
+// BatchedChannel) to the owner of the next voxel along it when it leaves without a hit; the
+// owner resumes the walk at that voxel. A voxel accepts only a
 // hit up to the end of the ray's span in it, so the first voxel that reports a hit reports the
 // ray's closest hit, the same one (bit for bit) as the BVH over the whole scene. Shadow rays
 // stop at the first voxel that reports any occluder. Shading and spawning happen on the PE
@@ -15,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "common/parallel/channel.h"
+#include "common/parallel/batched_channel.h"
 #include "raytrace/partition/film_assembly.h"
 #include "common/util/error.h"
 #include "raytrace/partition/partition_margin.h"
@@ -26,12 +27,16 @@ namespace {
 
 constexpr int kMaxVoxelsPerPe = 64;
 
-// A ray on its way: the message with its path state, and the index (in the ray's walk
-// through the voxels, which every PE recomputes identically) of the voxel to trace next.
+// A ray on its way to the owner of the next voxel along it: the message with its path state,
+// and where the walk through the voxels resumes (the voxel and the ray parameter at which the
+// ray enters it), so the owner continues the walk instead of restarting it from the origin.
 struct TravellingRay {
   RayMessage message;
-  uint32_t span = 0;
+  float tEnter = 0.0f;
+  uint32_t voxel = kStartVoxel;  // kStartVoxel: a new ray, traced from its first voxel
+  static constexpr uint32_t kStartVoxel = ~0u;
 };
+using RayBatch = std::vector<TravellingRay>;
 
 // One frame of the object-space tracer: the voxel split, the owners' BVHs and the PEs' local
 // work lists. Each PE touches only its own PeState and its own voxels' BVHs.
@@ -64,7 +69,11 @@ class ObjectSpaceFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};
-    par::Channel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, [this](par::Pe& pe, TravellingRay&& r) { trace(pe, r); });
+    par::BatchedChannel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, size_t(job_.options.rayBatch),
+                                            [this](par::Pe& pe, RayBatch&& batch) {
+                                              for (const TravellingRay& r : batch) trace(pe, r);
+                                              par::flushIfDry(pe, *rays_);
+                                            });
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
@@ -74,7 +83,8 @@ class ObjectSpaceFrame {
       std::vector<RayMessage> camera;
       integrator_->cameraRays(tiles[size_t(id)], camera);
       countStartRays(st.stats, camera);
-      for (const RayMessage& m : camera) trace(pe, TravellingRay{m, 0});
+      for (const RayMessage& m : camera) trace(pe, TravellingRay{m, m.ray.tMin});
+      par::flushIfDry(pe, *rays_);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
     });
@@ -100,7 +110,7 @@ class ObjectSpaceFrame {
     for (int p = 0; p < pes; ++p) {
       const PeState& st = state_[size_t(p)];
       raysTraced.push_back(st.stats);
-      rt_.addCounter("Partition/ray_messages_sent", p, double(st.raysSent));
+      rt_.addCounter("Partition/rays_sent", p, double(st.raysSent));
     }
     result.rays = recordRayCounters(rt_, raysTraced);
     recordPartitionHoldings(held, rt_);
@@ -111,7 +121,6 @@ class ObjectSpaceFrame {
   // Padded to a cache line: each PE writes only its own.
   struct alignas(64) PeState {
     std::vector<TravellingRay> work;  // rays to trace here, depth first
-    std::vector<VoxelSpan> spans;
     std::vector<RayMessage> spawned;
     TraceStats stats;
     uint64_t raysSent = 0;
@@ -129,43 +138,58 @@ class ObjectSpaceFrame {
     }
   }
 
+  // Walks the ray from where it entered this PE's voxel: traces it in each voxel this PE owns,
+  // in order along the ray, until it hits, is blocked, or reaches another owner's voxel.
   void advance(par::Pe& pe, PeState& st, const TravellingRay& item) {
     const RayMessage& m = item.message;
-    st.spans.clear();
-    split_.walk(m.ray, [&](const VoxelSpan& s) {
-      st.spans.push_back(s);
-      return true;
-    });
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
-    for (size_t k = item.span; k < st.spans.size(); ++k) {
-      const uint32_t v = st.spans[k].voxel;
-      if (split_.triangles(v).empty()) continue;  // nothing to hit: no owner needs the ray
-      if (owners_[v] != pe.id()) {
-        rays_->send(pe, owners_[v], TravellingRay{m, uint32_t(k)});
-        ++st.raysSent;
-        return;
+    bool reached = item.voxel == TravellingRay::kStartVoxel;  // at the voxel the walk resumes in
+    bool finished = false;  // hit, blocked or sent on
+    auto visit = [&](const VoxelSpan& s) {
+      if (!reached) {
+        if (s.voxel != item.voxel) return true;
+        reached = true;
       }
-      const Bvh& bvh = bvhs_[v];
-      if (m.kind == RayKind::Shadow) {
-        // Any occluder anywhere on the segment blocks it, wherever it lies along the ray.
-        if (bvh.occluded(m.ray)) return;
-        continue;
-      }
-      // Only hits up to the end of the span: a farther one may be behind a nearer triangle
-      // held by a later voxel.
-      Ray clipped = m.ray;
-      clipped.tMax = std::min(m.ray.tMax, st.spans[k].tExit);
-      Hit hit;
-      if (!bvh.intersect(clipped, hit)) continue;
-      integrator_->shade(makeInteraction(views_.of(pe.id()), m.ray, hit), m, emit);
-      for (const RayMessage& r : st.spawned) {
-        ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
-        st.work.push_back(TravellingRay{r, 0});
-      }
-      st.spawned.clear();
-      return;
+      finished = traceInVoxel(pe, st, m, s, emit);
+      return !finished;
+    };
+    // The walk from tEnter gives the same spans from the voxel on as the walk from the origin,
+    // unless the voxel's span has zero length at a corner the shorter walk steps past: then
+    // the whole walk finds it.
+    Ray resume = m.ray;
+    resume.tMin = item.tEnter;
+    split_.walk(resume, visit);
+    if (!reached) split_.walk(m.ray, visit);
+    PR_CHECK(reached, "object-space: a ray sent to a voxel its walk does not pass");
+    if (!finished) integrator_->miss(m, emit);  // left the scene (a shadow ray: unoccluded)
+  }
+
+  // The ray in one voxel of its walk; true when the ray is done here (hit, blocked, or sent to
+  // the voxel's owner).
+  bool traceInVoxel(par::Pe& pe, PeState& st, const RayMessage& m, const VoxelSpan& s, Emit& emit) {
+    const uint32_t v = s.voxel;
+    if (split_.triangles(v).empty()) return false;  // nothing to hit: no owner needs the ray
+    if (owners_[v] != pe.id()) {
+      rays_->send(pe, owners_[v], TravellingRay{m, s.tEnter, v});
+      ++st.raysSent;
+      return true;
     }
-    integrator_->miss(m, emit);  // left the scene (a shadow ray: unoccluded)
+    const Bvh& bvh = bvhs_[v];
+    // Any occluder anywhere on the segment blocks a shadow ray, wherever it lies along the ray.
+    if (m.kind == RayKind::Shadow) return bvh.occluded(m.ray);
+    // Only hits up to the end of the span: a farther one may be behind a nearer triangle held
+    // by a later voxel.
+    Ray clipped = m.ray;
+    clipped.tMax = std::min(m.ray.tMax, s.tExit);
+    Hit hit;
+    if (!bvh.intersect(clipped, hit)) return false;
+    integrator_->shade(makeInteraction(views_.of(pe.id()), m.ray, hit), m, emit);
+    for (const RayMessage& r : st.spawned) {
+      ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
+      st.work.push_back(TravellingRay{r, r.ray.tMin});
+    }
+    st.spawned.clear();
+    return true;
   }
 
   const TraceJob& job_;
@@ -177,7 +201,7 @@ class ObjectSpaceFrame {
   std::vector<Bvh> bvhs_;
   SceneViews views_;
   std::vector<PeState> state_;
-  par::Channel<TravellingRay>* rays_ = nullptr;
+  par::BatchedChannel<TravellingRay>* rays_ = nullptr;
 };
 
 }  // namespace

@@ -26,10 +26,16 @@
 
 namespace pr::rt {
 
+inline constexpr int kDefaultRayBatch = 64;
+inline constexpr int kMaxRayBatch = 65536;
+
 struct TraceOptions {
   IntegratorOptions integrator;
   int tileSizePx = 16;    // image-space: tile edge in pixels (the task granularity)
   bool adaptive = false;  // image-space: split tiles whose estimated cost is far above the mean
+  // object-space and object partitioning: rays (queries, replies) per message to one PE; a
+  // partial batch is sent when its PE runs dry (common/parallel/batched_channel.h).
+  int rayBatch = kDefaultRayBatch;
   BvhBuildOptions bvh;
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.

@@ -1,6 +1,7 @@
 // Tests of object partitioning's data split (raytrace/partition/object_assignment.cpp): every
 // triangle has exactly one owner, large objects are split, PEs are balanced by triangle
-// count, and a ray is sent to every owner holding a triangle it hits (never skipped).
+// count in compact regions, and the owner directory lists every owner holding a triangle a ray
+// hits (never skipped), no later than the hit.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/owner_directory.h"
 #include "raytrace/partition/partition_margin.h"
 
 using pr::rt::ObjectAssignment;
@@ -102,15 +104,18 @@ TEST_CASE("ObjectAssignment: triangles outside every object form one more object
   for (const auto& piece : a.pieces()) CHECK(piece.object == 0);
 }
 
-TEST_CASE("ObjectAssignment: a ray reaches every owner of a triangle it hits") {
+TEST_CASE("OwnerDirectory: a ray lists every owner of a triangle it hits, nearest first, no later than the hit") {
   const pr::scene::Scene s = objectsScene({200, 150, 120, 90, 60, 30});
   const glm::vec3 eye(7.0f, 0.5f, 6.0f);
   const ObjectAssignment a(s, {4, 50, pr::rt::partitionMargin(s, eye)});
+  const pr::rt::OwnerDirectory directory(a);
+  CHECK(directory.bytes() > 0u);
   std::vector<pr::rt::Bvh> bvhs;
   for (int pe = 0; pe < 4; ++pe) bvhs.emplace_back(s.positions, s.triangles, a.triangles(pe));
   std::mt19937 rng(13);
   std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<int> owners;
+  std::vector<pr::rt::OwnerEntry> owners, others;
+  std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
   size_t asked = 0, hits = 0;
   for (int i = 0; i < 400; ++i) {
     Ray ray;
@@ -121,39 +126,67 @@ TEST_CASE("ObjectAssignment: a ray reaches every owner of a triangle it hits") {
                                         : (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) / 3.0f;
     ray.direction = glm::normalize(target - eye);
     if (i % 4 == 0) ray.tMax = 3.0f;  // short segments skip far owners
-    a.ownersAlong(ray, owners);
-    CHECK(std::is_sorted(owners.begin(), owners.end()));
-    CHECK(std::set<int>(owners.begin(), owners.end()).size() == owners.size());
+    directory.ownersNearestFirst(ray, -1, owners, heap);
+    CHECK(std::is_sorted(owners.begin(), owners.end(), [](const auto& x, const auto& y) { return x.t < y.t; }));
+    std::set<int> distinct;
+    for (const auto& e : owners) distinct.insert(e.owner);
+    CHECK(distinct.size() == owners.size());
     asked += owners.size();
     for (int pe = 0; pe < 4; ++pe) {
       pr::rt::Hit h;
       if (!bvhs[pe].intersect(ray, h)) continue;
       ++hits;
-      CHECK(std::find(owners.begin(), owners.end(), pe) != owners.end());
+      auto it = std::find_if(owners.begin(), owners.end(), [&](const auto& e) { return e.owner == pe; });
+      REQUIRE(it != owners.end());
+      CHECK(it->t <= h.t);
     }
+    // Leaving one owner out lists the others in the same order.
+    const int except = i % 4;
+    directory.ownersNearestFirst(ray, except, others, heap);
+    std::vector<int> expected, got;
+    for (const auto& e : owners)
+      if (e.owner != except) expected.push_back(e.owner);
+    for (const auto& e : others) got.push_back(e.owner);
+    CHECK(got == expected);
   }
   CHECK(hits > 100);
-  CHECK(asked < 4 * 400);  // bounds culling sends fewer queries than a broadcast would
+  CHECK(asked < 4 * 400);  // bounds culling asks fewer owners than a broadcast would
 }
 
-TEST_CASE("ObjectAssignment: the box test is conservative for axis-parallel and boundary rays") {
-  const pr::scene::Bounds box{glm::vec3(0.0f), glm::vec3(1.0f)};
+TEST_CASE("ObjectAssignment: owners get compact regions along the Morton curve") {
+  // Six objects in a row along x: two PEs get the three left and the three right ones.
+  const pr::scene::Scene s = objectsScene({100, 100, 100, 100, 100, 100});
+  const ObjectAssignment a(s, {2, 100, 0.0f});
+  for (const auto& piece : a.pieces()) CHECK(piece.owner == (piece.object < 3 ? 0 : 1));
+}
+
+TEST_CASE("OwnerDirectory: the box test is conservative for axis-parallel and boundary rays") {
+  // One object whose bounds are the unit box (a triangle along its diagonal), one owner.
+  pr::scene::Scene s = pr::test::emptyScene();
+  pr::test::addTriangle(s, {0, 0, 0}, {1, 1, 0}, {1, 1, 1});
+  auto reaches = [&](const Ray& ray, float margin) {
+    const ObjectAssignment a(s, {1, 0, margin});
+    std::vector<pr::rt::OwnerEntry> owners;
+    std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
+    pr::rt::OwnerDirectory(a).ownersNearestFirst(ray, -1, owners, heap);
+    return !owners.empty();
+  };
   Ray along;  // in the face plane x = 0, parallel to it
   along.origin = glm::vec3(0.0f, 0.5f, -1.0f);
   along.direction = glm::vec3(0.0f, 0.0f, 1.0f);
-  CHECK(pr::rt::rayReachesBox(along, box, 0.0f));
+  CHECK(reaches(along, 0.0f));
   along.origin.x = -1e-3f;
-  CHECK(!pr::rt::rayReachesBox(along, box, 0.0f));
-  CHECK(pr::rt::rayReachesBox(along, box, 2e-3f));  // the margin grows the box
+  CHECK(!reaches(along, 0.0f));
+  CHECK(reaches(along, 2e-3f));  // the margin grows the box
   Ray touching;  // ends exactly on the face
   touching.origin = glm::vec3(0.5f, 0.5f, -1.0f);
   touching.direction = glm::vec3(0.0f, 0.0f, 1.0f);
   touching.tMax = 1.0f;
-  CHECK(pr::rt::rayReachesBox(touching, box, 0.0f));
+  CHECK(reaches(touching, 0.0f));
   touching.tMax = 0.5f;
-  CHECK(!pr::rt::rayReachesBox(touching, box, 0.0f));
+  CHECK(!reaches(touching, 0.0f));
   Ray away = touching;  // pointing away
   away.tMax = pr::rt::kInfinity;
   away.direction = -away.direction;
-  CHECK(!pr::rt::rayReachesBox(away, box, 0.0f));
+  CHECK(!reaches(away, 0.0f));
 }

@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <future>
 
+#include "common/parallel/batched_channel.h"
 #include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/integrators/integrator_scenes.h"
@@ -133,22 +134,22 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
     test::checkTraffic(run, p);
     CHECK(run.image.pixels == reference.pixels);
     CHECK(run.result.rays.total() == 2);
-    CHECK(run.figures.rayMessages == (p == 1 ? 0u : 1u));
-    CHECK(run.figures.hitMessages == (p == 1 ? 0u : 1u));
+    CHECK(run.figures.raysSent == (p == 1 ? 0u : 1u));
+    CHECK(run.figures.hitsSent == (p == 1 ? 0u : 1u));
     if (p == 2) {
       const par::StageRecord& st = test::traceStage(run.record);
       REQUIRE(st.traffic.size() == 2);  // the query one way, the hit the other
       CHECK(st.traffic[0].messages == 1);
       CHECK(st.traffic[1].messages == 1);
-      // The query carries a ray (32 bytes) and its return address; the hit reply also the
-      // hit record and the surface interaction, so it is the larger of the two.
+      // The query carries a ray (32 bytes) and its return address in a batch (8-byte header);
+      // the hit reply also the hit record and the surface interaction, so it is the larger.
       // Which PE originates depends on which PE took the tile, so tell them apart by size.
       CHECK(st.traffic[0].from == st.traffic[1].to);
       const bool firstIsQuery = st.traffic[0].bytes < st.traffic[1].bytes;
       const auto& query = firstIsQuery ? st.traffic[0] : st.traffic[1];
       const auto& hit = firstIsQuery ? st.traffic[1] : st.traffic[0];
-      CHECK(query.bytes >= sizeof(rt::Ray));
-      CHECK(query.bytes <= sizeof(rt::Ray) + 8);
+      CHECK(query.bytes >= sizeof(rt::Ray) + par::kBatchHeaderBytes);
+      CHECK(query.bytes <= sizeof(rt::Ray) + 8 + par::kBatchHeaderBytes);
       CHECK(hit.bytes > sizeof(rt::Hit));
     }
   }
@@ -170,8 +171,8 @@ TEST_CASE("ObjectPartition: PEs hold balanced, disjoint geometry") {
   CHECK(triangles == s.triangles.size());
   CHECK(double(hi) <= 1.1 * double(lo));  // LPT over pieces of at most 1/16 of the scene
   test::checkTraffic(run, 4);
-  CHECK(run.figures.rayMessages > 0);
-  CHECK(run.figures.hitMessages == run.figures.rayMessages);  // every remote query is answered
+  CHECK(run.figures.raysSent > 0);
+  CHECK(run.figures.hitsSent == run.figures.raysSent);  // every remote query is answered
 }
 
 TEST_CASE("ObjectPartition: renders terminate (timeout guard)") {

@@ -153,8 +153,9 @@ TEST_CASE("ObjectSpace: axis-aligned city, rays parallel to the split planes, = 
 TEST_CASE("ObjectSpace: two walls, one tile: exactly one ray message") {
   // Walls x = -3 and x = +3; the eye at the origin lies on the split plane x = 0 between
   // them. Pixel 0's ray goes left and stays in voxel 0, pixel 1's goes right and stays in
-  // voxel 1. One tile makes both rays on one PE: the ray of the other PE's voxel is sent
-  // once, traced there, and (diffuse, no lights, Whitted) spawns nothing. P = 1: no message.
+  // voxel 1 (one voxel per PE: voxel i is PE i's). One tile makes both rays on one PE: the ray
+  // of the other PE's voxel is sent once, traced there, and (diffuse, no lights, Whitted)
+  // spawns nothing. P = 1: no message.
   scene::Scene s = test::emptyScene();
   for (float x : {-3.0f, 3.0f}) {
     test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
@@ -164,14 +165,16 @@ TEST_CASE("ObjectSpace: two walls, one tile: exactly one ray message") {
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   for (int p : {1, 2}) {
     CAPTURE(p);
-    rt::ObjectSpacePartition partition;
+    rt::ObjectSpacePartition partition(1);
     const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 2, 1, opt, p);
     test::checkTraffic(run, p);
     CHECK(run.result.rays.total() == 2);
-    CHECK(run.figures.rayMessages == (p == 1 ? 0u : 1u));
+    CHECK(run.figures.raysSent == (p == 1 ? 0u : 1u));
     uint64_t bytes = 0;
     for (const par::PeStageRecord& pe : test::traceStage(run.record).pes) bytes += pe.bytesSent;
-    CHECK(bytes == (p == 1 ? 0u : 60u));  // one TravellingRay: RayMessage (56) + span index (4)
+    // One batch of one TravellingRay: RayMessage (56), where the walk resumes (t and voxel, 8)
+    // and the batch header (8).
+    CHECK(bytes == (p == 1 ? 0u : 72u));
     CHECK(run.figures.triangles == std::vector<uint64_t>(p == 1 ? std::vector<uint64_t>{4} : std::vector<uint64_t>{2, 2}));
   }
 }
@@ -192,7 +195,7 @@ TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   CHECK(triangles >= s.triangles.size());
   CHECK(triangles < s.triangles.size() * 11 / 10);  // few straddlers
   test::checkTraffic(run, 4);
-  CHECK(run.figures.rayMessages > 0);
+  CHECK(run.figures.raysSent > 0);
 }
 
 TEST_CASE("ObjectSpace: renders terminate (timeout guard)") {

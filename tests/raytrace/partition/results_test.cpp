@@ -69,7 +69,9 @@ void checkAssembly(P& partition, int pes) {
 TEST_CASE("Results: object-space sends each PE's film to the assembler as counted blocks, P = 2 and 3") {
   for (int pes : {2, 3}) {
     CAPTURE(pes);
-    rt::ObjectSpacePartition partition;
+    // One voxel per PE: each PE's region of the box holds visible, lit surfaces (with 4 per
+    // PE, one PE may own only voxels whose hits add nothing to the film at this size).
+    rt::ObjectSpacePartition partition(1);
     checkAssembly(partition, pes);
   }
 }

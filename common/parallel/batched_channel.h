@@ -1,0 +1,89 @@
+// BatchedChannel<T>: a Channel whose messages are batches of items per destination (the seed's
+// packets of rays): a PE appends items to one outbox per destination, an outbox is sent as one
+// message when it holds `batchSize` items, and every partial outbox is sent when the PE runs
+// dry (flushIfDry). One message per batch instead of per item is what makes the partitioned
+// tracers pay off: the lock, the doorbell and the handler's fixed cost are paid once per batch.
+// Counting is the Channel's: one message per batch, its bytes the sum of its items' bytes plus
+// a small header, as a distributed implementation would send it.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/parallel/channel.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+
+// Bytes of a batch's header on a wire: item count and sender.
+inline constexpr std::size_t kBatchHeaderBytes = 8;
+
+template <class T>
+class BatchedChannel {
+ public:
+  using Batch = std::vector<T>;
+  using Handler = std::function<void(Pe&, Batch&&)>;
+
+  // batchSize >= 1 items per message. The handler runs on the receiving PE, once per batch.
+  BatchedChannel(Runtime& runtime, std::string name, MessageKind kind, std::size_t batchSize, Handler handler)
+      : batchSize_(batchSize), channel_(runtime, std::move(name), kind, std::move(handler)), out_(size_t(runtime.pes())) {
+    PR_CHECK(batchSize >= 1, "BatchedChannel: a batch holds at least one item");
+    for (PeOutboxes& o : out_) o.boxes.resize(size_t(runtime.pes()));
+  }
+
+  // On PE `from`: queues the item for `to` (bytes: its size on a wire) and sends the batch
+  // when it is full.
+  void send(Pe& from, int to, T item, std::size_t bytes = sizeof(T)) {
+    Outbox& box = out_[size_t(from.id())].boxes[size_t(to)];
+    if (box.items.empty()) box.items.reserve(batchSize_);
+    box.items.push_back(std::move(item));
+    box.bytes += bytes;
+    if (box.items.size() >= batchSize_) sendBox(from, to, box);
+  }
+
+  // Whether a batch waits for pe (it will be handled before pe goes idle).
+  bool pending(int pe) const { return channel_.pending(pe); }
+
+  // On PE `from`: sends every partial batch. Call before the PE can go idle: an item left in
+  // an outbox is not yet a message, so the stage could end without it.
+  void flush(Pe& from) {
+    std::vector<Outbox>& boxes = out_[size_t(from.id())].boxes;
+    for (size_t to = 0; to < boxes.size(); ++to)
+      if (!boxes[to].items.empty()) sendBox(from, int(to), boxes[to]);
+  }
+
+ private:
+  struct Outbox {
+    Batch items;
+    std::size_t bytes = 0;
+  };
+  // Padded to a cache line: each PE writes only its own outboxes.
+  struct alignas(64) PeOutboxes {
+    std::vector<Outbox> boxes;  // per destination
+  };
+
+  void sendBox(Pe& from, int to, Outbox& box) {
+    const std::size_t bytes = box.bytes + kBatchHeaderBytes;
+    channel_.send(from, to, std::move(box.items), bytes);
+    box.items = Batch();
+    box.bytes = 0;
+  }
+
+  std::size_t batchSize_;
+  Channel<Batch> channel_;
+  std::vector<PeOutboxes> out_;
+};
+
+// Flushes every channel's partial batches of PE pe when none of them has a batch waiting for
+// pe: a PE runs dry only when nothing more will be handled on it, and flushing earlier would
+// send small batches. Call at the end of every task and handler of a batched stage.
+template <class... Channels>
+void flushIfDry(Pe& pe, Channels&... channels) {
+  if ((channels.pending(pe.id()) || ...)) return;
+  (channels.flush(pe), ...);
+}
+
+}  // namespace pr::par

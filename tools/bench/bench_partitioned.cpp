@@ -1,0 +1,119 @@
+// bench_partitioned: the data-partitioned ray tracers (object-space, object partitioning) at
+// P = 1 and P = 2 on the hot-spot scene and, when given, the 1M-triangle landscape: wall time
+// of the whole render (best of N), each method's speed-up over its own P = 1 (target >= 1.6),
+// ray messages per ray traced with the default batch against one ray per message (the
+// unbatched tracers; target: at least 10x fewer), the effect of the batch size at P = 2, and
+// a check that every image equals the sequential tracer's bit for bit. Figures come from the
+// runtime's run record; ratios are measured in the same run.
+#include <algorithm>
+#include <cstdio>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "common/scene/camera_select.h"
+#include "common/scene/gltf_loader.h"
+#include "raytrace/partition/partition.h"
+
+namespace {
+
+using namespace pr;
+
+struct Run {
+  double seconds = 1e30;  // best wall time of the whole render (every stage)
+  double messagesPerRay = 0.0;  // ray messages (rays, queries, replies) per ray traced
+  double imbalance = 0.0;
+  bool sameImage = true;
+};
+
+Run measure(const scene::Scene& s, const scene::Camera& cam, int w, int h, rt::TraceOptions opt, const std::string& method,
+            int pes, int batch, int repeats, const image::Image& reference) {
+  Run out;
+  opt.rayBatch = batch;
+  for (int r = 0; r < repeats; ++r) {
+    par::Runtime runtime(pes, "demand");
+    const rt::TraceResult result = rt::renderRays(s, cam, w, h, opt, method, runtime);
+    const par::RunRecord& record = runtime.record();
+    out.sameImage = out.sameImage && result.image.pixels == reference.pixels;
+    if (record.wallSeconds >= out.seconds) continue;
+    out.seconds = record.wallSeconds;
+    uint64_t messages = 0;
+    for (const par::StageRecord& st : record.stages)
+      for (const par::ChannelTraffic& c : st.channels)
+        if (c.kind == "rays") messages += c.messages;
+    out.messagesPerRay = double(messages) / double(std::max<uint64_t>(1, result.rays.total()));
+    for (const par::StageRecord& st : record.stages)
+      if (st.name == "trace") {
+        double busiest = 0.0, mean = 0.0;
+        for (const par::PeStageRecord& pe : st.pes) {
+          busiest = std::max(busiest, pe.busySeconds);
+          mean += pe.busySeconds / double(st.pes.size());
+        }
+        out.imbalance = mean > 0.0 ? busiest / mean - 1.0 : 0.0;
+      }
+  }
+  return out;
+}
+
+int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& opt, int repeats, const std::vector<int>& batches) {
+  const scene::Scene s = scene::loadGltf(file);
+  const scene::Camera cam = scene::selectCamera(s, "", float(w) / float(h));
+  par::Runtime sequential(1, "demand");
+  const image::Image reference = rt::renderRays(s, cam, w, h, opt, "sequential", sequential).image;
+  std::printf("\n%s: %zu triangles, %dx%d, %s spp %d, best of %d\n", file.c_str(), s.triangles.size(), w, h,
+              opt.integrator.kind == rt::IntegratorKind::Whitted ? "whitted" : "path", opt.integrator.spp, repeats);
+  int failures = 0;
+  for (const std::string method : {"object-space", "object"}) {
+    const Run p1 = measure(s, cam, w, h, opt, method, 1, rt::kDefaultRayBatch, repeats, reference);
+    const Run p2 = measure(s, cam, w, h, opt, method, 2, rt::kDefaultRayBatch, repeats, reference);
+    const Run unbatched = measure(s, cam, w, h, opt, method, 2, 1, 1, reference);
+    const double speedup = p1.seconds / p2.seconds;
+    const double fewer = unbatched.messagesPerRay / std::max(1e-12, p2.messagesPerRay);
+    std::printf("  %-12s P=1 %.3f s, P=2 %.3f s: speed-up over its own P=1 %.2f (target >= 1.6), load imbalance %.3f\n",
+                method.c_str(), p1.seconds, p2.seconds, speedup, p2.imbalance);
+    std::printf("  %-12s ray messages per ray at P=2: %.4f with batch %d, %.4f one ray per message: %.1fx fewer (target >= 10)\n",
+                method.c_str(), p2.messagesPerRay, rt::kDefaultRayBatch, unbatched.messagesPerRay, fewer);
+    std::printf("  %-12s batch size at P=2:", method.c_str());
+    bool same = p1.sameImage && p2.sameImage && unbatched.sameImage;
+    for (int batch : batches) {
+      const Run b = measure(s, cam, w, h, opt, method, 2, batch, 1, reference);
+      same = same && b.sameImage;
+      std::printf("  %d: %.3f s %.4f msg/ray", batch, b.seconds, b.messagesPerRay);
+    }
+    std::printf("\n  %-12s images %s the sequential tracer's\n", method.c_str(), same ? "bit-identical to" : "DIFFER from");
+    failures += same ? 0 : 1;
+  }
+  return failures;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"bench_partitioned: object-space and object partitioning at P = 1 and 2, ray batches and messages per ray"};
+  std::vector<std::string> scenes = {std::string(PARRENDER_SOURCE_DIR) + "/scenes/hotspot.gltf"};
+  int width = 384, height = 384, spp = 2, repeats = 3;
+  std::string integrator = "path";
+  std::vector<int> batches = {1, 4, 16, 64, 256, 1024};
+  app.add_option("--scenes", scenes, "scenes (e.g. scenes/hotspot.gltf build/scenes/landscape.glb)")->capture_default_str();
+  app.add_option("--width", width)->check(CLI::Range(8, 8192))->capture_default_str();
+  app.add_option("--height", height)->check(CLI::Range(8, 8192))->capture_default_str();
+  app.add_option("--spp", spp)->check(CLI::Range(1, 1024))->capture_default_str();
+  app.add_option("--repeats", repeats, "best of N runs")->check(CLI::Range(1, 100))->capture_default_str();
+  app.add_option("--integrator", integrator)->check(CLI::IsMember({"whitted", "path"}))->capture_default_str();
+  app.add_option("--batches", batches, "batch sizes of the sweep at P = 2")->check(CLI::Range(1, rt::kMaxRayBatch));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    rt::TraceOptions opt;
+    opt.integrator.kind = integrator == "whitted" ? rt::IntegratorKind::Whitted : rt::IntegratorKind::Path;
+    opt.integrator.spp = spp;
+    std::printf("bench_partitioned on %u hardware threads\n", std::thread::hardware_concurrency());
+    int failures = 0;
+    for (const std::string& f : scenes) failures += benchScene(f, width, height, opt, repeats, batches);
+    return failures == 0 ? 0 : 1;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "bench_partitioned: %s\n", e.what());
+    return 1;
+  }
+}
