@@ -272,6 +272,7 @@ class ObjectFrame {
 }  // namespace
 
 TraceResult ObjectPartition::render(const TraceJob& job, par::Runtime& rt) {
+  checkRayBatch(job.options, "object partitioning");
   ObjectFrame frame(job, rt, maxPieceTriangles_);
   return frame.run();
 }

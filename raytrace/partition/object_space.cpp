@@ -26,6 +26,10 @@ namespace pr::rt {
 namespace {
 
 constexpr int kMaxVoxelsPerPe = 64;
+constexpr int kMaxVoxels = 4096;  // VoxelSplit's limit
+
+// k·P voxels, k lowered where k·P would pass the split's limit (P up to 4096 PEs).
+int voxelCount(int voxelsPerPe, int pes) { return pes * std::max(1, std::min(voxelsPerPe, kMaxVoxels / pes)); }
 
 // A ray on its way to the owner of the next voxel along it: the message with its path state,
 // and where the walk through the voxels resumes (the voxel and the ray parameter at which the
@@ -45,7 +49,7 @@ class ObjectSpaceFrame {
   ObjectSpaceFrame(const TraceJob& job, par::Runtime& rt, int voxelsPerPe)
       : job_(job),
         rt_(rt),
-        split_(job.scene, {voxelsPerPe * rt.pes(), partitionMargin(job.scene, job.camera.position())}),
+        split_(job.scene, {voxelCount(voxelsPerPe, rt.pes()), partitionMargin(job.scene, job.camera.position())}),
         owners_(assignVoxelOwners(split_, rt.pes())),
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
@@ -213,6 +217,7 @@ ObjectSpacePartition::ObjectSpacePartition(int voxelsPerPe) : voxelsPerPe_(voxel
 }
 
 TraceResult ObjectSpacePartition::render(const TraceJob& job, par::Runtime& rt) {
+  checkRayBatch(job.options, "object-space partitioning");
   ObjectSpaceFrame frame(job, rt, voxelsPerPe_);
   return frame.run();
 }

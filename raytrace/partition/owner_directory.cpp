@@ -43,12 +43,19 @@ class BoxSlabs {
     const __m128 b = _mm_mul_ps(_mm_sub_ps(h, origin_), inverse_);
     const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
     const __m128 slack = _mm_set1_ps(kSlack);
-    __m128 tNear = _mm_min_ps(a, b), tFar = _mm_max_ps(a, b);
+    const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
+    const __m128 minusInf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
+    // A direction component so small that its reciprocal is infinite, with the origin on the
+    // face: 0 * inf is NaN, which limits nothing (-inf as a near, +inf as a far distance).
+    const __m128 nanA = _mm_cmpunord_ps(a, a), nanB = _mm_cmpunord_ps(b, b);
+    const __m128 aNear = _mm_or_ps(_mm_and_ps(nanA, minusInf), _mm_andnot_ps(nanA, a));
+    const __m128 bNear = _mm_or_ps(_mm_and_ps(nanB, minusInf), _mm_andnot_ps(nanB, b));
+    const __m128 aFar = _mm_or_ps(_mm_and_ps(nanA, inf), _mm_andnot_ps(nanA, a));
+    const __m128 bFar = _mm_or_ps(_mm_and_ps(nanB, inf), _mm_andnot_ps(nanB, b));
+    __m128 tNear = _mm_min_ps(aNear, bNear), tFar = _mm_max_ps(aFar, bFar);
     tNear = _mm_sub_ps(tNear, _mm_mul_ps(_mm_and_ps(tNear, absMask), slack));
     tFar = _mm_add_ps(tFar, _mm_mul_ps(_mm_and_ps(tFar, absMask), slack));
     // Parallel axes: (-inf, +inf) inside the slab, (+inf, -inf) outside.
-    const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());
-    const __m128 minusInf = _mm_set1_ps(-std::numeric_limits<float>::infinity());
     const __m128 inside = _mm_and_ps(_mm_cmple_ps(l, origin_), _mm_cmple_ps(origin_, h));
     const __m128 parallelNear = _mm_or_ps(_mm_and_ps(inside, minusInf), _mm_andnot_ps(inside, inf));
     const __m128 parallelFar = _mm_or_ps(_mm_and_ps(inside, inf), _mm_andnot_ps(inside, minusInf));

@@ -9,6 +9,7 @@
 #include <functional>
 #include <limits>
 #include <span>
+#include <string>
 #include <memory>
 #include <string_view>
 #include <vector>
@@ -93,6 +94,13 @@ class SceneViews {
   const TraceJob& job_;
   std::vector<std::unique_ptr<scene::Scene>> views_;
 };
+
+// Throws pr::InputError for a ray batch size outside [1, kMaxRayBatch].
+inline void checkRayBatch(const TraceOptions& options, std::string_view method) {
+  if (options.rayBatch < 1 || options.rayBatch > kMaxRayBatch)
+    throw InputError(std::string(method) + ": ray batch of " + std::to_string(options.rayBatch) +
+                     " requested, expected 1 to " + std::to_string(kMaxRayBatch));
+}
 
 // Image tiles of tileSizePx, row-major: the camera-ray tasks of the partitioned tracers.
 inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx) {

@@ -175,6 +175,9 @@ TEST_CASE("OwnerDirectory: the box test is conservative for axis-parallel and bo
   along.origin = glm::vec3(0.0f, 0.5f, -1.0f);
   along.direction = glm::vec3(0.0f, 0.0f, 1.0f);
   CHECK(reaches(along, 0.0f));
+  Ray nearlyAlong = along;  // 1 / 1e-39 overflows to inf: 0 * inf on the face must not drop it
+  nearlyAlong.direction = glm::vec3(1e-39f, 0.0f, 1.0f);
+  CHECK(reaches(nearlyAlong, 0.0f));
   along.origin.x = -1e-3f;
   CHECK(!reaches(along, 0.0f));
   CHECK(reaches(along, 2e-3f));  // the margin grows the box

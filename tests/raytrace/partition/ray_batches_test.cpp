@@ -5,6 +5,7 @@
 
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
+#include "common/util/error.h"
 #include "raytrace/partition/object_partition.h"
 #include "raytrace/partition/object_space.h"
 #include "raytrace/partition/partitioned_test_support.h"
@@ -25,7 +26,7 @@ void checkBatchSizes(const scene::Scene& s, const scene::Camera& cam) {
   const image::Image reference = test::renderSequential(s, cam, 24, 24, opt);
   for (int pes : {2, 3}) {
     uint64_t one = 0, many = 0;
-    for (int batch : {1, 5, 64, 100000}) {
+    for (int batch : {1, 5, 64, rt::kMaxRayBatch}) {
       CAPTURE(pes);
       CAPTURE(batch);
       opt.rayBatch = batch;
@@ -53,4 +54,18 @@ TEST_CASE("RayBatches: object-space gives the sequential image for every batch s
 TEST_CASE("RayBatches: object partitioning gives the sequential image for every batch size, fewer messages for larger ones") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   checkBatchSizes<rt::ObjectPartition>(s, scene::selectCamera(s, "", 1.0f));
+}
+
+TEST_CASE("RayBatches: a batch size outside [1, kMaxRayBatch] is an input error") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("cornell.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  for (int batch : {0, -3, rt::kMaxRayBatch + 1}) {
+    CAPTURE(batch);
+    rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
+    opt.rayBatch = batch;
+    rt::ObjectSpacePartition space;
+    CHECK_THROWS_AS(test::renderPartitioned(space, s, cam, 8, 8, opt, 2), InputError);
+    rt::ObjectPartition objects;
+    CHECK_THROWS_AS(test::renderPartitioned(objects, s, cam, 8, 8, opt, 2), InputError);
+  }
 }
