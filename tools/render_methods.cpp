@@ -2,6 +2,8 @@
 // of the raytrace partition registry, so a new partition appears here with its registry line.
 #include "tools/render_methods.h"
 
+#include <cstdio>
+
 #include "common/parallel/metrics.h"
 #include "common/util/error.h"
 #include "common/util/memory_limit.h"
@@ -34,6 +36,7 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   options.tileSizePx = r.settings.ray.tileSizePx;
   options.adaptive = r.settings.ray.adaptive;
   options.rayBatch = r.settings.ray.rayBatch;
+  options.cacheBytes = std::size_t(r.settings.ray.cacheMb * 1048576.0);
   options.progress = r.progress;
   rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
   const bool photonmap = r.settings.ray.integrator == "photonmap";
@@ -71,6 +74,15 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
                 ", max depth " + std::to_string(options.integrator.maxDepth) + "; rays: camera " +
                 std::to_string(camera) + ", continuation " + std::to_string(continuation) + ", shadow " +
                 std::to_string(shadow) + "; tasks " + std::to_string(result.tasks);
+  if (name == "image-space-cached") {
+    const uint64_t hits = total("Cache/hits"), misses = total("Cache/misses");
+    const uint64_t uses = hits + misses;
+    char ratio[32];
+    std::snprintf(ratio, sizeof ratio, "%.4f", uses > 0 ? double(hits) / double(uses) : 1.0);
+    out.details += "; geometry cache " + formatBytes(options.cacheBytes) + " per PE: hits " + std::to_string(hits) +
+                   ", misses " + std::to_string(misses) + " (hit ratio " + ratio + "), prefetches " +
+                   std::to_string(total("Cache/prefetches")) + ", own items used " + std::to_string(total("Cache/own_item_uses"));
+  }
   if (photonmap)
     out.details += "; photons stored: global " + std::to_string(total("Photons/global_stored")) + ", caustic " +
                    std::to_string(total("Photons/caustic_stored")) + "; irradiance-cache records " +
@@ -216,6 +228,10 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
                           ->capture_default_str(),
                       MethodFamily::Ray);
   family.emplace_back(command.add_flag("--adaptive", ray.adaptive, "image-space: split tiles estimated at over twice the mean cost"),
+                      MethodFamily::Ray);
+  family.emplace_back(command.add_option("--cache-mb", ray.cacheMb, "image-space-cached: each PE's LRU cache of other PEs' geometry items, in MiB (0: none, every use of a remote item fetches it)")
+                          ->check(CLI::Range(0.0, 1048576.0))
+                          ->capture_default_str(),
                       MethodFamily::Ray);
   family.emplace_back(command.add_option("--ray-batch", ray.rayBatch, "object-space, object: rays per message to one PE (a partial batch goes when its PE runs dry)")
                           ->check(CLI::Range(1, rt::kMaxRayBatch))

@@ -38,6 +38,7 @@ struct RayOptions {
   int tileSizePx = 16;
   bool adaptive = false;
   int rayBatch = rt::kDefaultRayBatch;
+  double cacheMb = double(rt::kDefaultCacheBytes) / 1048576.0;
   // --integrator photonmap's settings (--photons, --gather, --view, ...), and the options
   // that set them: giving one with another integrator is an input error.
   pm::PhotonMapSettings photonmap;

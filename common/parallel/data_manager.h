@@ -56,42 +56,61 @@ class OwnerMap {
   std::vector<int> owners_;
 };
 
-// A cache of remote items on one PE, least recently used evicted first. Used by one PE only.
+// A cache of remote items on one PE, least recently used evicted first, holding at most
+// `capacity` items and, when a size function is given, at most `capacityBytes` bytes of them.
+// Used by one PE only.
 template <class T>
 class DataCache {
  public:
-  explicit DataCache(std::size_t capacity) : capacity_(capacity) {}
+  using ByteSize = std::function<std::size_t(const T&)>;
+  explicit DataCache(std::size_t capacity, std::size_t capacityBytes = SIZE_MAX, ByteSize bytes = {})
+      : capacity_(capacity), capacityBytes_(capacityBytes), bytes_(std::move(bytes)) {}
 
   // The cached item, marked most recently used; nullptr when absent.
   const T* find(ItemId item) {
     auto it = index_.find(item);
     if (it == index_.end()) return nullptr;
     order_.splice(order_.begin(), order_, it->second);
-    return &it->second->second;
+    return &it->second->value;
   }
+  // Whether an item of this size can be held at all (alone, after evicting everything else).
+  bool fits(const T& value) const { return capacity_ > 0 && sizeOf(value) <= capacityBytes_; }
   const T& insert(ItemId item, T value) {
-    PR_CHECK(capacity_ > 0, "DataCache: insert into a cache of capacity 0");
+    PR_CHECK(fits(value), "DataCache: insert of an item larger than the cache");
+    const std::size_t size = sizeOf(value);
     if (auto it = index_.find(item); it != index_.end()) {
-      it->second->second = std::move(value);
-      order_.splice(order_.begin(), order_, it->second);
-      return it->second->second;
+      usedBytes_ -= it->second->bytes;
+      order_.erase(it->second);
+      index_.erase(it);
     }
-    if (order_.size() == capacity_) {
-      index_.erase(order_.back().first);
+    while (!order_.empty() && (order_.size() >= capacity_ || usedBytes_ + size > capacityBytes_)) {
+      usedBytes_ -= order_.back().bytes;
+      index_.erase(order_.back().item);
       order_.pop_back();
     }
-    order_.emplace_front(item, std::move(value));
+    order_.push_front(Entry{item, std::move(value), size});
+    usedBytes_ += size;
     index_[item] = order_.begin();
-    return order_.front().second;
+    return order_.front().value;
   }
   bool contains(ItemId item) const { return index_.count(item) > 0; }
   std::size_t size() const { return order_.size(); }
   std::size_t capacity() const { return capacity_; }
+  std::size_t usedBytes() const { return usedBytes_; }
 
  private:
-  std::size_t capacity_;
-  std::list<std::pair<ItemId, T>> order_;  // front = most recently used
-  std::unordered_map<ItemId, typename std::list<std::pair<ItemId, T>>::iterator> index_;
+  struct Entry {
+    ItemId item;
+    T value;
+    std::size_t bytes;
+  };
+  std::size_t sizeOf(const T& value) const { return bytes_ ? bytes_(value) : 0; }
+
+  std::size_t capacity_, capacityBytes_;
+  ByteSize bytes_;
+  std::size_t usedBytes_ = 0;
+  std::list<Entry> order_;  // front = most recently used
+  std::unordered_map<ItemId, typename std::list<Entry>::iterator> index_;
 };
 
 // Items of a partition move only as messages: a PE that misses sends a request ("<name>
@@ -109,16 +128,17 @@ class DataManager {
   using Loader = std::function<T(Pe& owner, ItemId item)>;
   using ByteSize = std::function<std::size_t(const T&)>;
 
-  // Created between stages, like any Channel.
+  // Created between stages, like any Channel. The cache holds at most cacheCapacity items and
+  // cacheBytes bytes of them (by `bytes`); an item larger than that is used once and dropped.
   DataManager(Runtime& runtime, const std::string& name, OwnerMap owners, std::size_t cacheCapacity, Loader load,
-              ByteSize bytes = {})
+              ByteSize bytes = {}, std::size_t cacheBytes = SIZE_MAX)
       : owners_(std::move(owners)),
         load_(std::move(load)),
         bytes_(std::move(bytes)),
         items_(runtime, name + " items", MessageKind::Data),
         requests_(runtime, name + " requests", MessageKind::Requests,
                   [this](Pe& owner, Request&& r) { serve(owner, r); }) {
-    for (int p = 0; p < runtime.pes(); ++p) caches_.emplace_back(cacheCapacity);
+    for (int p = 0; p < runtime.pes(); ++p) caches_.emplace_back(cacheCapacity, cacheBytes, bytes_);
     local_.resize(static_cast<std::size_t>(runtime.pes()));
     hits_.assign(static_cast<std::size_t>(runtime.pes()), 0);
     misses_.assign(static_cast<std::size_t>(runtime.pes()), 0);
@@ -143,7 +163,7 @@ class DataManager {
     requests_.send(pe, owner, Request{item, pe.id()}, kItemRequestBytes);
     Reply reply = awaitReply(pe);
     PR_CHECK(reply.item == item, "DataManager: a reply for another item");
-    if (cache.capacity() == 0) return local_[pe.id()] = std::move(reply.value);
+    if (!cache.fits(reply.value)) return local_[pe.id()] = std::move(reply.value);
     return cache.insert(item, std::move(reply.value));
   }
 
@@ -161,7 +181,7 @@ class DataManager {
     }
     for (; asked > 0; --asked) {
       Reply reply = awaitReply(pe);
-      if (caches_[pe.id()].capacity() > 0) caches_[pe.id()].insert(reply.item, std::move(reply.value));
+      if (caches_[pe.id()].fits(reply.value)) caches_[pe.id()].insert(reply.item, std::move(reply.value));
     }
   }
 

@@ -122,11 +122,11 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
   for (const ObjectPiece& p : pieces_) all.extend(p.bounds);
   std::vector<uint64_t> key(pieces_.size());
   for (size_t p = 0; p < pieces_.size(); ++p) key[p] = mortonKey(pieces_[p].bounds.center(), all);
-  std::vector<uint32_t> order(pieces_.size());
-  std::iota(order.begin(), order.end(), 0u);
-  std::stable_sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return key[x] < key[y]; });
+  curveOrder_.resize(pieces_.size());
+  std::iota(curveOrder_.begin(), curveOrder_.end(), 0u);
+  std::stable_sort(curveOrder_.begin(), curveOrder_.end(), [&](uint32_t x, uint32_t y) { return key[x] < key[y]; });
   uint64_t before = 0;  // triangles of the pieces before this one on the curve
-  for (uint32_t p : order) {
+  for (uint32_t p : curveOrder_) {
     const uint64_t n = pieces_[p].triangles.size();
     // The PE whose share of the curve holds the piece's middle triangle.
     const uint64_t middle = before + n / 2;

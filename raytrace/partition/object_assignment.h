@@ -46,6 +46,8 @@ class ObjectAssignment {
   std::span<const uint32_t> triangles(int pe) const { return perPe_[pe]; }
   // Indices into pieces() of the pieces PE `pe` owns.
   std::span<const uint32_t> piecesOf(int pe) const { return piecesOf_[pe]; }
+  // Indices into pieces() along the Morton curve: each PE's pieces are one run of it.
+  std::span<const uint32_t> curveOrder() const { return curveOrder_; }
   // Bytes of the directory every PE keeps to route rays: each piece's bounds and owner.
   size_t directoryBytes() const { return pieces_.size() * (sizeof(scene::Bounds) + sizeof(int)); }
 
@@ -53,6 +55,7 @@ class ObjectAssignment {
   std::vector<ObjectPiece> pieces_;
   std::vector<std::vector<uint32_t>> perPe_;
   std::vector<std::vector<uint32_t>> piecesOf_;
+  std::vector<uint32_t> curveOrder_;
   float margin_ = 0.0f;
 };
 

@@ -7,11 +7,13 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "common/scene/scene.h"
 #include "raytrace/core/ray.h"
 #include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/ray_slabs.h"
 
 namespace pr::rt {
 
@@ -25,7 +27,11 @@ struct OwnerEntry {
 class OwnerDirectory {
  public:
   OwnerDirectory() = default;
+  // Over the owners of the assignment's pieces, each with the union of its pieces' bounds.
   explicit OwnerDirectory(const ObjectAssignment& assignment);
+  // Over any boxes, grown by margin: entry i is box i (an empty box is never reached); the
+  // "owners" it lists are box indices (the data items of image-space-cached).
+  OwnerDirectory(std::span<const scene::Bounds> boxes, float margin);
 
   // A node waiting in the walk's heap (the caller's storage, reused between rays).
   struct NodeEntry {
@@ -35,6 +41,23 @@ class OwnerDirectory {
   // The owners other than `except` whose pieces the ray reaches for t in [tMin, tMax], each
   // once with its nearest entry, nearest first. A pure function of the ray and `except`.
   void ownersNearestFirst(const Ray& ray, int except, std::vector<OwnerEntry>& out, std::vector<NodeEntry>& heap) const;
+  // The owners a ray reaches, one at a time, nearest first, walking only as far as asked: the
+  // cheap form when the search stops at the closest hit.
+  class NearestFirst {
+   public:
+    NearestFirst(const OwnerDirectory& directory, const Ray& ray, int except, std::vector<NodeEntry>& heap);
+    // The next owner whose entry is no farther than maxT; false when there is none.
+    bool next(float maxT, OwnerEntry& out);
+
+   private:
+    static bool later(const NodeEntry& a, const NodeEntry& b) { return a.t > b.t || (a.t == b.t && a.node > b.node); }
+    void push(uint32_t node);
+    const OwnerDirectory& directory_;
+    RaySlabs slabs_;
+    int except_;
+    std::vector<NodeEntry>& heap_;
+  };
+
   // Bytes every PE holds a copy of: the tree's nodes.
   size_t bytes() const { return nodes_.size() * sizeof(Node); }
 
@@ -50,11 +73,11 @@ class OwnerDirectory {
     scene::Bounds box;  // the owner's pieces' bounds, grown by the margin
     int owner = 0;
   };
+  void init(std::span<const scene::Bounds> boxes, float margin);
   void build(uint32_t node, uint32_t begin, uint32_t end);
 
   std::vector<Node> nodes_;
   std::vector<Leaf> leaves_;      // one per owner that holds pieces, in tree order
-  std::vector<bool> ownsPieces_;  // per PE
 };
 
 }  // namespace pr::rt

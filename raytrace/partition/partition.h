@@ -7,6 +7,7 @@
 #pragma once
 
 #include <atomic>
+#include <cstddef>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -28,6 +29,7 @@ namespace pr::rt {
 
 inline constexpr int kDefaultRayBatch = 64;
 inline constexpr int kMaxRayBatch = 65536;
+inline constexpr std::size_t kDefaultCacheBytes = std::size_t{64} << 20;
 
 struct TraceOptions {
   IntegratorOptions integrator;
@@ -36,6 +38,8 @@ struct TraceOptions {
   // object-space and object partitioning: rays (queries, replies) per message to one PE; a
   // partial batch is sent when its PE runs dry (common/parallel/batched_channel.h).
   int rayBatch = kDefaultRayBatch;
+  // image-space-cached: each PE's cache of other PEs' geometry items, in bytes (LRU).
+  std::size_t cacheBytes = kDefaultCacheBytes;
   BvhBuildOptions bvh;
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.
@@ -143,6 +147,7 @@ TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, i
 // Factories, one per partition file.
 std::unique_ptr<Partition> makeSequentialPartition();
 std::unique_ptr<Partition> makeImageSpacePartition();
+std::unique_ptr<Partition> makeCachedImageSpacePartition();
 std::unique_ptr<Partition> makeObjectSpacePartition();  // object_space.cpp
 std::unique_ptr<Partition> makeObjectPartition();       // object_partition.cpp
 

@@ -16,6 +16,7 @@ const PartitionRegistry& partitions() {
       {
           {"sequential", "one PE, one message queue, the whole scene (the reference)", makeSequentialPartition},
           {"image-space", "PEs render image tiles as tasks; world model (scene broadcast to every PE)", makeImageSpacePartition},
+          {"image-space-cached", "image tiles as tasks; geometry items owned by PEs, fetched on demand into an LRU cache (data manager)", makeCachedImageSpacePartition},
           {"object-space", "voxels of a cost-balanced kd split own their geometry; rays travel between owners as messages", makeObjectSpacePartition},
           {"object", "objects balanced by triangle count own their geometry; rays query the owners they can reach, hits return", makeObjectPartition},
       });

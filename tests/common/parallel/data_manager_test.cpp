@@ -3,6 +3,8 @@
 // each item served by its owner's PE.
 #include <doctest/doctest.h>
 
+#include <cstdint>
+
 #include <atomic>
 #include <string>
 
@@ -31,6 +33,25 @@ TEST_CASE("DataManager: LRU cache keeps the most recently used items") {
   CHECK(*cache.find(1) == 10);
   CHECK(*cache.find(3) == 30);
   CHECK(cache.size() == 2);
+}
+
+TEST_CASE("DataManager: a byte budget evicts least recently used items until the new one fits") {
+  // Items are strings of their own length in bytes; 10 bytes of cache, any number of items.
+  DataCache<std::string> cache(SIZE_MAX, 10, [](const std::string& v) { return v.size(); });
+  cache.insert(1, std::string(4, 'a'));
+  cache.insert(2, std::string(4, 'b'));
+  CHECK(cache.usedBytes() == 8u);
+  REQUIRE(cache.find(1) != nullptr);    // 1 is now most recent
+  cache.insert(3, std::string(5, 'c'));  // 13 > 10: evicts 2, then 9 bytes
+  CHECK(cache.find(2) == nullptr);
+  CHECK(cache.find(1) != nullptr);
+  CHECK(cache.usedBytes() == 9u);
+  cache.insert(4, std::string(10, 'd'));  // needs the whole cache
+  CHECK(cache.size() == 1u);
+  CHECK(cache.usedBytes() == 10u);
+  CHECK(!cache.fits(std::string(11, 'e')));  // larger than the cache: never held
+  cache.insert(4, std::string(2, 'f'));       // replacing an item counts its new size only
+  CHECK(cache.usedBytes() == 2u);
 }
 
 TEST_CASE("DataManager: hit and miss counts are exact for a known access sequence") {

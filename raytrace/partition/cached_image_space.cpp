@@ -1,0 +1,302 @@
+// The image-space tracer with a data manager. Stage "build": each owner makes the data items of
+// its pieces (a BVH over the piece's triangles, built against the scene's vertex positions, and
+// a small scene of the piece's vertex data for interactions). Stage "trace": image tiles are
+// tasks under any schedule; each ray is traced by the PE that runs its tile. The closest hit is
+// found over the items the ray reaches, nearest first (the replicated item directory, with the
+// closest hit so far as the next query's tMax), each item taken through the DataManager; a
+// shadow ray stops at the first item with an occluder. The interaction is made from the item
+// that holds the hit, so no PE reads geometry it neither owns nor fetched (the poisoned-view
+// check of the tests). Finished tiles travel to the assembler as in image-space.
+//
+// A fetched item is the owner's immutable item handed over by reference and counted as its
+// bytes (the copy a distributed machine would send); the cache bounds how many bytes of other
+// PEs' items a PE may use without asking again.
+#include "raytrace/partition/cached_image_space.h"
+
+#include <algorithm>
+#include <atomic>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "common/parallel/data_manager.h"
+#include "raytrace/partition/film_assembly.h"
+#include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/owner_directory.h"
+#include "raytrace/partition/partition_margin.h"
+#include "raytrace/partition/partitioned.h"
+
+namespace pr::rt {
+namespace {
+
+// One data item: a piece's BVH (its triangles' vertices are inside it; hits report scene
+// triangle indices) and the vertex data interactions read, as a scene of the piece alone.
+struct GeometryItem {
+  Bvh bvh;
+  scene::Scene local;              // the piece's vertices and triangles, renumbered; all materials
+  std::vector<uint32_t> triangles;  // scene index of local triangle i, ascending
+  std::size_t bytes = 0;
+
+  // The interaction at a hit of this item's BVH, bit for bit the one the whole scene gives.
+  SurfaceInteraction interaction(const Ray& ray, const Hit& hit) const {
+    const auto it = std::lower_bound(triangles.begin(), triangles.end(), hit.triangle);
+    PR_CHECK(it != triangles.end() && *it == hit.triangle, "image-space-cached: a hit outside its item");
+    SurfaceInteraction si = makeInteraction(local, ray, Hit{hit.t, uint32_t(it - triangles.begin()), hit.u, hit.v});
+    si.triangle = hit.triangle;
+    return si;
+  }
+};
+using ItemRef = std::shared_ptr<const GeometryItem>;
+
+// The item of piece `tris` from scene s (the owner's view of the scene).
+ItemRef makeItem(const scene::Scene& s, std::span<const uint32_t> tris, const BvhBuildOptions& options) {
+  auto item = std::make_shared<GeometryItem>();
+  item->bvh = Bvh(s.positions, s.triangles, tris, options);
+  item->triangles.assign(tris.begin(), tris.end());
+  scene::Scene& l = item->local;
+  l.materials = s.materials;  // the anisotropy test of makeInteraction reads the material
+  std::vector<uint32_t> renumber(s.positions.size(), UINT32_MAX);
+  auto copyVertex = [&](uint32_t v) {
+    if (renumber[v] != UINT32_MAX) return renumber[v];
+    renumber[v] = uint32_t(l.positions.size());
+    l.positions.push_back(s.positions[v]);
+    if (s.normals.size() == s.positions.size()) l.normals.push_back(s.normals[v]);
+    if (s.uvs.size() == s.positions.size()) l.uvs.push_back(s.uvs[v]);
+    if (s.colors.size() == s.positions.size()) l.colors.push_back(s.colors[v]);
+    if (s.tangents.size() == s.positions.size()) l.tangents.push_back(s.tangents[v]);
+    return renumber[v];
+  };
+  for (uint32_t t : tris) {
+    scene::Triangle tri = s.triangles[t];
+    for (uint32_t& v : tri.v) v = copyVertex(v);
+    l.triangles.push_back(tri);
+  }
+  item->bytes = item->bvh.stats().memoryBytes + tris.size() * kTriangleVertexBytes;
+  return item;
+}
+
+// What a data item holds and who owns it: consecutive pieces of one owner along the Morton
+// curve, gathered until the item holds about total / (kItemsPerPe P) triangles, so a PE's
+// geometry is a few spatially compact items (a ray walks few of them, each a deep BVH).
+constexpr uint32_t kItemsPerPe = 8;
+struct ItemSpec {
+  int owner = 0;
+  std::vector<uint32_t> triangles;  // ascending scene indices
+  scene::Bounds bounds;
+};
+
+std::vector<ItemSpec> groupPieces(const ObjectAssignment& a, size_t totalTriangles) {
+  const size_t target = std::max<size_t>(64, totalTriangles / (size_t(kItemsPerPe) * size_t(a.pes())));
+  std::vector<ItemSpec> items;
+  for (uint32_t p : a.curveOrder()) {
+    const ObjectPiece& piece = a.pieces()[p];
+    if (items.empty() || items.back().owner != piece.owner || items.back().triangles.size() >= target)
+      items.push_back(ItemSpec{piece.owner, {}, {}});
+    ItemSpec& item = items.back();
+    item.triangles.insert(item.triangles.end(), piece.triangles.begin(), piece.triangles.end());
+    item.bounds.extend(piece.bounds);
+  }
+  for (ItemSpec& item : items) std::sort(item.triangles.begin(), item.triangles.end());
+  return items;
+}
+
+class CachedImageSpaceFrame {
+ public:
+  CachedImageSpaceFrame(const TraceJob& job, par::Runtime& rt)
+      : job_(job),
+        rt_(rt),
+        assignment_(job.scene, {rt.pes(), 0, partitionMargin(job.scene, job.camera.position())}),
+        specs_(groupPieces(assignment_, job.scene.triangles.size())),
+        directory_(itemBounds(specs_), assignment_.margin()),
+        integrator_(jobIntegrator(job)),
+        items_(specs_.size()),
+        views_(job, rt.pes()),
+        state_(size_t(rt.pes())) {}
+
+  TraceResult run() {
+    const int pes = rt_.pes();
+    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
+      views_.build(pe.id(), assignment_.triangles(pe.id()), integrator_->context().lights());
+      for (size_t i = 0; i < specs_.size(); ++i)
+        if (specs_[i].owner == pe.id()) items_[i] = makeItem(views_.of(pe.id()), specs_[i].triangles, job_.options.bvh);
+    });
+
+    std::vector<int> owners;
+    for (const ItemSpec& item : specs_) owners.push_back(item.owner);
+    par::DataManager<ItemRef> data(
+        rt_, "geometry", par::OwnerMap(std::move(owners)), SIZE_MAX,
+        [this](par::Pe& owner, par::ItemId id) {
+          PR_CHECK(specs_[id].owner == owner.id(), "image-space-cached: an item served by a PE that does not own it");
+          return items_[id];
+        },
+        [](const ItemRef& item) { return item->bytes; }, job_.options.cacheBytes);
+    data_ = &data;
+
+    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    Film film(job_.filmWidth(), job_.filmHeight(), integrator_->options().spp);
+    FilmAssembly assembly(rt_, film);
+    // Materials, textures, lights, the emitters and the item directory are replicated; the
+    // geometry items are not.
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
+    std::atomic<int64_t> done{0};
+    const auto total = int64_t(tiles.size());
+    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+      PeState& st = state_[size_t(pe.id())];
+      const PixelRect& rect = tiles[size_t(id)];
+      Film tile(rect, job_.width, job_.height, integrator_->options().spp);
+      integrator_->cameraRays(rect, st.queue);
+      countStartRays(st.stats, st.queue);
+      prefetch(pe, st);
+      traceQueue(pe, st, tile);
+      if (job_.assembleImage) assembly.deliver(pe, tile, rect, false);
+      const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
+      if (job_.options.progress) job_.options.progress(n, total);
+    });
+    data_ = nullptr;
+
+    PartitionHoldings held;
+    std::vector<TraceStats> raysTraced;
+    for (int p = 0; p < pes; ++p) {
+      uint64_t bytes = 0, owned = 0, largest = 0;
+      for (size_t i = 0; i < specs_.size(); ++i)
+        if (specs_[i].owner == p) {
+          bytes += items_[i]->bytes;
+          largest = std::max<uint64_t>(largest, items_[i]->bytes);
+          ++owned;
+        }
+      rt_.addCounter("Cache/largest_item_bytes", p, double(largest));
+      held.geometryBytes.push_back(bytes);
+      held.triangles.push_back(assignment_.triangles(p).size());
+      held.partitionsOwned.push_back(owned);
+      const PeState& st = state_[size_t(p)];
+      raysTraced.push_back(st.stats);
+      rt_.addCounter("Cache/capacity_bytes", p, double(job_.options.cacheBytes));
+      rt_.addCounter("Cache/hits", p, double(data.hits(p)));
+      rt_.addCounter("Cache/misses", p, double(data.misses(p)));
+      rt_.addCounter("Cache/prefetches", p, double(st.prefetched));
+      rt_.addCounter("Cache/own_item_uses", p, double(st.ownUses));
+      rt_.addCounter("Cache/bytes_held_at_end", p, double(data.cache(p).usedBytes()));
+    }
+    recordPartitionHoldings(held, rt_);
+    return TraceResult{film.toImage(), recordRayCounters(rt_, raysTraced), tiles.size()};
+  }
+
+ private:
+  // Padded to a cache line: each PE writes only its own.
+  struct alignas(64) PeState {
+    std::vector<RayMessage> queue;
+    std::vector<OwnerDirectory::NodeEntry> heap;
+    std::vector<par::ItemId> wanted;
+    TraceStats stats;
+    uint64_t prefetched = 0, ownUses = 0;
+  };
+
+  static std::vector<scene::Bounds> itemBounds(const std::vector<ItemSpec>& items) {
+    std::vector<scene::Bounds> boxes;
+    for (const ItemSpec& item : items) boxes.push_back(item.bounds);
+    return boxes;
+  }
+
+  // Before a tile: the items that every 16th of its camera rays reaches first, fetched at once
+  // (one request each, the replies awaited together) so that the tile's rays find them cached.
+  void prefetch(par::Pe& pe, PeState& st) {
+    constexpr size_t kStride = 16;
+    st.wanted.clear();
+    for (size_t i = 0; i < st.queue.size(); i += kStride) {
+      OwnerDirectory::NearestFirst walk(directory_, st.queue[i].ray, -1, st.heap);
+      OwnerEntry e;
+      if (walk.next(kInfinity, e)) st.wanted.push_back(par::ItemId(e.owner));
+    }
+    std::sort(st.wanted.begin(), st.wanted.end());
+    st.wanted.erase(std::unique(st.wanted.begin(), st.wanted.end()), st.wanted.end());
+    std::erase_if(st.wanted, [&](par::ItemId id) {
+      return data_->owner(id) == pe.id() || data_->cache(pe.id()).contains(id);
+    });
+    st.prefetched += st.wanted.size();
+    data_->prefetch(pe, st.wanted);
+  }
+
+  // An item of this PE's own partition is read in place; another PE's goes through the
+  // DataManager (cache or owner).
+  const GeometryItem& item(par::Pe& pe, PeState& st, par::ItemId id) {
+    if (specs_[id].owner == pe.id()) {
+      ++st.ownUses;
+      return *items_[id];
+    }
+    return *data_->acquire(pe, id);
+  }
+
+  // The closest hit over the items the ray reaches, nearest first.
+  bool closest(par::Pe& pe, PeState& st, const Ray& ray, SurfaceInteraction& si) {
+    OwnerDirectory::NearestFirst walk(directory_, ray, -1, st.heap);
+    Hit best;
+    bool found = false;
+    OwnerEntry e;
+    // Items whose entry is no farther than the best hit so far (every other starts farther).
+    while (walk.next(found ? best.t : kInfinity, e)) {
+      const GeometryItem& g = item(pe, st, par::ItemId(e.owner));
+      Ray bounded = ray;
+      if (found) bounded.tMax = best.t;  // inclusive: an equal t with a lower triangle still wins
+      Hit h;
+      if (!g.bvh.intersect(bounded, h) || (found && !h.closerThan(best))) continue;
+      best = h;
+      found = true;
+      si = g.interaction(ray, h);  // now: the item may leave the cache at the next acquire
+    }
+    return found;
+  }
+
+  bool occluded(par::Pe& pe, PeState& st, const Ray& ray) {
+    OwnerDirectory::NearestFirst walk(directory_, ray, -1, st.heap);
+    OwnerEntry e;
+    while (walk.next(kInfinity, e))
+      if (item(pe, st, par::ItemId(e.owner)).bvh.occluded(ray)) return true;
+    return false;
+  }
+
+  // The tile's rays and all they spawn, depth first, on this PE.
+  void traceQueue(par::Pe& pe, PeState& st, Film& film) {
+    std::vector<RayMessage> spawned;
+    Emit emit(film, spawned, st.stats, pe.id());
+    while (!st.queue.empty()) {
+      const RayMessage m = st.queue.back();
+      st.queue.pop_back();
+      if (m.kind == RayKind::Shadow) {
+        if (!occluded(pe, st, m.ray)) integrator_->miss(m, emit);
+      } else {
+        SurfaceInteraction si;
+        if (closest(pe, st, m.ray, si))
+          integrator_->shade(si, m, emit);
+        else
+          integrator_->miss(m, emit);
+      }
+      for (const RayMessage& r : spawned) {
+        ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
+        st.queue.push_back(r);
+      }
+      spawned.clear();
+    }
+  }
+
+  const TraceJob& job_;
+  par::Runtime& rt_;
+  ObjectAssignment assignment_;
+  std::vector<ItemSpec> specs_;
+  OwnerDirectory directory_;  // over the items, replicated
+  std::shared_ptr<const Integrator> integrator_;
+  std::vector<ItemRef> items_;  // item i, made and read only by its owner (others fetch it)
+  SceneViews views_;
+  std::vector<PeState> state_;
+  par::DataManager<ItemRef>* data_ = nullptr;
+};
+
+}  // namespace
+
+TraceResult CachedImageSpacePartition::render(const TraceJob& job, par::Runtime& rt) {
+  CachedImageSpaceFrame frame(job, rt);
+  return frame.run();
+}
+
+std::unique_ptr<Partition> makeCachedImageSpacePartition() { return std::make_unique<CachedImageSpacePartition>(); }
+
+}  // namespace pr::rt

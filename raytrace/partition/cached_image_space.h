@@ -1,0 +1,26 @@
+// Image-space partitioning with data management (seed chapter 4): image tiles are demand-driven
+// tasks as in image-space, but the scene is not replicated. Its geometry is split into data
+// items (the object pieces of object_assignment.h, each with its own BVH and vertex data) owned
+// by PEs in compact Morton-curve runs; a PE tracing a ray walks a replicated directory of the
+// items' bounds nearest first and takes each item it needs from its own partition, from its
+// cache, or from the owner through the DataManager (a request and a reply message, served by
+// the owner's PE), keeping fetched items in an LRU cache of --cache-mb. Before a tile it
+// prefetches the items the tile's camera rays reach first. Run record: cache hits, misses and
+// prefetches per PE (PeStageRecord), the fetched bytes as "data" traffic, the time spent
+// waiting for items as message waiting, and Cache/... counters.
+#pragma once
+
+#include <cstddef>
+#include <string_view>
+
+#include "raytrace/partition/partition.h"
+
+namespace pr::rt {
+
+class CachedImageSpacePartition final : public Partition {
+ public:
+  std::string_view name() const override { return "image-space-cached"; }
+  TraceResult render(const TraceJob& job, par::Runtime& rt) override;
+};
+
+}  // namespace pr::rt

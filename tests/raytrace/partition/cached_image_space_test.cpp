@@ -1,0 +1,113 @@
+// The image-space tracer with a data manager (raytrace/partition/cached_image_space.h): the
+// image is the sequential tracer's for every P and every cache size (none, 1 KiB that holds only
+// the smallest items, one that holds the largest item alone, one that holds everything), no PE reads geometry
+// it neither owns nor fetched (poisoned views), and the cache figures in the run record agree
+// with the messages the DataManager counted.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+
+#include "common/scene/camera_select.h"
+#include "common/scene/gltf_loader.h"
+#include "raytrace/partition/cached_image_space.h"
+#include "raytrace/partition/partitioned_test_support.h"
+
+using namespace pr;
+
+namespace {
+
+double counterMax(const par::RunRecord& record, const char* name) {
+  double m = 0.0;
+  for (const par::CounterRecord& c : record.counters)
+    if (c.name == name)
+      for (double v : c.perPe) m = std::max(m, v);
+  return m;
+}
+
+double counterTotal(const par::RunRecord& record, const char* name) {
+  double sum = 0.0;
+  for (const par::CounterRecord& c : record.counters)
+    if (c.name == name)
+      for (double v : c.perPe) sum += v;
+  return sum;
+}
+
+uint64_t channelMessages(const par::RunRecord& record, const char* kind) {
+  uint64_t n = 0;
+  for (const par::StageRecord& st : record.stages)
+    for (const par::ChannelTraffic& c : st.channels)
+      if (c.kind == kind) n += c.messages;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("CachedImageSpace: the sequential image for P = 1, 2, 3 and every cache size") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  for (const rt::IntegratorKind kind : {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path}) {
+    rt::TraceOptions opt = test::partitionedOptions(kind, 1, 4);
+    const image::Image reference = test::renderSequential(s, cam, 24, 24, opt);
+    for (int pes : {1, 2, 3}) {
+      CAPTURE(pes);
+      rt::CachedImageSpacePartition partition;
+      const test::PartitionedRun all = test::renderPartitioned(partition, s, cam, 24, 24, opt, pes);
+      CHECK(all.image.pixels == reference.pixels);
+      const auto largest = std::size_t(counterMax(all.record, "Cache/largest_item_bytes"));
+      CHECK(largest > 0u);
+      if (pes > 1) {
+        // A cache that holds everything fetches each remote item at most once per PE.
+        CHECK(counterTotal(all.record, "Cache/misses") <= double(pes) * all.figures.partitions);
+        CHECK(counterTotal(all.record, "Cache/hits") > 0.0);
+      }
+      for (const std::size_t bytes : {std::size_t{0}, std::size_t{1024}, largest}) {
+        CAPTURE(bytes);
+        opt.cacheBytes = bytes;
+        const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 24, 24, opt, pes);
+        CHECK(run.image.pixels == reference.pixels);
+        CHECK(counterMax(run.record, "Cache/bytes_held_at_end") <= double(bytes));
+        if (bytes == 0) CHECK(counterTotal(run.record, "Cache/hits") == 0.0);  // no cache: every use fetches
+        if (pes == 1) CHECK(channelMessages(run.record, "data") == 0u);
+        // Every miss and every prefetch is one request and one reply.
+        const double fetches = counterTotal(run.record, "Cache/misses") + counterTotal(run.record, "Cache/prefetches");
+        CHECK(double(channelMessages(run.record, "data")) == fetches);
+        CHECK(double(channelMessages(run.record, "requests")) == fetches);
+      }
+      opt.cacheBytes = rt::kDefaultCacheBytes;
+    }
+  }
+}
+
+TEST_CASE("CachedImageSpace: with every PE's foreign geometry poisoned the image is still the sequential one") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("cornell.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 2);
+  const image::Image reference = test::renderSequential(s, cam, 32, 32, opt);
+  opt.poisonForeignGeometry = true;
+  for (int pes : {2, 3}) {
+    CAPTURE(pes);
+    for (const std::size_t bytes : {std::size_t{0}, rt::kDefaultCacheBytes}) {
+      opt.cacheBytes = bytes;
+      rt::CachedImageSpacePartition partition;
+      CHECK(test::renderPartitioned(partition, s, cam, 32, 32, opt, pes).image.pixels == reference.pixels);
+    }
+  }
+}
+
+TEST_CASE("CachedImageSpace: each PE holds only its own items; P = 1 moves nothing") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
+  for (int pes : {1, 2, 4}) {
+    CAPTURE(pes);
+    rt::CachedImageSpacePartition partition;
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 16, 16, opt, pes);
+    uint64_t triangles = 0;
+    for (int p = 0; p < pes; ++p) {
+      CHECK(run.figures.triangles[size_t(p)] > 0u);
+      triangles += run.figures.triangles[size_t(p)];
+    }
+    CHECK(triangles == s.triangles.size());  // every triangle in exactly one item
+    if (pes == 1) CHECK(channelMessages(run.record, "data") == 0u);
+  }
+}
