@@ -101,7 +101,7 @@ Renders renderEverything(const std::string& name, int maxDepth = 8) {
   for (const rt::IntegratorKind kind : {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path}) {
     const image::Image reference = trace(s, cam, kind, maxDepth, "sequential", 1);
     CHECK(nonFinite(reference) == 0);
-    for (const char* partition : {"image-space", "object-space", "object"})
+    for (const char* partition : {"image-space", "image-space-cached", "object-space", "object"})
       for (int pes : {1, 2, 3}) {
         CAPTURE(partition);
         CAPTURE(pes);
@@ -113,6 +113,7 @@ Renders renderEverything(const std::string& name, int maxDepth = 8) {
   CHECK(nonFinite(r.photonmap) == 0);
   CHECK(photonMap(s, cam, "image-space", 2).pixels == r.photonmap.pixels);
   CHECK(photonMap(s, cam, "object-space", 2).pixels == r.photonmap.pixels);
+  CHECK(photonMap(s, cam, "image-space-cached", 2).pixels == r.photonmap.pixels);
   return r;
 }
 

@@ -3,8 +3,11 @@
 // of the whole render (best of N), each method's speed-up over its own P = 1 (target >= 1.6),
 // ray messages per ray traced with the default batch against one ray per message (the
 // unbatched tracers; target: at least 10x fewer), the effect of the batch size at P = 2, and
-// a check that every image equals the sequential tracer's bit for bit. Figures come from the
-// runtime's run record; ratios are measured in the same run.
+// a check that every image equals the sequential tracer's bit for bit. Then the image-space
+// tracer with a data manager (image-space-cached): its P = 1 and P = 2 times beside
+// image-space's, and at P = 2 the cache hit ratio, misses, prefetches, bytes fetched and time
+// waiting for items for each cache size. Figures come from the runtime's run record; ratios
+// are measured in the same run.
 #include <algorithm>
 #include <cstdio>
 #include <string>
@@ -88,6 +91,52 @@ int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& op
   return failures;
 }
 
+double counterTotal(const par::RunRecord& record, const std::string& name) {
+  double sum = 0.0;
+  for (const par::CounterRecord& c : record.counters)
+    if (c.name == name)
+      for (double v : c.perPe) sum += v;
+  return sum;
+}
+
+int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int repeats, const std::vector<double>& cacheMb) {
+  const scene::Scene s = scene::loadGltf(file);
+  const scene::Camera cam = scene::selectCamera(s, "", float(w) / float(h));
+  par::Runtime sequential(1, "demand");
+  const image::Image reference = rt::renderRays(s, cam, w, h, opt, "sequential", sequential).image;
+  std::printf("\n%s: image-space-cached (data manager), %dx%d, best of %d\n", file.c_str(), w, h, repeats);
+  const Run world1 = measure(s, cam, w, h, opt, "image-space", 1, rt::kDefaultRayBatch, repeats, reference);
+  const Run world2 = measure(s, cam, w, h, opt, "image-space", 2, rt::kDefaultRayBatch, repeats, reference);
+  const Run cached1 = measure(s, cam, w, h, opt, "image-space-cached", 1, rt::kDefaultRayBatch, repeats, reference);
+  const Run cached2 = measure(s, cam, w, h, opt, "image-space-cached", 2, rt::kDefaultRayBatch, repeats, reference);
+  std::printf("  image-space        P=1 %.3f s, P=2 %.3f s, speed-up %.2f\n", world1.seconds, world2.seconds, world1.seconds / world2.seconds);
+  std::printf("  image-space-cached P=1 %.3f s, P=2 %.3f s, speed-up %.2f; P=1 time / image-space's %.2f\n", cached1.seconds,
+              cached2.seconds, cached1.seconds / cached2.seconds, cached1.seconds / world1.seconds);
+  bool same = world1.sameImage && world2.sameImage && cached1.sameImage && cached2.sameImage;
+  std::printf("  %10s %9s %10s %10s %10s %12s %9s %9s\n", "cache MiB", "time s", "hit ratio", "misses", "prefetch",
+              "fetched MB", "wait s", "held MB");
+  for (double mb : cacheMb) {
+    opt.cacheBytes = std::size_t(mb * 1048576.0);
+    par::Runtime runtime(2, "demand");
+    const rt::TraceResult result = rt::renderRays(s, cam, w, h, opt, "image-space-cached", runtime);
+    const par::RunRecord& record = runtime.record();
+    same = same && result.image.pixels == reference.pixels;
+    const double hits = counterTotal(record, "Cache/hits"), misses = counterTotal(record, "Cache/misses");
+    double fetched = 0.0, wait = 0.0;
+    for (const par::StageRecord& st : record.stages) {
+      for (const par::ChannelTraffic& c : st.channels)
+        if (c.kind == "data") fetched += double(c.bytes);
+      if (st.name == "trace")
+        for (const par::PeStageRecord& pe : st.pes) wait += pe.messageWaitSeconds;
+    }
+    std::printf("  %10.3f %9.3f %10.4f %10.0f %10.0f %12.2f %9.4f %9.2f\n", mb, record.wallSeconds,
+                hits + misses > 0 ? hits / (hits + misses) : 1.0, misses, counterTotal(record, "Cache/prefetches"), fetched * 1e-6,
+                wait, counterTotal(record, "Cache/bytes_held_at_end") * 1e-6);
+  }
+  std::printf("  images %s the sequential tracer's\n", same ? "bit-identical to" : "DIFFER from");
+  return same ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -103,6 +152,8 @@ int main(int argc, char** argv) {
   app.add_option("--repeats", repeats, "best of N runs")->check(CLI::Range(1, 100))->capture_default_str();
   app.add_option("--integrator", integrator)->check(CLI::IsMember({"whitted", "path"}))->capture_default_str();
   app.add_option("--batches", batches, "batch sizes of the sweep at P = 2")->check(CLI::Range(1, rt::kMaxRayBatch));
+  std::vector<double> cacheMb = {0.0, 0.0625, 0.25, 1.0, 4.0, 64.0};
+  app.add_option("--cache-mb", cacheMb, "image-space-cached: cache sizes of the sweep at P = 2, MiB")->check(CLI::Range(0.0, 1048576.0));
   CLI11_PARSE(app, argc, argv);
   try {
     rt::TraceOptions opt;
@@ -111,6 +162,7 @@ int main(int argc, char** argv) {
     std::printf("bench_partitioned on %u hardware threads\n", std::thread::hardware_concurrency());
     int failures = 0;
     for (const std::string& f : scenes) failures += benchScene(f, width, height, opt, repeats, batches);
+    for (const std::string& f : scenes) failures += benchCached(f, width, height, opt, repeats, cacheMb);
     return failures == 0 ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_partitioned: %s\n", e.what());
