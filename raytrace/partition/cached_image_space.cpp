@@ -100,6 +100,13 @@ std::vector<ItemSpec> groupPieces(const ObjectAssignment& a, size_t totalTriangl
   return items;
 }
 
+// The job's BVH options with the scene's alpha test (renderRays sets it; a direct render() call
+// may not), so that every item's BVH cuts the same surfaces as the sequential tracer's.
+BvhBuildOptions withAlpha(BvhBuildOptions options, const scene::Scene& s) {
+  if (!options.alpha) options.alpha = AlphaTest::forScene(s);
+  return options;
+}
+
 class CachedImageSpaceFrame {
  public:
   CachedImageSpaceFrame(const TraceJob& job, par::Runtime& rt)
@@ -109,7 +116,9 @@ class CachedImageSpaceFrame {
         specs_(groupPieces(assignment_, job.scene.triangles.size())),
         directory_(itemBounds(specs_), assignment_.margin()),
         integrator_(jobIntegrator(job)),
+        bvhOptions_(withAlpha(job.options.bvh, job.scene)),
         items_(specs_.size()),
+        itemBytes_(specs_.size(), 0),
         views_(job, rt.pes()),
         state_(size_t(rt.pes())) {}
 
@@ -118,7 +127,10 @@ class CachedImageSpaceFrame {
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       views_.build(pe.id(), assignment_.triangles(pe.id()), integrator_->context().lights());
       for (size_t i = 0; i < specs_.size(); ++i)
-        if (specs_[i].owner == pe.id()) items_[i] = makeItem(views_.of(pe.id()), specs_[i].triangles, job_.options.bvh);
+        if (specs_[i].owner == pe.id()) {
+          items_[i] = makeItem(views_.of(pe.id()), specs_[i].triangles, bvhOptions_);
+          itemBytes_[i] = items_[i]->bytes;
+        }
     });
 
     std::vector<int> owners;
@@ -135,9 +147,11 @@ class CachedImageSpaceFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     Film film(job_.filmWidth(), job_.filmHeight(), integrator_->options().spp);
     FilmAssembly assembly(rt_, film);
-    // Materials, textures, lights, the emitters and the item directory are replicated; the
-    // geometry items are not.
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
+    // Materials, textures, lights, the emitters and the item directory (bounds, owner and size
+    // of every item) are replicated; the geometry items are not.
+    if (!job_.sceneResident)
+      recordReplicatedData(rt_, job_.scene, integrator_->context().lights(),
+                           directory_.bytes() + specs_.size() * (sizeof(int) + sizeof(uint64_t)));
     std::atomic<int64_t> done{0};
     const auto total = int64_t(tiles.size());
     rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
@@ -209,8 +223,10 @@ class CachedImageSpaceFrame {
     }
     std::sort(st.wanted.begin(), st.wanted.end());
     st.wanted.erase(std::unique(st.wanted.begin(), st.wanted.end()), st.wanted.end());
+    // Not its own, not cached already, and small enough to be kept (a prefetched item the
+    // cache cannot hold would be fetched again at its use).
     std::erase_if(st.wanted, [&](par::ItemId id) {
-      return data_->owner(id) == pe.id() || data_->cache(pe.id()).contains(id);
+      return data_->owner(id) == pe.id() || data_->cache(pe.id()).contains(id) || itemBytes_[id] > job_.options.cacheBytes;
     });
     st.prefetched += st.wanted.size();
     data_->prefetch(pe, st.wanted);
@@ -241,7 +257,7 @@ class CachedImageSpaceFrame {
       if (!g.bvh.intersect(bounded, h) || (found && !h.closerThan(best))) continue;
       best = h;
       found = true;
-      si = g.interaction(ray, h);  // now: the item may leave the cache at the next acquire
+      si = g.interaction(ray, h);  // now, while this item is the one at hand
     }
     return found;
   }
@@ -284,7 +300,9 @@ class CachedImageSpaceFrame {
   std::vector<ItemSpec> specs_;
   OwnerDirectory directory_;  // over the items, replicated
   std::shared_ptr<const Integrator> integrator_;
+  BvhBuildOptions bvhOptions_;
   std::vector<ItemRef> items_;  // item i, made and read only by its owner (others fetch it)
+  std::vector<uint64_t> itemBytes_;  // part of the directory: every item's size
   SceneViews views_;
   std::vector<PeState> state_;
   par::DataManager<ItemRef>* data_ = nullptr;

@@ -99,10 +99,10 @@ TEST_CASE("PhotonMapIntegrator: sequential and image-space give the same image f
   }
 }
 
-TEST_CASE("PhotonMapIntegrator: object-space and object partitioning give the sequential image, pre-pass and all") {
+TEST_CASE("PhotonMapIntegrator: image-space-cached, object-space and object partitioning give the sequential image, pre-pass and all") {
   const scene::Scene s = cornell();
   const image::Image reference = render(s, smallSettings(), "sequential", 1, "demand");
-  for (const char* partition : {"object-space", "object"})
+  for (const char* partition : {"image-space-cached", "object-space", "object"})
     for (int pes : {1, 2, 3}) {
       CAPTURE(partition);
       CAPTURE(pes);
@@ -116,7 +116,7 @@ TEST_CASE("PhotonMapIntegrator: the partitioned pre-pass reads no geometry a PE 
   const scene::Scene s = cornell();
   const scene::Camera cam = scene::selectCamera(s, "", float(kW) / float(kH));
   const image::Image reference = render(s, smallSettings(), "sequential", 1, "demand");
-  for (const char* partition : {"object-space", "object"}) {
+  for (const char* partition : {"image-space-cached", "object-space", "object"}) {
     CAPTURE(partition);
     rt::TraceJob job{s, cam, kW, kH, {}};
     job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kW, kH, rt::IntegratorOptions{}, smallSettings());

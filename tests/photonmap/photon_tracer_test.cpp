@@ -311,7 +311,7 @@ TEST_CASE("PhotonPass: the message-passing pass stores the batch tracer's photon
   const pm::PhotonLists reference = pm::tracePhotonLists(s, bvh, options, serial);
   REQUIRE(reference.globalNormals.size() == reference.global.size());
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
-  for (const char* partition : {"sequential", "image-space", "object-space", "object"}) {
+  for (const char* partition : {"sequential", "image-space", "image-space-cached", "object-space", "object"}) {
     CAPTURE(partition);
     par::Runtime runtime(3);
     // Drive the pass through a tracer the way renderRays does for an integrator's pre-pass.

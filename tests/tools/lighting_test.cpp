@@ -30,7 +30,7 @@ std::string duck() { return pr::test::quoted(pr::test::sharedScenes() / "Duck" /
 TEST_CASE("Lighting: a model without lights is lit by the default environment in every ray tracer") {
   if (!pr::test::haveSharedScenes()) return;
   const std::filesystem::path dir = pr::test::scratchDir("lighting");
-  for (const char* method : {"sequential", "image-space", "object-space", "object"}) {
+  for (const char* method : {"sequential", "image-space", "image-space-cached", "object-space", "object"}) {
     CAPTURE(method);
     const auto r = runParrender(join({"render ", duck(), " -m ", method, " --threads 2 --width 24 --height 24 --spp 2 -o \"",
                                       (dir / (std::string(method) + ".exr")).string(), "\""}));

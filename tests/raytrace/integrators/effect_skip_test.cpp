@@ -135,7 +135,7 @@ TEST_CASE("EffectSkip: skipped work is the same for every partition and P") {
   const Bundled b = bundled("cornell.gltf");
   const scene::EffectSet effects = forced(b.plan, "shadows=off,caustics=off");
   const rt::TraceResult reference = render(b.scene, b.camera, rt::IntegratorKind::Path, effects);
-  for (const char* partition : {"image-space", "object-space", "object"}) {
+  for (const char* partition : {"image-space", "image-space-cached", "object-space", "object"}) {
     CAPTURE(partition);
     const rt::TraceResult r = render(b.scene, b.camera, rt::IntegratorKind::Path, effects, partition, 3);
     CHECK(r.image.pixels == reference.image.pixels);

@@ -79,7 +79,7 @@ TEST_CASE("EnvironmentLight: the furnace stays rho L when the plan turns indirec
 TEST_CASE("EnvironmentLight: every tracer gives the same image under an environment") {
   const scene::Scene s = furnace(0.5f, 1.0f);
   const image::Image reference = render(s, rt::IntegratorKind::Path, "sequential", 1, 4);
-  for (const char* partition : {"image-space", "object-space", "object"}) {
+  for (const char* partition : {"image-space", "image-space-cached", "object-space", "object"}) {
     CAPTURE(partition);
     CHECK(render(s, rt::IntegratorKind::Path, partition, 3, 4).pixels == reference.pixels);
   }

@@ -1,6 +1,6 @@
 // The image-space tracer with a data manager (raytrace/partition/cached_image_space.h): the
-// image is the sequential tracer's for every P and every cache size (none, 1 KiB that holds only
-// the smallest items, one that holds the largest item alone, one that holds everything), no PE reads geometry
+// image and ray counts are the sequential tracer's for every P and every cache size (none,
+// 1 KiB, half the largest item, the largest item alone, everything), no PE reads geometry
 // it neither owns nor fetched (poisoned views), and the cache figures in the run record agree
 // with the messages the DataManager counted.
 #include <doctest/doctest.h>
@@ -47,12 +47,17 @@ TEST_CASE("CachedImageSpace: the sequential image for P = 1, 2, 3 and every cach
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
   for (const rt::IntegratorKind kind : {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path}) {
     rt::TraceOptions opt = test::partitionedOptions(kind, 1, 4);
-    const image::Image reference = test::renderSequential(s, cam, 24, 24, opt);
+    par::Runtime one(1, "demand");
+    const rt::TraceResult sequential = rt::renderRays(s, cam, 24, 24, opt, "sequential", one);
+    const image::Image& reference = sequential.image;
     for (int pes : {1, 2, 3}) {
       CAPTURE(pes);
       rt::CachedImageSpacePartition partition;
       const test::PartitionedRun all = test::renderPartitioned(partition, s, cam, 24, 24, opt, pes);
       CHECK(all.image.pixels == reference.pixels);
+      CHECK(all.result.rays.cameraRays == sequential.rays.cameraRays);
+      CHECK(all.result.rays.continuationRays == sequential.rays.continuationRays);
+      CHECK(all.result.rays.shadowRays == sequential.rays.shadowRays);
       const auto largest = std::size_t(counterMax(all.record, "Cache/largest_item_bytes"));
       CHECK(largest > 0u);
       if (pes > 1) {
@@ -60,7 +65,7 @@ TEST_CASE("CachedImageSpace: the sequential image for P = 1, 2, 3 and every cach
         CHECK(counterTotal(all.record, "Cache/misses") <= double(pes) * all.figures.partitions);
         CHECK(counterTotal(all.record, "Cache/hits") > 0.0);
       }
-      for (const std::size_t bytes : {std::size_t{0}, std::size_t{1024}, largest}) {
+      for (const std::size_t bytes : {std::size_t{0}, std::size_t{1024}, largest / 2, largest}) {
         CAPTURE(bytes);
         opt.cacheBytes = bytes;
         const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 24, 24, opt, pes);

@@ -77,11 +77,11 @@ std::filesystem::path bundled(const char* name) { return test::sourceDir() / "sc
 EQUIVALENCE_AT_EVERY_P("Cornell box, Whitted, every partition and schedule = sequential",
                        Row{bundled("cornell.gltf"), rt::IntegratorKind::Whitted, 1, {"sequential", "image-space"}})
 EQUIVALENCE_AT_EVERY_P("Cornell box, path tracer, every partition and schedule = sequential",
-                       Row{bundled("cornell.gltf"), rt::IntegratorKind::Path, 2, {"image-space"}})
+                       Row{bundled("cornell.gltf"), rt::IntegratorKind::Path, 2, {"image-space", "image-space-cached"}})
 EQUIVALENCE_AT_EVERY_P("diffuse Cornell box, path tracer, every partition and schedule = sequential",
                        Row{bundled("cornell-diffuse.gltf"), rt::IntegratorKind::Path, 1, {"image-space"}})
 EQUIVALENCE_AT_EVERY_P("hot-spot scene, Whitted, every partition and schedule = sequential",
-                       Row{bundled("hotspot.gltf"), rt::IntegratorKind::Whitted, 1, {"image-space"}})
+                       Row{bundled("hotspot.gltf"), rt::IntegratorKind::Whitted, 1, {"image-space", "image-space-cached"}})
 
 // Shared glTF models: textures (BoxTextured), punctual lights and transmission
 // (LightsPunctualLamp), three schedules at every P.
@@ -90,6 +90,14 @@ TEST_CASE("Equivalence: shared BoxTextured, image-space = sequential at every P"
   for (rt::IntegratorKind kind : {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path})
     checkRow({test::sharedScenes() / "BoxTextured/glTF/BoxTextured.gltf", kind, 1, {"image-space"}}, 0,
              {"demand", "spiral", "distributed"});
+}
+
+// Alpha-cut surfaces and an anisotropic material, whose interaction reads the material and the
+// uvs: the data-managed tracer's items must cut and shade them as the whole scene does.
+TEST_CASE("Equivalence: shared AlphaBlendModeTest and AnisotropyStrengthTest, image-space-cached = sequential at every P") {
+  if (!test::haveSharedScenes()) return;
+  for (const char* model : {"AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb", "AnisotropyStrengthTest/glTF-Binary/AnisotropyStrengthTest.glb"})
+    checkRow({test::sharedScenes() / model, rt::IntegratorKind::Path, 1, {"image-space-cached"}}, 0, {"demand"});
 }
 
 TEST_CASE("Equivalence: shared LightsPunctualLamp, image-space = sequential at every P") {

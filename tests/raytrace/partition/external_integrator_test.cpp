@@ -65,7 +65,7 @@ TEST_CASE("ExternalIntegrator: the job's integrator is the one image-space, obje
   REQUIRE(constant->name() == "constant");
 
   image::Image reference;
-  for (const std::string partition : {"sequential", "image-space", "object-space", "object"}) {
+  for (const std::string partition : {"sequential", "image-space", "image-space-cached", "object-space", "object"}) {
     CAPTURE(partition);
     rt::TraceJob job{s, cam, kW, kH, rt::TraceOptions{}};
     job.options.tileSizePx = 8;
