@@ -37,6 +37,8 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   options.adaptive = r.settings.ray.adaptive;
   options.rayBatch = r.settings.ray.rayBatch;
   options.cacheBytes = std::size_t(r.settings.ray.cacheMb * 1048576.0);
+  options.dataLatencySeconds = r.settings.ray.dataLatencyUs * 1e-6;
+  options.hideLatency = !r.settings.ray.noLatencyHiding;
   options.progress = r.progress;
   rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
   const bool photonmap = r.settings.ray.integrator == "photonmap";
@@ -75,12 +77,12 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
                 std::to_string(camera) + ", continuation " + std::to_string(continuation) + ", shadow " +
                 std::to_string(shadow) + "; tasks " + std::to_string(result.tasks);
   if (name == "image-space-cached") {
-    const uint64_t hits = total("Cache/hits"), misses = total("Cache/misses");
-    const uint64_t uses = hits + misses;
+    const uint64_t hits = total("Cache/hits"), misses = total("Cache/misses"), joined = total("Cache/misses_joined");
+    const uint64_t uses = hits + misses + joined;
     char ratio[32];
     std::snprintf(ratio, sizeof ratio, "%.4f", uses > 0 ? double(hits) / double(uses) : 1.0);
     out.details += "; geometry cache " + formatBytes(options.cacheBytes) + " per PE: hits " + std::to_string(hits) +
-                   ", misses " + std::to_string(misses) + " (hit ratio " + ratio + "), prefetches " +
+                   ", misses " + std::to_string(misses) + " requested and " + std::to_string(joined) + " joined (hit ratio " + ratio + "), prefetches " +
                    std::to_string(total("Cache/prefetches")) + ", own items used " + std::to_string(total("Cache/own_item_uses"));
   }
   if (photonmap)
@@ -232,6 +234,12 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
   family.emplace_back(command.add_option("--cache-mb", ray.cacheMb, "image-space-cached: each PE's LRU cache of other PEs' geometry items, in MiB (0: none, every use of a remote item fetches it)")
                           ->check(CLI::Range(0.0, 1048576.0))
                           ->capture_default_str(),
+                      MethodFamily::Ray);
+  family.emplace_back(command.add_option("--data-latency-us", ray.dataLatencyUs, "image-space-cached: simulated one-way latency of every data message, microseconds")
+                          ->check(CLI::Range(0.0, 1e6))
+                          ->capture_default_str(),
+                      MethodFamily::Ray);
+  family.emplace_back(command.add_flag("--no-latency-hiding", ray.noLatencyHiding, "image-space-cached: a ray that needs a remote item waits for it (by default it yields to the tile's other rays)"),
                       MethodFamily::Ray);
   family.emplace_back(command.add_option("--ray-batch", ray.rayBatch, "object-space, object: rays per message to one PE (a partial batch goes when its PE runs dry)")
                           ->check(CLI::Range(1, rt::kMaxRayBatch))

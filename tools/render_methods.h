@@ -39,6 +39,8 @@ struct RayOptions {
   bool adaptive = false;
   int rayBatch = rt::kDefaultRayBatch;
   double cacheMb = double(rt::kDefaultCacheBytes) / 1048576.0;
+  double dataLatencyUs = 0.0;
+  bool noLatencyHiding = false;
   // --integrator photonmap's settings (--photons, --gather, --view, ...), and the options
   // that set them: giving one with another integrator is an input error.
   pm::PhotonMapSettings photonmap;

@@ -16,22 +16,25 @@ namespace pr::par {
 // handled channel `serving` until it comes. When another PE fails, the stage aborts and the
 // reply may never come: throws std::runtime_error naming `what` instead of waiting forever (the
 // runtime keeps the first error, so the original failure is what runStage rethrows).
+// One turn of waiting on PE pe inside a task: answers one message of `serving` if one waits,
+// else yields the core and books the time as waiting. Throws when the stage aborts.
+inline void serveOrYield(Pe& pe, ChannelBase& serving, const std::string& what) {
+  Runtime& rt = pe.runtime();
+  if (rt.aborting()) throw std::runtime_error("stage aborted while PE " + std::to_string(pe.id()) + " waited for " + what);
+  if (serving.handleOne(pe)) {
+    pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+    rt.outstanding().done();  // the waiting task is still counted, so never the last unit
+    return;
+  }
+  const double t0 = rt.now();
+  std::this_thread::yield();
+  pe.recordWait(rt.now() - t0);
+}
+
 template <class Reply>
 Reply awaitReply(Pe& pe, Channel<Reply>& replies, ChannelBase& serving, const std::string& what) {
-  Runtime& rt = pe.runtime();
   Reply reply;
-  while (!replies.tryReceive(pe, reply)) {
-    if (rt.aborting())
-      throw std::runtime_error("stage aborted while PE " + std::to_string(pe.id()) + " waited for " + what);
-    if (serving.handleOne(pe)) {
-      pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
-      rt.outstanding().done();  // the waiting task is still counted, so never the last unit
-      continue;
-    }
-    const double t0 = rt.now();
-    std::this_thread::yield();
-    pe.recordWait(rt.now() - t0);
-  }
+  while (!replies.tryReceive(pe, reply)) serveOrYield(pe, serving, what);
   return reply;
 }
 

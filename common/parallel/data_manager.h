@@ -11,6 +11,10 @@
 #include <list>
 #include <string>
 #include <unordered_map>
+#include <unordered_set>
+#include <algorithm>
+#include <stdexcept>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -140,11 +144,17 @@ class DataManager {
                   [this](Pe& owner, Request&& r) { serve(owner, r); }) {
     for (int p = 0; p < runtime.pes(); ++p) caches_.emplace_back(cacheCapacity, cacheBytes, bytes_);
     local_.resize(static_cast<std::size_t>(runtime.pes()));
+    async_.resize(static_cast<std::size_t>(runtime.pes()));
     hits_.assign(static_cast<std::size_t>(runtime.pes()), 0);
     misses_.assign(static_cast<std::size_t>(runtime.pes()), 0);
   }
 
   int owner(ItemId item) const { return owners_.owner(item); }
+
+  // A simulated one-way network latency for requests and replies: a reply is usable no sooner
+  // than 2 x latency after its request was sent (later when the owner was busy). Between
+  // stages.
+  void setLatency(double seconds) { latency_ = seconds; }
 
   // On PE pe inside a task: the item, from pe's own partition, its cache (a hit) or its owner
   // (a miss: one request and one reply message). The reference stays valid until pe's next
@@ -160,9 +170,10 @@ class DataManager {
     }
     ++misses_[pe.id()];
     pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
-    requests_.send(pe, owner, Request{item, pe.id()}, kItemRequestBytes);
+    requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
     Reply reply = awaitReply(pe);
     PR_CHECK(reply.item == item, "DataManager: a reply for another item");
+    waitUntilReady(pe, reply);
     if (!cache.fits(reply.value)) return local_[pe.id()] = std::move(reply.value);
     return cache.insert(item, std::move(reply.value));
   }
@@ -176,16 +187,76 @@ class DataManager {
       const int owner = owners_.owner(item);
       if (owner == pe.id() || caches_[pe.id()].contains(item)) continue;
       pe.counters().prefetches.fetch_add(1, std::memory_order_relaxed);
-      requests_.send(pe, owner, Request{item, pe.id()}, kItemRequestBytes);
+      requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
       ++asked;
     }
     for (; asked > 0; --asked) {
       Reply reply = awaitReply(pe);
+      waitUntilReady(pe, reply);
       if (caches_[pe.id()].fits(reply.value)) caches_[pe.id()].insert(reply.item, std::move(reply.value));
     }
   }
 
+  // Latency hiding (seed section 4.5.2): the non-blocking form of acquire for a PE that has
+  // other work (other rays, other tiles) to do while an item travels. A remote item's pointer
+  // when it is cached or has just arrived (a hit when countHit), else nullptr after sending its
+  // request unless one is out already (a miss, counted once per request; the others as
+  // joined(pe)). The pointer stays
+  // valid until pe's next awaitArrival. Items of pe's own partition go through acquire.
+  const T* tryAcquire(Pe& pe, ItemId item, bool countHit = true) {
+    Async& a = async_[pe.id()];
+    if (a.heldValid && a.heldItem == item) return &a.held;
+    if (const T* cached = caches_[pe.id()].find(item)) {
+      if (countHit) {
+        ++hits_[pe.id()];
+        pe.counters().cacheHits.fetch_add(1, std::memory_order_relaxed);
+      }
+      return cached;
+    }
+    if (a.outstanding.insert(item).second) {
+      ++misses_[pe.id()];
+      pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
+      requests_.send(pe, owners_.owner(item), Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
+    } else {
+      ++a.joined;  // a miss whose item is already on its way: no second request
+    }
+    return nullptr;
+  }
+
+  // Blocks (serving the requests sent to pe meanwhile, booked as waiting) until one of pe's
+  // outstanding items has arrived and is usable; puts it in the cache, or holds it until the
+  // next awaitArrival when it does not fit, and returns its id.
+  ItemId awaitArrival(Pe& pe) {
+    Async& a = async_[pe.id()];
+    PR_CHECK(!a.outstanding.empty(), "DataManager: awaiting an arrival with no request out");
+    a.heldValid = false;
+    a.held = T{};
+    Runtime& rt = pe.runtime();
+    for (;;) {
+      Reply reply;
+      while (items_.tryReceive(pe, reply)) a.travelling.push_back(std::move(reply));
+      auto ready = std::min_element(a.travelling.begin(), a.travelling.end(),
+                                    [](const Reply& x, const Reply& y) { return x.readyAt < y.readyAt; });
+      if (ready != a.travelling.end() && ready->readyAt <= rt.now()) {
+        Reply r = std::move(*ready);
+        a.travelling.erase(ready);
+        a.outstanding.erase(r.item);
+        if (caches_[pe.id()].fits(r.value)) {
+          caches_[pe.id()].insert(r.item, std::move(r.value));
+        } else {
+          a.held = std::move(r.value);
+          a.heldItem = r.item;
+          a.heldValid = true;
+        }
+        return r.item;
+      }
+      serveOrYield(pe, requests_, "a data item");
+    }
+  }
+
   std::uint64_t hits(int pe) const { return hits_[pe]; }
+  // tryAcquire calls that missed an item already requested (no message of their own).
+  std::uint64_t joined(int pe) const { return async_[pe].joined; }
   std::uint64_t misses(int pe) const { return misses_[pe]; }
   const DataCache<T>& cache(int pe) const { return caches_[pe]; }
 
@@ -193,20 +264,40 @@ class DataManager {
   struct Request {
     ItemId item;
     int requester;
+    double sentAt = 0.0;  // runtime time, for the simulated latency
   };
   struct Reply {
     ItemId item = 0;
     T value{};
+    double readyAt = 0.0;  // usable from this runtime time on (simulated latency)
+  };
+  // Per PE: the requests of tryAcquire still out, the replies received but still travelling
+  // (simulated latency), and the last arrival the cache could not hold.
+  struct Async {
+    std::unordered_set<ItemId> outstanding;
+    std::vector<Reply> travelling;
+    T held{};
+    ItemId heldItem = 0;
+    bool heldValid = false;
+    std::uint64_t joined = 0;
   };
 
   // On the owner's PE, in the request handler: the item from its own partition, sent back.
   void serve(Pe& owner, const Request& r) {
-    Reply reply{r.item, load_(owner, r.item)};
+    const double now = owner.runtime().now();
+    Reply reply{r.item, load_(owner, r.item), std::max(now, r.sentAt + latency_) + latency_};
     const std::size_t bytes = bytes_ ? bytes_(reply.value) : sizeof(T);
     items_.send(owner, r.requester, std::move(reply), bytes);
   }
 
   Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, requests_, "a data item"); }
+
+  // The simulated latency of a reply already received: waits (serving requests, booked as
+  // waiting) until it is usable.
+  void waitUntilReady(Pe& pe, const Reply& reply) {
+    Runtime& rt = pe.runtime();
+    while (rt.now() < reply.readyAt) serveOrYield(pe, requests_, "a data item");
+  }
 
   OwnerMap owners_;
   Loader load_;
@@ -215,6 +306,8 @@ class DataManager {
   Channel<Request> requests_;
   std::vector<DataCache<T>> caches_;  // one per PE, touched only by that PE
   std::vector<T> local_;
+  std::vector<Async> async_;  // one per PE, touched only by that PE
+  double latency_ = 0.0;
   std::vector<std::uint64_t> hits_, misses_;
 };
 

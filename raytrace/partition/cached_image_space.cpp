@@ -17,6 +17,7 @@
 #include <atomic>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "common/parallel/data_manager.h"
@@ -142,6 +143,7 @@ class CachedImageSpaceFrame {
           return items_[id];
         },
         [](const ItemRef& item) { return item->bytes; }, job_.options.cacheBytes);
+    data.setLatency(job_.options.dataLatencySeconds);
     data_ = &data;
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -161,7 +163,10 @@ class CachedImageSpaceFrame {
       integrator_->cameraRays(rect, st.queue);
       countStartRays(st.stats, st.queue);
       prefetch(pe, st);
-      traceQueue(pe, st, tile);
+      if (job_.options.hideLatency)
+        traceHidingLatency(pe, st, tile);
+      else
+        traceQueue(pe, st, tile);
       if (job_.assembleImage) assembly.deliver(pe, tile, rect, false);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
@@ -187,6 +192,7 @@ class CachedImageSpaceFrame {
       rt_.addCounter("Cache/capacity_bytes", p, double(job_.options.cacheBytes));
       rt_.addCounter("Cache/hits", p, double(data.hits(p)));
       rt_.addCounter("Cache/misses", p, double(data.misses(p)));
+      rt_.addCounter("Cache/misses_joined", p, double(data.joined(p)));
       rt_.addCounter("Cache/prefetches", p, double(st.prefetched));
       rt_.addCounter("Cache/own_item_uses", p, double(st.ownUses));
       rt_.addCounter("Cache/bytes_held_at_end", p, double(data.cache(p).usedBytes()));
@@ -291,6 +297,108 @@ class CachedImageSpaceFrame {
         st.queue.push_back(r);
       }
       spawned.clear();
+    }
+  }
+
+  // A ray of the latency-hiding loop, with its walk through the item directory so far: parked
+  // at an item that is on its way, it resumes there, so every arrival advances the rays that
+  // waited for it (no ray restarts, none can starve, whatever the cache size).
+  struct WalkingRay {
+    RayMessage message;
+    std::vector<OwnerDirectory::NodeEntry> heap;
+    bool started = false;
+    bool parked = false;  // `at` is the item it waits for, already taken from the walk
+    OwnerEntry at;
+    Hit best;
+    bool found = false;
+    SurfaceInteraction si;
+  };
+
+  // The tile's rays as threads (seed section 4.5.2): a ray that needs an item on its way is
+  // parked and the PE goes on with the tile's other rays; only when every ray waits does it wait
+  // for the next arrival, and then resumes the rays that waited for that item.
+  void traceHidingLatency(par::Pe& pe, PeState& st, Film& film) {
+    std::vector<WalkingRay> ready;
+    std::unordered_map<par::ItemId, std::vector<WalkingRay>> parked;
+    size_t waiting = 0;
+    for (const RayMessage& m : st.queue) ready.push_back(WalkingRay{m});
+    st.queue.clear();
+    std::vector<RayMessage> spawned;
+    Emit emit(film, spawned, st.stats, pe.id());
+    for (;;) {
+      if (ready.empty()) {
+        if (waiting == 0) return;
+        const par::ItemId arrived = data_->awaitArrival(pe);
+        auto it = parked.find(arrived);
+        if (it == parked.end()) continue;  // a prefetch's or an earlier ray's request
+        waiting -= it->second.size();
+        for (WalkingRay& w : it->second) ready.push_back(std::move(w));
+        parked.erase(it);
+        continue;
+      }
+      WalkingRay w = std::move(ready.back());
+      ready.pop_back();
+      if (!step(pe, st, w)) {
+        const auto item = par::ItemId(w.at.owner);
+        parked[item].push_back(std::move(w));
+        ++waiting;
+        continue;
+      }
+      const RayMessage& m = w.message;
+      if (m.kind == RayKind::Shadow) {
+        if (!w.found) integrator_->miss(m, emit);
+      } else if (w.found) {
+        integrator_->shade(w.si, m, emit);
+      } else {
+        integrator_->miss(m, emit);
+      }
+      for (const RayMessage& r : spawned) {
+        ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
+        ready.push_back(WalkingRay{r});
+      }
+      spawned.clear();
+    }
+  }
+
+  // Walks the ray on through the items until it is done (true; for a shadow ray `found` means
+  // occluded) or needs an item that is not here (false: parked at `at`, its request sent).
+  bool step(par::Pe& pe, PeState& st, WalkingRay& w) {
+    const bool shadow = w.message.kind == RayKind::Shadow;
+    OwnerDirectory::NearestFirst walk(directory_, w.message.ray, -1, w.heap, w.started);
+    w.started = true;
+    for (;;) {
+      bool resumed = false;
+      if (w.parked) {
+        w.parked = false;
+        resumed = true;
+      } else if (!walk.next(w.found && !shadow ? w.best.t : kInfinity, w.at)) {
+        return true;
+      }
+      const auto id = par::ItemId(w.at.owner);
+      const GeometryItem* g = nullptr;
+      if (specs_[id].owner == pe.id()) {
+        ++st.ownUses;
+        g = items_[id].get();
+      } else if (const ItemRef* ref = data_->tryAcquire(pe, id, !resumed)) {
+        g = ref->get();
+      } else {
+        w.parked = true;
+        return false;
+      }
+      if (shadow) {
+        if (g->bvh.occluded(w.message.ray)) {
+          w.found = true;
+          return true;
+        }
+        continue;
+      }
+      Ray bounded = w.message.ray;
+      if (w.found) bounded.tMax = w.best.t;  // inclusive: an equal t with a lower triangle still wins
+      Hit h;
+      if (!g->bvh.intersect(bounded, h) || (w.found && !h.closerThan(w.best))) continue;
+      w.best = h;
+      w.found = true;
+      w.si = g->interaction(w.message.ray, h);
     }
   }
 

@@ -70,8 +70,9 @@ void OwnerDirectory::build(uint32_t node, uint32_t begin, uint32_t end) {
 // Nodes in order of their entry (a heap): a node's entry is no farther than its children's,
 // so owners come out nearest first.
 OwnerDirectory::NearestFirst::NearestFirst(const OwnerDirectory& directory, const Ray& ray, int except,
-                                           std::vector<NodeEntry>& heap)
+                                           std::vector<NodeEntry>& heap, bool resume)
     : directory_(directory), slabs_(ray), except_(except), heap_(heap) {
+  if (resume) return;
   heap_.clear();
   if (!directory_.nodes_.empty()) push(0);
 }

@@ -45,7 +45,9 @@ class OwnerDirectory {
   // cheap form when the search stops at the closest hit.
   class NearestFirst {
    public:
-    NearestFirst(const OwnerDirectory& directory, const Ray& ray, int except, std::vector<NodeEntry>& heap);
+    // resume: continue a walk of the same ray whose state is `heap` (a walk parked midway).
+    NearestFirst(const OwnerDirectory& directory, const Ray& ray, int except, std::vector<NodeEntry>& heap,
+                 bool resume = false);
     // The next owner whose entry is no farther than maxT; false when there is none.
     bool next(float maxT, OwnerEntry& out);
 

@@ -40,6 +40,11 @@ struct TraceOptions {
   int rayBatch = kDefaultRayBatch;
   // image-space-cached: each PE's cache of other PEs' geometry items, in bytes (LRU).
   std::size_t cacheBytes = kDefaultCacheBytes;
+  // image-space-cached: a simulated one-way latency of every data message, in seconds, and
+  // whether a ray that waits for an item yields to the tile's other rays (latency hiding, seed
+  // section 4.5.2) instead of the PE waiting for the reply.
+  double dataLatencySeconds = 0.0;
+  bool hideLatency = true;
   BvhBuildOptions bvh;
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.

@@ -6,7 +6,9 @@
 // a check that every image equals the sequential tracer's bit for bit. Then the image-space
 // tracer with a data manager (image-space-cached): its P = 1 and P = 2 times beside
 // image-space's, and at P = 2 the cache hit ratio, misses, prefetches, bytes fetched and time
-// waiting for items for each cache size. Figures come from the runtime's run record; ratios
+// waiting for items for each cache size, and at simulated network latencies the wall time with
+// and without latency hiding (a ray waiting for an item yields to the tile's other rays).
+// Figures come from the runtime's run record; ratios
 // are measured in the same run.
 #include <algorithm>
 #include <cstdio>
@@ -99,7 +101,8 @@ double counterTotal(const par::RunRecord& record, const std::string& name) {
   return sum;
 }
 
-int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int repeats, const std::vector<double>& cacheMb) {
+int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int repeats, const std::vector<double>& cacheMb,
+                const std::vector<double>& latencyUs) {
   const scene::Scene s = scene::loadGltf(file);
   const scene::Camera cam = scene::selectCamera(s, "", float(w) / float(h));
   par::Runtime sequential(1, "demand");
@@ -122,6 +125,7 @@ int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int
     const par::RunRecord& record = runtime.record();
     same = same && result.image.pixels == reference.pixels;
     const double hits = counterTotal(record, "Cache/hits"), misses = counterTotal(record, "Cache/misses");
+    const double joined = counterTotal(record, "Cache/misses_joined");
     double fetched = 0.0, wait = 0.0;
     for (const par::StageRecord& st : record.stages) {
       for (const par::ChannelTraffic& c : st.channels)
@@ -130,8 +134,28 @@ int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int
         for (const par::PeStageRecord& pe : st.pes) wait += pe.messageWaitSeconds;
     }
     std::printf("  %10.3f %9.3f %10.4f %10.0f %10.0f %12.2f %9.4f %9.2f\n", mb, record.wallSeconds,
-                hits + misses > 0 ? hits / (hits + misses) : 1.0, misses, counterTotal(record, "Cache/prefetches"), fetched * 1e-6,
+                hits + misses + joined > 0 ? hits / (hits + misses + joined) : 1.0, misses, counterTotal(record, "Cache/prefetches"), fetched * 1e-6,
                 wait, counterTotal(record, "Cache/bytes_held_at_end") * 1e-6);
+  }
+  // Latency hiding at a simulated network latency: a cache that misses often (1 MiB), the
+  // tile's rays as threads against every ray waiting for its item.
+  opt.cacheBytes = std::size_t{1} << 20;
+  std::printf("  simulated latency at P=2, 1 MiB cache: wall time with latency hiding / waiting for each item\n");
+  for (double us : latencyUs) {
+    double seconds[2] = {0.0, 0.0}, wait[2] = {0.0, 0.0};
+    for (int hide = 0; hide < 2; ++hide) {
+      opt.dataLatencySeconds = us * 1e-6;
+      opt.hideLatency = hide == 1;
+      par::Runtime runtime(2, "demand");
+      const rt::TraceResult result = rt::renderRays(s, cam, w, h, opt, "image-space-cached", runtime);
+      same = same && result.image.pixels == reference.pixels;
+      seconds[hide] = runtime.record().wallSeconds;
+      for (const par::StageRecord& st : runtime.record().stages)
+        if (st.name == "trace")
+          for (const par::PeStageRecord& pe : st.pes) wait[hide] += pe.messageWaitSeconds;
+    }
+    std::printf("  %8.0f us: %8.3f s (waiting %.3f s) / %8.3f s (waiting %.3f s): %.1fx faster\n", us, seconds[1], wait[1],
+                seconds[0], wait[0], seconds[0] / seconds[1]);
   }
   std::printf("  images %s the sequential tracer's\n", same ? "bit-identical to" : "DIFFER from");
   return same ? 0 : 1;
@@ -153,6 +177,9 @@ int main(int argc, char** argv) {
   app.add_option("--integrator", integrator)->check(CLI::IsMember({"whitted", "path"}))->capture_default_str();
   app.add_option("--batches", batches, "batch sizes of the sweep at P = 2")->check(CLI::Range(1, rt::kMaxRayBatch));
   std::vector<double> cacheMb = {0.0, 0.0625, 0.25, 1.0, 4.0, 64.0};
+  std::vector<double> latencyUs = {0.0, 50.0, 200.0};
+  app.add_option("--latency-us", latencyUs, "image-space-cached: simulated one-way latencies of the latency-hiding runs, microseconds")
+      ->check(CLI::Range(0.0, 1e6));
   app.add_option("--cache-mb", cacheMb, "image-space-cached: cache sizes of the sweep at P = 2, MiB")->check(CLI::Range(0.0, 1048576.0));
   CLI11_PARSE(app, argc, argv);
   try {
@@ -162,7 +189,7 @@ int main(int argc, char** argv) {
     std::printf("bench_partitioned on %u hardware threads\n", std::thread::hardware_concurrency());
     int failures = 0;
     for (const std::string& f : scenes) failures += benchScene(f, width, height, opt, repeats, batches);
-    for (const std::string& f : scenes) failures += benchCached(f, width, height, opt, repeats, cacheMb);
+    for (const std::string& f : scenes) failures += benchCached(f, width, height, opt, repeats, cacheMb, latencyUs);
     return failures == 0 ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_partitioned: %s\n", e.what());

@@ -11,11 +11,12 @@ build_dir="${1:-$source_dir/build-tsan}"
 jobs="${JOBS:-2}"
 
 # Every runtime test case starts with one of these concept names (tests/common/parallel), plus
-# RayBatches (raytrace/partition): the partitioned tracers with batched rays; TilePull
+# RayBatches and CachedImageSpace (raytrace/partition): the partitioned tracers with batched
+# rays, the data-managed tracer with latency hiding; TilePull
 # (raster/sort): PEs waiting on each other's messages inside a task, and the abort;
 # GatherToRoot and PhotonPass (photonmap): per-PE results written during a pre-pass program
 # in every tracer and merged on PE 0.
-runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*"
+runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*"
 
 cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests

@@ -116,3 +116,32 @@ TEST_CASE("CachedImageSpace: each PE holds only its own items; P = 1 moves nothi
     if (pes == 1) CHECK(channelMessages(run.record, "data") == 0u);
   }
 }
+
+TEST_CASE("CachedImageSpace: latency hiding and a simulated latency keep the sequential image and counts") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 1, 4);
+  par::Runtime one(1, "demand");
+  const rt::TraceResult sequential = rt::renderRays(s, cam, 16, 16, opt, "sequential", one);
+  rt::CachedImageSpacePartition partition;
+  const std::size_t largest =
+      std::size_t(counterMax(test::renderPartitioned(partition, s, cam, 16, 16, opt, 2).record, "Cache/largest_item_bytes"));
+  for (const bool hide : {false, true})
+    for (const double latency : {0.0, 20e-6})
+      for (const std::size_t bytes : {std::size_t{0}, largest, rt::kDefaultCacheBytes})
+        for (int pes : {2, 3}) {
+          CAPTURE(hide);
+          CAPTURE(latency);
+          CAPTURE(bytes);
+          CAPTURE(pes);
+          opt.hideLatency = hide;
+          opt.dataLatencySeconds = latency;
+          opt.cacheBytes = bytes;
+          const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 16, 16, opt, pes);
+          CHECK(run.image.pixels == sequential.image.pixels);
+          CHECK(run.result.rays.total() == sequential.rays.total());
+          const double fetches = counterTotal(run.record, "Cache/misses") + counterTotal(run.record, "Cache/prefetches");
+          CHECK(double(channelMessages(run.record, "data")) == fetches);
+          CHECK(counterMax(run.record, "Cache/bytes_held_at_end") <= double(bytes));
+        }
+}
