@@ -16,25 +16,33 @@ namespace pr::par {
 // handled channel `serving` until it comes. When another PE fails, the stage aborts and the
 // reply may never come: throws std::runtime_error naming `what` instead of waiting forever (the
 // runtime keeps the first error, so the original failure is what runStage rethrows).
-// One turn of waiting on PE pe inside a task: answers one message of `serving` if one waits,
-// else yields the core and books the time as waiting. Throws when the stage aborts.
-inline void serveOrYield(Pe& pe, ChannelBase& serving, const std::string& what) {
+// On PE pe inside a task: polls done() until it returns true, answering the messages of the
+// handled channel `serving` meanwhile. A turn that neither finished nor answered a message
+// (the poll and the yield) is booked as waiting (Pe::recordWait); answering is busy. Throws
+// std::runtime_error naming `what` when the stage aborts.
+template <class Done>
+void waitUntil(Pe& pe, ChannelBase& serving, const std::string& what, Done&& done) {
   Runtime& rt = pe.runtime();
-  if (rt.aborting()) throw std::runtime_error("stage aborted while PE " + std::to_string(pe.id()) + " waited for " + what);
-  if (serving.handleOne(pe)) {
-    pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
-    rt.outstanding().done();  // the waiting task is still counted, so never the last unit
-    return;
+  double t0 = rt.now();
+  while (!done()) {
+    if (rt.aborting()) throw std::runtime_error("stage aborted while PE " + std::to_string(pe.id()) + " waited for " + what);
+    if (serving.handleOne(pe)) {
+      pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+      rt.outstanding().done();  // the waiting task is still counted, so never the last unit
+      t0 = rt.now();
+      continue;
+    }
+    std::this_thread::yield();
+    const double t1 = rt.now();
+    pe.recordWait(t1 - t0);
+    t0 = t1;
   }
-  const double t0 = rt.now();
-  std::this_thread::yield();
-  pe.recordWait(rt.now() - t0);
 }
 
 template <class Reply>
 Reply awaitReply(Pe& pe, Channel<Reply>& replies, ChannelBase& serving, const std::string& what) {
   Reply reply;
-  while (!replies.tryReceive(pe, reply)) serveOrYield(pe, serving, what);
+  waitUntil(pe, serving, what, [&] { return replies.tryReceive(pe, reply); });
   return reply;
 }
 

@@ -232,26 +232,27 @@ class DataManager {
     a.heldValid = false;
     a.held = T{};
     Runtime& rt = pe.runtime();
-    for (;;) {
+    ItemId arrived = 0;
+    waitUntil(pe, requests_, kWhat, [&] {
       Reply reply;
       while (items_.tryReceive(pe, reply)) a.travelling.push_back(std::move(reply));
       auto ready = std::min_element(a.travelling.begin(), a.travelling.end(),
                                     [](const Reply& x, const Reply& y) { return x.readyAt < y.readyAt; });
-      if (ready != a.travelling.end() && ready->readyAt <= rt.now()) {
-        Reply r = std::move(*ready);
-        a.travelling.erase(ready);
-        a.outstanding.erase(r.item);
-        if (caches_[pe.id()].fits(r.value)) {
-          caches_[pe.id()].insert(r.item, std::move(r.value));
-        } else {
-          a.held = std::move(r.value);
-          a.heldItem = r.item;
-          a.heldValid = true;
-        }
-        return r.item;
+      if (ready == a.travelling.end() || ready->readyAt > rt.now()) return false;
+      Reply r = std::move(*ready);
+      a.travelling.erase(ready);
+      a.outstanding.erase(r.item);
+      if (caches_[pe.id()].fits(r.value)) {
+        caches_[pe.id()].insert(r.item, std::move(r.value));
+      } else {
+        a.held = std::move(r.value);
+        a.heldItem = r.item;
+        a.heldValid = true;
       }
-      serveOrYield(pe, requests_, "a data item");
-    }
+      arrived = r.item;
+      return true;
+    });
+    return arrived;
   }
 
   std::uint64_t hits(int pe) const { return hits_[pe]; }
@@ -290,13 +291,14 @@ class DataManager {
     items_.send(owner, r.requester, std::move(reply), bytes);
   }
 
-  Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, requests_, "a data item"); }
+  inline static const std::string kWhat = "a data item";
+  Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, requests_, kWhat); }
 
   // The simulated latency of a reply already received: waits (serving requests, booked as
   // waiting) until it is usable.
   void waitUntilReady(Pe& pe, const Reply& reply) {
     Runtime& rt = pe.runtime();
-    while (rt.now() < reply.readyAt) serveOrYield(pe, requests_, "a data item");
+    waitUntil(pe, requests_, kWhat, [&] { return rt.now() >= reply.readyAt; });
   }
 
   OwnerMap owners_;
