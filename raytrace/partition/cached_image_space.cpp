@@ -163,10 +163,7 @@ class CachedImageSpaceFrame {
       integrator_->cameraRays(rect, st.queue);
       countStartRays(st.stats, st.queue);
       prefetch(pe, st);
-      if (job_.options.hideLatency)
-        traceHidingLatency(pe, st, tile);
-      else
-        traceQueue(pe, st, tile);
+      traceTile(pe, st, tile);
       if (job_.assembleImage) assembly.deliver(pe, tile, rect, false);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
@@ -238,72 +235,11 @@ class CachedImageSpaceFrame {
     data_->prefetch(pe, st.wanted);
   }
 
-  // An item of this PE's own partition is read in place; another PE's goes through the
-  // DataManager (cache or owner).
-  const GeometryItem& item(par::Pe& pe, PeState& st, par::ItemId id) {
-    if (specs_[id].owner == pe.id()) {
-      ++st.ownUses;
-      return *items_[id];
-    }
-    return *data_->acquire(pe, id);
-  }
-
-  // The closest hit over the items the ray reaches, nearest first.
-  bool closest(par::Pe& pe, PeState& st, const Ray& ray, SurfaceInteraction& si) {
-    OwnerDirectory::NearestFirst walk(directory_, ray, -1, st.heap);
-    Hit best;
-    bool found = false;
-    OwnerEntry e;
-    // Items whose entry is no farther than the best hit so far (every other starts farther).
-    while (walk.next(found ? best.t : kInfinity, e)) {
-      const GeometryItem& g = item(pe, st, par::ItemId(e.owner));
-      Ray bounded = ray;
-      if (found) bounded.tMax = best.t;  // inclusive: an equal t with a lower triangle still wins
-      Hit h;
-      if (!g.bvh.intersect(bounded, h) || (found && !h.closerThan(best))) continue;
-      best = h;
-      found = true;
-      si = g.interaction(ray, h);  // now, while this item is the one at hand
-    }
-    return found;
-  }
-
-  bool occluded(par::Pe& pe, PeState& st, const Ray& ray) {
-    OwnerDirectory::NearestFirst walk(directory_, ray, -1, st.heap);
-    OwnerEntry e;
-    while (walk.next(kInfinity, e))
-      if (item(pe, st, par::ItemId(e.owner)).bvh.occluded(ray)) return true;
-    return false;
-  }
-
-  // The tile's rays and all they spawn, depth first, on this PE.
-  void traceQueue(par::Pe& pe, PeState& st, Film& film) {
-    std::vector<RayMessage> spawned;
-    Emit emit(film, spawned, st.stats, pe.id());
-    while (!st.queue.empty()) {
-      const RayMessage m = st.queue.back();
-      st.queue.pop_back();
-      if (m.kind == RayKind::Shadow) {
-        if (!occluded(pe, st, m.ray)) integrator_->miss(m, emit);
-      } else {
-        SurfaceInteraction si;
-        if (closest(pe, st, m.ray, si))
-          integrator_->shade(si, m, emit);
-        else
-          integrator_->miss(m, emit);
-      }
-      for (const RayMessage& r : spawned) {
-        ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
-        st.queue.push_back(r);
-      }
-      spawned.clear();
-    }
-  }
-
-  // A ray of the latency-hiding loop, with its walk through the item directory so far: parked
-  // at an item that is on its way, it resumes there, so every arrival advances the rays that
-  // waited for it (no ray restarts, none can starve, whatever the cache size).
+  // A ray of the tile, with its walk through the item directory so far: parked at an item that
+  // is on its way, it resumes there, so every arrival advances the rays that waited for it (no
+  // ray restarts, none can starve, whatever the cache size).
   struct WalkingRay {
+    explicit WalkingRay(const RayMessage& m) : message(m) {}
     RayMessage message;
     std::vector<OwnerDirectory::NodeEntry> heap;
     bool started = false;
@@ -314,14 +250,15 @@ class CachedImageSpaceFrame {
     SurfaceInteraction si;
   };
 
-  // The tile's rays as threads (seed section 4.5.2): a ray that needs an item on its way is
-  // parked and the PE goes on with the tile's other rays; only when every ray waits does it wait
-  // for the next arrival, and then resumes the rays that waited for that item.
-  void traceHidingLatency(par::Pe& pe, PeState& st, Film& film) {
+  // The tile's rays and all they spawn, depth first. With latency hiding they are threads (seed
+  // section 4.5.2): a ray that needs an item on its way is parked and the PE goes on with the
+  // tile's other rays; only when every ray waits does it wait for the next arrival, and then
+  // resumes the rays that waited for that item. Without, a ray waits for its item in place.
+  void traceTile(par::Pe& pe, PeState& st, Film& film) {
     std::vector<WalkingRay> ready;
     std::unordered_map<par::ItemId, std::vector<WalkingRay>> parked;
     size_t waiting = 0;
-    for (const RayMessage& m : st.queue) ready.push_back(WalkingRay{m});
+    for (const RayMessage& m : st.queue) ready.emplace_back(m);
     st.queue.clear();
     std::vector<RayMessage> spawned;
     Emit emit(film, spawned, st.stats, pe.id());
@@ -354,14 +291,15 @@ class CachedImageSpaceFrame {
       }
       for (const RayMessage& r : spawned) {
         ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
-        ready.push_back(WalkingRay{r});
+        ready.emplace_back(r);
       }
       spawned.clear();
     }
   }
 
   // Walks the ray on through the items until it is done (true; for a shadow ray `found` means
-  // occluded) or needs an item that is not here (false: parked at `at`, its request sent).
+  // occluded) or, with latency hiding, needs an item that is not here (false: parked at `at`,
+  // its request sent).
   bool step(par::Pe& pe, PeState& st, WalkingRay& w) {
     const bool shadow = w.message.kind == RayKind::Shadow;
     OwnerDirectory::NearestFirst walk(directory_, w.message.ray, -1, w.heap, w.started);
@@ -379,6 +317,8 @@ class CachedImageSpaceFrame {
       if (specs_[id].owner == pe.id()) {
         ++st.ownUses;
         g = items_[id].get();
+      } else if (!job_.options.hideLatency) {
+        g = data_->acquire(pe, id).get();
       } else if (const ItemRef* ref = data_->tryAcquire(pe, id, !resumed)) {
         g = ref->get();
       } else {
