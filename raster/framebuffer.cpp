@@ -31,6 +31,16 @@ void PixelWindow::clear() const {
   }
 }
 
+void PixelWindow::clearKeys() const {
+  const size_t w = static_cast<size_t>(rect.width());
+  for (int y = 0; y < rect.height(); ++y) std::fill_n(keys + static_cast<size_t>(y) * stride, w, kClearKey);
+}
+
+void PixelWindow::clearColours() const {
+  const size_t w = static_cast<size_t>(rect.width());
+  for (int y = 0; y < rect.height(); ++y) std::fill_n(colours + static_cast<size_t>(y) * stride, w, glm::vec3(0.0f));
+}
+
 PixelWindow RegionFramebuffer::window(const Rect& r) {
   PR_CHECK(r.empty() || intersect(r, rect_) == r, "RegionFramebuffer::window: rectangle outside the buffer");
   if (r.empty()) return PixelWindow{r, static_cast<size_t>(rect_.width()), nullptr, nullptr, nullptr};

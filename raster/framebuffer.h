@@ -36,6 +36,10 @@ struct PixelWindow {
   }
   // The cleared state (no fragment, no triangle, colour 0) for every pixel of rect.
   void clear() const;
+  // Parts of it, for a buffer whose owner knows the rest needs none: the keys only (no
+  // fragment; a triangle index means nothing where the key is clear), or the colours only.
+  void clearKeys() const;
+  void clearColours() const;
 };
 
 class RegionFramebuffer {

@@ -21,6 +21,13 @@ struct Rect {
 
 Rect intersect(const Rect& a, const Rect& b);
 bool overlaps(const Rect& a, const Rect& b);
+// The smallest rectangle holding both (an empty one adds nothing). Inline: sort-last calls it
+// once per rasterized triangle.
+inline Rect enclose(const Rect& a, const Rect& b) {
+  if (a.empty()) return b.empty() ? Rect{} : b;
+  if (b.empty()) return a;
+  return Rect{a.x0 < b.x0 ? a.x0 : b.x0, a.y0 < b.y0 ? a.y0 : b.y0, a.x1 > b.x1 ? a.x1 : b.x1, a.y1 > b.y1 ? a.y1 : b.y1};
+}
 
 // Square tiles of tileSizePx (the last row and column may be smaller), in row-major order.
 std::vector<Rect> tileRegions(int width, int height, int tileSizePx);

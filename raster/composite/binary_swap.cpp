@@ -29,7 +29,8 @@ class BinarySwap : public Compositor {
  public:
   std::string_view name() const override { return "binary-swap"; }
 
-  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,
+                              bool sparse) override {
     const int pes = rt.pes();
     if (!std::has_single_bit(static_cast<unsigned>(pes)))
       throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +
@@ -44,21 +45,21 @@ class BinarySwap : public Compositor {
       par::Channel<PixelMessage> pixels(rt, "binary-swap pixels", par::MessageKind::Pixels);
       rt.runOnEachPe("binary-swap round " + std::to_string(k), [&](par::Pe& pe) {
                     const int p = pe.id();
-                    for (const PixelMessage& m : inbox[p]) mergePixels(m, buffers[p]);
+                    for (const PixelMessage& m : inbox[p]) mergePixels(m, buffers[p], drawn[p]);
                     inbox[p].clear();
                     const auto [lower, upper] = halves(kept[p]);
                     const bool keepLower = ((p >> k) & 1) == 0;
-                    PixelMessage m = packPixels(buffers[p], keepLower ? upper : lower, sparse);
+                    PixelMessage m = packPixels(buffers[p], keepLower ? upper : lower, drawn[p], sparse);
                     kept[p] = keepLower ? lower : upper;
-                    if (sparse && m.pixels() == 0) return;  // nothing covered there: no message
-                    const size_t bytes = m.bytes(sparse);
+                    if (sparse && m.pixels() == 0) return;  // nothing drawn there: no message
+                    const size_t bytes = m.bytes();
                     counters[p].count(m, bytes);
                     pixels.send(pe, p ^ (1 << k), std::move(m), bytes);
                   });
       for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
     }
     rt.runOnEachPe("binary-swap merge", [&](par::Pe& pe) {
-      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
+      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()], drawn[pe.id()]);
     });
     recordCompositeTallies(rt, counters);
     return kept;

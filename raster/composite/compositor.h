@@ -1,7 +1,7 @@
-// Compositor: the redistribution step of sort-last. Every PE holds a full-screen colour+depth
-// framebuffer of its own primitives; compositing moves pixels between PEs as counted messages
-// until each screen pixel has met every PE's fragment there and kept the nearest key (depth
-// compositing, depth_resolve.h). direct_send.cpp: each PE sends each region straight to its
+// Compositor: the redistribution step of sort-last. Every PE holds a full-screen depth buffer
+// of its own primitives' fragments; compositing moves fragment keys between PEs as counted
+// messages until each screen pixel has met every PE's fragment there and kept the nearest key
+// (depth compositing, depth_resolve.h), which the region's owner then shades. direct_send.cpp: each PE sends each region straight to its
 // owner; binary_swap.cpp: log2 P pairwise exchanges of halves (Ma et al. 1994); one line each
 // in registry.cpp.
 #pragma once
@@ -19,28 +19,30 @@
 
 namespace pr::raster {
 
-// Bytes per pixel on the wire: full frame = depth key (8) + colour (3 floats, 12); sparse adds
-// the pixel's 4-byte index inside the message rectangle. Message headers are not counted, so
+// Bytes per pixel on the wire: the fragment's depth key (8; it names the primitive, so the
+// region's owner shades it after compositing). Message headers are not counted, so
 // full-frame volumes equal the analytic b * A * (1 - 1/P) exactly.
-inline constexpr size_t kFullPixelBytes = sizeof(uint64_t) + sizeof(glm::vec3);
-inline constexpr size_t kSparsePixelBytes = kFullPixelBytes + sizeof(uint32_t);
+inline constexpr size_t kPixelBytes = sizeof(uint64_t);
 
-// Pixels of one rectangle of a PE's framebuffer. Full: every pixel in row-major order (index
-// empty). Sparse: only covered pixels, index = row-major position inside rect.
+// Pixels of one rectangle of a PE's framebuffer, every pixel in row-major order. `drawn` is the
+// part of rect where the sender's buffer may hold fragments (outside it every pixel is clear,
+// so the receiver skips it). Full frame: rect is the whole region. Sparse: rect is the
+// region's bounding rectangle of what the sender drew (Ma et al. 1994), rect == drawn.
 struct PixelMessage {
   Rect rect;
-  std::vector<uint32_t> index;
+  Rect drawn;
   std::vector<uint64_t> keys;
-  std::vector<glm::vec3> colours;
 
   size_t pixels() const { return keys.size(); }
-  size_t bytes(bool sparse) const { return pixels() * (sparse ? kSparsePixelBytes : kFullPixelBytes); }
+  size_t bytes() const { return pixels() * kPixelBytes; }
 };
 
-// The part of fb inside rect, as the sending PE packs it.
-PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool sparse);
-// Depth-composites a received message into dst (the receiver's own buffer), where they overlap.
-void mergePixels(const PixelMessage& message, RegionFramebuffer& dst);
+// The part of fb inside region, as the sending PE packs it; drawn bounds the pixels of fb
+// that may hold fragments (every other pixel is clear).
+PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& region, const Rect& drawn, bool sparse);
+// Depth-composites a received message into dst (the receiver's own buffer), where they overlap,
+// and widens dstDrawn (the receiver's bounding rectangle of drawn pixels) by what it stored.
+void mergePixels(const PixelMessage& message, RegionFramebuffer& dst, Rect& dstDrawn);
 
 // Compositing traffic of one PE, kept while the compositor's stages run and then put in the
 // run record per PE (Sort/pixels_sent, Sort/composite_messages, Sort/composite_bytes: what
@@ -60,13 +62,13 @@ class Compositor {
   virtual ~Compositor() = default;
   virtual std::string_view name() const = 0;  // "direct-send" | "binary-swap"
   // Called by the controlling thread after every PE has rendered and shaded into buffers[pe]
-  // (full screen each); runs its own stages, merging received pixels into the receiver's own
-  // buffer. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
+  // (full screen each; every pixel outside drawn[pe] is clear); runs its own stages, merging
+  // received pixels into the receiver's own buffer and widening its drawn[pe] by them. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
   // (disjoint rectangles that cover the screen; empty for a PE left without one).
   // Each PE's traffic goes to the run record (recordCompositeTallies). Throws pr::InputError
   // when the method cannot run with this PE count.
   virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers,
-                                      bool sparse) = 0;
+                                      std::vector<Rect>& drawn, bool sparse) = 0;
 };
 
 // Factories, one per compositor file.

@@ -13,64 +13,36 @@
 
 namespace pr::raster {
 
-PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& rect, bool sparse) {
+PixelMessage packPixels(const RegionFramebuffer& fb, const Rect& region, const Rect& drawn, bool sparse) {
   PixelMessage m;
-  m.rect = intersect(fb.rect(), rect);
+  const Rect inside = intersect(fb.rect(), region);
+  m.drawn = intersect(inside, drawn);
+  m.rect = sparse ? m.drawn : inside;
   const Rect& r = m.rect;
-  if (!sparse) {
-    // Full frame: every pixel, row by row.
-    const size_t w = static_cast<size_t>(r.width());
-    m.keys.resize(static_cast<size_t>(r.area()));
-    m.colours.resize(static_cast<size_t>(r.area()));
-    for (int y = r.y0; y < r.y1; ++y) {
-      const size_t row = static_cast<size_t>(y - r.y0) * w;
-      std::copy_n(fb.keys() + fb.index(r.x0, y), w, m.keys.data() + row);
-      std::copy_n(fb.colours() + fb.index(r.x0, y), w, m.colours.data() + row);
-    }
-    return m;
-  }
-  for (int y = r.y0; y < r.y1; ++y) {
-    for (int x = r.x0; x < r.x1; ++x) {
-      const size_t i = fb.index(x, y);
-      if (!keyCovered(fb.keys()[i])) continue;
-      m.index.push_back(static_cast<uint32_t>((y - r.y0) * r.width() + (x - r.x0)));
-      m.keys.push_back(fb.keys()[i]);
-      m.colours.push_back(fb.colours()[i]);
-    }
-  }
+  const size_t w = static_cast<size_t>(r.width());
+  m.keys.resize(static_cast<size_t>(r.area()));
+  for (int y = r.y0; y < r.y1; ++y)
+    std::copy_n(fb.keys() + fb.index(r.x0, y), w, m.keys.data() + static_cast<size_t>(y - r.y0) * w);
   return m;
 }
 
-namespace {
-
-// Keeps (key, colour) at dst's pixel i when it beats what is there.
-inline void mergePixel(RegionFramebuffer& dst, size_t i, uint64_t key, const glm::vec3& colour) {
-  if (!depthTest(dst.keys()[i], key)) return;
-  dst.keys()[i] = key;
-  dst.colours()[i] = colour;
-  dst.triangles()[i] = kNoTriangle;
-}
-
-}  // namespace
-
-void mergePixels(const PixelMessage& m, RegionFramebuffer& dst) {
+void mergePixels(const PixelMessage& m, RegionFramebuffer& dst, Rect& dstDrawn) {
+  // Only the sender's drawn part can win the depth test: the rest of the message is clear.
+  const Rect both = intersect(m.drawn, dst.rect());
+  if (both.empty()) return;
   const Rect& r = m.rect;
-  if (m.index.empty() && m.pixels() == static_cast<size_t>(r.area())) {
-    // Full frame: row by row over the part inside dst.
-    const Rect both = intersect(r, dst.rect());
-    for (int y = both.y0; y < both.y1; ++y) {
-      size_t k = static_cast<size_t>(y - r.y0) * static_cast<size_t>(r.width()) + static_cast<size_t>(both.x0 - r.x0);
-      size_t i = dst.index(both.x0, y);
-      for (int x = both.x0; x < both.x1; ++x, ++k, ++i) mergePixel(dst, i, m.keys[k], m.colours[k]);
+  uint64_t* keys = dst.keys();
+  uint32_t* triangles = dst.triangles();
+  for (int y = both.y0; y < both.y1; ++y) {
+    size_t k = static_cast<size_t>(y - r.y0) * static_cast<size_t>(r.width()) + static_cast<size_t>(both.x0 - r.x0);
+    size_t i = dst.index(both.x0, y);
+    for (int x = both.x0; x < both.x1; ++x, ++k, ++i) {
+      if (!depthTest(keys[i], m.keys[k])) continue;
+      keys[i] = m.keys[k];
+      triangles[i] = kNoTriangle;  // another PE's fragment: the owner resolves it before shading
     }
-    return;
   }
-  for (size_t k = 0; k < m.pixels(); ++k) {
-    const uint32_t local = m.index.empty() ? static_cast<uint32_t>(k) : m.index[k];
-    const int x = r.x0 + static_cast<int>(local % static_cast<uint32_t>(r.width()));
-    const int y = r.y0 + static_cast<int>(local / static_cast<uint32_t>(r.width()));
-    if (dst.rect().contains(x, y)) mergePixel(dst, dst.index(x, y), m.keys[k], m.colours[k]);
-  }
+  dstDrawn = enclose(dstDrawn, both);
 }
 
 void recordCompositeTallies(par::Runtime& rt, const std::vector<CompositeTally>& tallies) {
@@ -87,7 +59,8 @@ class DirectSend : public Compositor {
  public:
   std::string_view name() const override { return "direct-send"; }
 
-  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, bool sparse) override {
+  std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,
+                              bool sparse) override {
     const int pes = rt.pes();
     const Rect screen = buffers[0].rect();
     // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
@@ -100,9 +73,9 @@ class DirectSend : public Compositor {
       CompositeTally& c = counters[pe.id()];
       for (int o = 0; o < owners; ++o) {
         if (o == pe.id()) continue;
-        PixelMessage m = packPixels(buffers[pe.id()], strips[o], sparse);
-        if (sparse && m.pixels() == 0) continue;  // nothing covered there: no message
-        const size_t bytes = m.bytes(sparse);
+        PixelMessage m = packPixels(buffers[pe.id()], strips[o], drawn[pe.id()], sparse);
+        if (sparse && m.pixels() == 0) continue;  // nothing drawn there: no message
+        const size_t bytes = m.bytes();
         c.count(m, bytes);
         pixels.send(pe, o, std::move(m), bytes);
       }
@@ -111,7 +84,7 @@ class DirectSend : public Compositor {
     std::vector<std::vector<PixelMessage>> inbox(pes);
     for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
     rt.runOnEachPe("direct-send merge", [&](par::Pe& pe) {
-      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()]);
+      for (const PixelMessage& m : inbox[pe.id()]) mergePixels(m, buffers[pe.id()], drawn[pe.id()]);
     });
     recordCompositeTallies(rt, counters);
     strips.resize(pes);  // PEs beyond the strips own nothing

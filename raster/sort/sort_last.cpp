@@ -1,16 +1,28 @@
 // Sort-last: the sort sits after rasterization. Each PE renders its own primitives (geometry
-// batches under the runtime's schedule) over the whole screen into its own full-screen colour
-// and depth buffers, shades them, and the Compositor (direct-send or binary-swap, full frame
-// or sparse) redistributes pixels by screen region and keeps the nearest fragment per pixel;
-// each PE then delivers its composited rectangle to the assembler (frame_assembly.h). The scene
-// is replicated (world model: any PE may take any geometry batch).
+// batches under the runtime's schedule) over the whole screen into its own full-screen depth
+// buffer, and the Compositor (direct-send or binary-swap, full frame or sparse) redistributes
+// the fragments by screen region, keeping the nearest per pixel (visibility); each region's
+// owner then shades the visible fragments of its region once, and delivers the region to the
+// assembler (frame_assembly.h). Shading after visibility, as in PixelFlow (Molnar et al. 1992):
+// a PE that shaded its own fragments first would also shade every fragment another PE hides,
+// which on a depth-complex scene is most of its screen at every P. A fragment's key names its
+// primitive and fan piece (depth_resolve.h), so the owner recomputes the screen triangle of a
+// fragment another PE sent from the replicated scene (world model: any PE may take any
+// geometry batch).
+// Each PE keeps the bounding rectangle of the pixels its buffer holds (drawn or merged): only
+// that is cleared next frame, and sparse compositing sends only its part of each region, so a
+// PE whose primitives cover a corner of the screen pays for the corner.
 #include <algorithm>
+
+#include "common/util/error.h"
 
 #include "raster/composite/compositor.h"
 #include "raster/frame_assembly.h"
 #include "raster/scene_distribution.h"
 #include "raster/sort/sort_point.h"
+#include "raster/stages/geometry.h"
 #include "raster/stages/rasterize.h"
+#include "raster/stages/setup.h"
 #include "raster/stages/shade.h"
 
 namespace pr::raster {
@@ -30,18 +42,30 @@ class SortLast : public SortPoint {
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
 
-    // Every PE clears its own full-screen buffer (kept from frame to frame).
+    // Every PE clears what its full-screen buffer (kept from frame to frame) holds: the keys
+    // where it drew or merged, the colours where it shaded. Triangle indices need no clearing:
+    // one is read only where this frame wrote a key, and whatever wrote it set the index.
     buffers_.resize(pes);
+    drawn_.resize(pes);
+    shaded_.resize(pes);
+    adopted_.resize(pes);
     rt.runOnEachPe("sort-last clear", [&](par::Pe& pe) {
       RegionFramebuffer& mine = buffers_[pe.id()];
-      if (mine.rect() == screen) mine.clear();
-      else mine = RegionFramebuffer(screen);
+      if (mine.rect() == screen) {
+        mine.window(intersect(drawn_[pe.id()], screen)).clearKeys();
+        mine.window(intersect(shaded_[pe.id()], screen)).clearColours();
+      } else {
+        mine = RegionFramebuffer(screen);
+      }
+      drawn_[pe.id()] = shaded_[pe.id()] = Rect{};
     });
     std::vector<RegionFramebuffer>& buffers = buffers_;
 
     // Stage 1, geometry and rasterization of a PE's batches into its own full-screen buffer;
     // the triangle list stays with the PE for deferred shading (triangle index = list position).
-    std::vector<std::vector<ScreenTriangle>> tris(pes);
+    tris_.resize(pes);
+    for (std::vector<ScreenTriangle>& list : tris_) list.clear();  // storage kept: no page faults per frame
+    std::vector<std::vector<ScreenTriangle>>& tris = tris_;
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const uint32_t batch = f.options.batchSize;
     const size_t batches = (total + batch - 1) / batch;
@@ -53,16 +77,24 @@ class SortLast : public SortPoint {
       for (size_t i = before; i < mine.size(); ++i)
         rasterizeTriangle(mine[i], static_cast<uint32_t>(i), buffers[pe.id()].window(), nullptr,
                           ctx.alphaTested ? &f.scene : nullptr);
+      const std::span<const ScreenTriangle> batchTriangles(mine.data() + before, mine.size() - before);
+      drawn_[pe.id()] = enclose(drawn_[pe.id()], intersect(pixelBounds(batchTriangles), screen));
     });
 
-    // Stage 2, shading of each PE's visible pixels, in its own buffer.
+    // Stage 2, the sort: depth compositing by screen region (its counters go to the record).
+    const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse);
+
+    // Stage 3, shading of the visible fragments of each PE's region, in its own buffer.
     shade_.assign(size_t(pes), ShadeCounters{});
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
-      shadeRegion(ctx, tris[pe.id()], buffers[pe.id()], &shade_[size_t(pe.id())]);
+      const Rect visible = intersect(regions[pe.id()], drawn_[pe.id()]);
+      if (visible.empty()) return;
+      shaded_[pe.id()] = visible;
+      PixelWindow pixels = buffers[pe.id()].window(visible);
+      adoptForeignFragments(f, pixels, tris[pe.id()], adopted_[pe.id()]);
+      shadeRegion(ctx, tris[pe.id()], pixels, &shade_[size_t(pe.id())]);
     });
 
-    // Stage 3, the sort: depth compositing by screen region (its counters go to the record).
-    const std::vector<Rect> regions = compositor->composite(rt, buffers, f.options.sparse);
     // Each PE delivers the rectangle it composited to the assembler (in place on PE 0).
     FrameAssembly frame(rt, image, pool_);
     rt.runOnEachPe("sort-last assemble", [&](par::Pe& pe) {
@@ -71,7 +103,56 @@ class SortLast : public SortPoint {
   }
 
  private:
+  // Where a PE keeps the screen triangles it recomputed for other PEs' fragments this frame:
+  // per scene triangle, the index in the PE's triangle list of its first fan piece, valid when
+  // its stamp is the current frame's (no clearing between frames).
+  struct AdoptedTriangles {
+    std::vector<uint32_t> stamp, first;
+    uint32_t frame = 0;
+    void nextFrame(size_t primitives) {
+      if (stamp.size() != primitives || ++frame == 0) {
+        stamp.assign(primitives, 0);
+        first.resize(primitives);
+        frame = 1;
+      }
+    }
+  };
+
+  // Gives every visible fragment that came from another PE (triangle index kNoTriangle) an
+  // index into `tris`, appending the screen triangles of its primitive, recomputed by the
+  // geometry stage, once per primitive.
+  static void adoptForeignFragments(const FrameInputs& f, const PixelWindow& pixels, std::vector<ScreenTriangle>& tris,
+                                    AdoptedTriangles& adopted) {
+    adopted.nextFrame(f.scene.triangles.size());
+    ScreenTriangle pieces[kMaxSubTriangles];
+    for (int y = pixels.rect.y0; y < pixels.rect.y1; ++y)
+      for (int x = pixels.rect.x0; x < pixels.rect.x1; ++x) {
+        const size_t i = pixels.index(x, y);
+        const uint64_t key = pixels.keys[i];
+        if (!keyCovered(key) || pixels.triangles[i] != kNoTriangle) continue;
+        const uint32_t primitive = keyPrimitive(key);
+        if (adopted.stamp[primitive] != adopted.frame) {
+          const int n = processTriangle(f.scene, f.view, primitive, pieces);
+          adopted.stamp[primitive] = adopted.frame;
+          adopted.first[primitive] = static_cast<uint32_t>(tris.size());
+          tris.insert(tris.end(), pieces, pieces + n);
+        }
+        // The fragment's fan piece among the primitive's pieces (one, unless clipped).
+        const uint32_t sub = static_cast<uint32_t>(key) & ((1u << kSubTriangleBits) - 1);
+        uint32_t at = adopted.first[primitive];
+        while (tris[at].sub != sub) {
+          ++at;
+          PR_CHECK(at < tris.size() && tris[at].primitive == primitive, "sort-last: a fragment's fan piece is missing");
+        }
+        pixels.triangles[i] = at;
+      }
+  }
+
   std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
+  std::vector<Rect> drawn_;                 // per PE: its keys are clear outside this rectangle
+  std::vector<Rect> shaded_;                // per PE: its colours are 0 outside this rectangle
+  std::vector<AdoptedTriangles> adopted_;   // per PE
+  std::vector<std::vector<ScreenTriangle>> tris_;  // per PE: this frame's screen triangles
   std::vector<ShadeCounters> shade_;        // per PE, the last frame's
   RegionBufferPool pool_;                   // region message storage, kept between frames
   SceneDistribution distribution_;

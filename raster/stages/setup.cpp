@@ -14,11 +14,9 @@ int64_t floorSub(int64_t v) { return v >> kSubpixelBits; }
 
 }  // namespace
 
-Rect pixelBounds(const ScreenTriangle& t) {
-  int64_t minX = std::min({t.x[0], t.x[1], t.x[2]});
-  int64_t maxX = std::max({t.x[0], t.x[1], t.x[2]});
-  int64_t minY = std::min({t.y[0], t.y[1], t.y[2]});
-  int64_t maxY = std::max({t.y[0], t.y[1], t.y[2]});
+namespace {
+
+Rect pixelsBetween(int64_t minX, int64_t maxX, int64_t minY, int64_t maxY) {
   // Pixel i has its sample at 256 i + 128: the first with sample >= min is
   // ceil((min - 128) / 256), the last with sample <= max is floor((max - 128) / 256).
   constexpr int64_t kHalf = kSubpixelScale >> 1;
@@ -28,6 +26,26 @@ Rect pixelBounds(const ScreenTriangle& t) {
   r.y0 = static_cast<int>(floorSub(minY - kHalf + kSubpixelScale - 1));
   r.y1 = static_cast<int>(floorSub(maxY - kHalf) + 1);
   return r;
+}
+
+}  // namespace
+
+Rect pixelBounds(const ScreenTriangle& t) {
+  return pixelsBetween(std::min({t.x[0], t.x[1], t.x[2]}), std::max({t.x[0], t.x[1], t.x[2]}),
+                       std::min({t.y[0], t.y[1], t.y[2]}), std::max({t.y[0], t.y[1], t.y[2]}));
+}
+
+Rect pixelBounds(std::span<const ScreenTriangle> tris) {
+  if (tris.empty()) return Rect{};
+  int32_t minX = tris[0].x[0], maxX = minX, minY = tris[0].y[0], maxY = minY;
+  for (const ScreenTriangle& t : tris)
+    for (int k = 0; k < 3; ++k) {
+      minX = std::min(minX, t.x[k]);
+      maxX = std::max(maxX, t.x[k]);
+      minY = std::min(minY, t.y[k]);
+      maxY = std::max(maxY, t.y[k]);
+    }
+  return pixelsBetween(minX, maxX, minY, maxY);
 }
 
 void edgeFunctions(const ScreenTriangle& t, EdgeFunctions& e) {

@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 
 #include "raster/region.h"
 #include "raster/stages/geometry.h"
@@ -42,6 +43,8 @@ bool setupTriangle(const ScreenTriangle& tri, TriangleSetup& setup);
 
 // The pixel bounds alone, for binning triangles to region owners.
 Rect pixelBounds(const ScreenTriangle& tri);
+// Pixel bounds that hold every triangle's of the list (those of its vertices' bounding box).
+Rect pixelBounds(std::span<const ScreenTriangle> tris);
 
 // Fixed-point sample position of pixel column/row i: its centre, i + 1/2.
 inline int64_t samplePosition(int i) {

@@ -154,16 +154,37 @@ Anchor runAnchor(const std::string& program, const std::string& scenePath, int w
 // between frames, as in an animation), the image checked against the sequential reference.
 struct SortRow {
   double ms = 0.0, cpuMs = 0.0;
+  std::string stages;  // wall ms per frame of each stage, from the run record
 };
 
+// "name ms, name ms, ..." per frame, each stage's wall time summed over the timed frames (the
+// record's stages from index `first` on).
+std::string stageSummary(const pr::par::RunRecord& record, size_t first, int frames) {
+  std::vector<std::pair<std::string, double>> sums;
+  for (size_t i = first; i < record.stages.size(); ++i) {
+    const pr::par::StageRecord& st = record.stages[i];
+    auto at = std::find_if(sums.begin(), sums.end(), [&](const auto& e) { return e.first == st.name; });
+    if (at == sums.end()) sums.emplace_back(st.name, st.wallSeconds);
+    else at->second += st.wallSeconds;
+  }
+  std::string out;
+  char buf[128];
+  for (const auto& [name, seconds] : sums) {
+    std::snprintf(buf, sizeof buf, "%s%s %.1f", out.empty() ? "" : ", ", name.c_str(), 1e3 * seconds / frames);
+    out += buf;
+  }
+  return out;
+}
+
 SortRow timeSortPoint(const raster::SortPointInfo& info, int pes, const pr::scene::Scene& scene,
-                      const raster::FrameView& view, int frames, const raster::RegionFramebuffer& reference) {
-  pr::par::Runtime runtime(pes);
-  const raster::SortOptions options;
+                      const raster::FrameView& view, int frames, const raster::RegionFramebuffer& reference,
+                      const raster::SortOptions& options, const std::string& schedule) {
+  pr::par::Runtime runtime(pes, schedule);
   std::unique_ptr<raster::SortPoint> sortPoint = info.make();
   raster::RegionFramebuffer image;
   raster::renderFrame(*sortPoint, scene, view, options, runtime, image);  // warm-up
   PR_CHECK(raster::identical(image, reference), "bench_raster: parallel image differs from the sequential one");
+  const size_t firstTimedStage = runtime.record().stages.size();
   std::vector<double> wall, cpu;
   for (int f = 0; f < frames; ++f) {
     const double c0 = processCpuMs(), t0 = nowMs();
@@ -171,7 +192,7 @@ SortRow timeSortPoint(const raster::SortPointInfo& info, int pes, const pr::scen
     wall.push_back(nowMs() - t0);
     cpu.push_back(processCpuMs() - c0);
   }
-  return SortRow{median(wall), median(cpu)};
+  return SortRow{median(wall), median(cpu), stageSummary(runtime.record(), firstTimedStage, frames)};
 }
 
 struct Options {
@@ -238,16 +259,41 @@ void benchScene(const std::string& label, const std::string& path, const Options
   };
   std::printf("sequential P=1: %.1f ms (cpu %.1f ms)%s\n", ms, cpuMs, ratio(0, ms, cpuMs).c_str());
 
+  struct Variant {
+    const raster::SortPointInfo* info;
+    std::string label;
+    raster::SortOptions options;
+    std::string schedule = "demand";
+  };
+  std::vector<Variant> variants;
   for (const raster::SortPointInfo& info : raster::sortPoints()) {
-    const SortRow p1 = timeSortPoint(info, 1, scene, view, o.frames, reference);
-    const SortRow p2 = timeSortPoint(info, 2, scene, view, o.frames, reference);
+    variants.push_back({&info, std::string(info.name), {}});
+    if (info.name == "sort-last") {
+      // Sparse compositing (bounding rectangles), with geometry batches on demand and in equal
+      // contiguous portions (each PE's primitives then cover a part of the screen).
+      raster::SortOptions sparse;
+      sparse.sparse = true;
+      variants.push_back({&info, "sort-last --sparse", sparse});
+      variants.push_back({&info, "sort-last --sparse --schedule balanced", sparse, "balanced"});
+    }
+  }
+  for (const Variant& v : variants) {
+    const raster::SortPointInfo& info = *v.info;
+    const SortRow p1 = timeSortPoint(info, 1, scene, view, o.frames, reference, v.options, v.schedule);
+    const SortRow p2 = timeSortPoint(info, 2, scene, view, o.frames, reference, v.options, v.schedule);
     const std::string p2Ratios = ratio(1, p2.ms, p2.cpuMs) + ratio(2, p2.ms, p2.cpuMs);
-    std::printf("%s P=1: %.1f ms (cpu %.1f ms), %.2f Mtriangles/s, %.1f Mpixels/s%s\n", std::string(info.name).c_str(),
+    std::printf("%s P=1: %.1f ms (cpu %.1f ms), %.2f Mtriangles/s, %.1f Mpixels/s%s\n", v.label.c_str(),
                 p1.ms, p1.cpuMs, triangles / p1.ms / 1e3, pixels / p1.ms / 1e3, ratio(0, p1.ms, p1.cpuMs).c_str());
     std::printf("%s P=2: %.1f ms (cpu %.1f ms), %.2f Mtriangles/s, %.1f Mpixels/s, speed-up T1/T2 %.2f, efficiency "
                 "%.2f%s\n",
-                std::string(info.name).c_str(), p2.ms, p2.cpuMs, triangles / p2.ms / 1e3, pixels / p2.ms / 1e3,
+                v.label.c_str(), p2.ms, p2.cpuMs, triangles / p2.ms / 1e3, pixels / p2.ms / 1e3,
                 p1.ms / p2.ms, p1.ms / (2.0 * p2.ms), p2Ratios.c_str());
+    if (info.name == "sort-last") {
+      std::printf("  %s stages, ms per frame, P=1: %s\n", v.label.c_str(), p1.stages.c_str());
+      std::printf("  %s stages, ms per frame, P=2: %s\n", v.label.c_str(), p2.stages.c_str());
+    }
+    if (info.name == "sort-last" && v.options.sparse)
+      std::printf("%s P=2 efficiency %.2f (target >= 0.8 on the landscape)\n", v.label.c_str(), p1.ms / (2.0 * p2.ms));
     if (info.name == "sort-middle" && (anchors[1].ok || anchors[2].ok)) {
       const double best = std::min(anchors[1].ok ? anchors[1].ms : 1e300, anchors[2].ok ? anchors[2].ms : 1e300);
       std::printf("sort-middle P=2 / fastest llvmpipe on two cores: %.2f (bar 1.5, goal 1.0)\n", p2.ms / best);

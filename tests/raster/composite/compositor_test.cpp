@@ -1,6 +1,9 @@
-// Compositor: pixel packing (full and sparse) round-trips through a merge, a merge keeps the
-// smaller depth key whatever the arrival order, and unknown compositor names are input errors.
+// Compositor: fragment packing (full, and sparse = the drawn bounding rectangle only) round-trips
+// through a merge that widens the receiver's drawn rectangle, a merge keeps the smaller depth
+// key whatever the arrival order, and unknown compositor names are input errors.
 #include <doctest/doctest.h>
+
+#include <algorithm>
 
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
@@ -20,18 +23,29 @@ RegionFramebuffer stripes(uint32_t primitive, float depth, int every) {
   return fb;
 }
 
-TEST_CASE("Compositor: full and sparse messages carry the same pixels") {
+TEST_CASE("Compositor: full and sparse messages carry the same pixels; sparse only the drawn rectangle") {
   const RegionFramebuffer a = stripes(1, 0.5f, 2);
+  const Rect region{1, 1, 5, 4}, drawn{0, 2, 3, 4};  // a's fragments drawn in rows 2..3, columns 0..2 only
+  RegionFramebuffer only(a.rect());
+  for (int y = drawn.y0; y < drawn.y1; ++y)
+    for (int x = drawn.x0; x < drawn.x1; ++x) {
+      only.keys()[only.index(x, y)] = a.key(x, y);
+      only.colours()[only.index(x, y)] = a.colour(x, y);
+    }
   for (bool sparse : {false, true}) {
-    const PixelMessage m = packPixels(a, Rect{1, 1, 5, 4}, sparse);
-    CHECK(m.rect == Rect{1, 1, 5, 4});
-    CHECK(m.pixels() == (sparse ? 6u : 12u));  // half of the 4 x 3 pixels are covered
-    CHECK(m.bytes(sparse) == m.pixels() * (sparse ? kSparsePixelBytes : kFullPixelBytes));
+    CAPTURE(sparse);
+    const PixelMessage m = packPixels(only, region, drawn, sparse);
+    CHECK(m.drawn == Rect{1, 2, 3, 4});
+    CHECK(m.rect == (sparse ? Rect{1, 2, 3, 4} : region));
+    CHECK(m.pixels() == (sparse ? 4u : 12u));
+    CHECK(m.bytes() == m.pixels() * kPixelBytes);
     RegionFramebuffer dst(Rect{0, 0, 6, 4});
-    mergePixels(m, dst);
+    Rect dstDrawn{5, 0, 6, 1};
+    mergePixels(m, dst, dstDrawn);
+    CHECK(dstDrawn == Rect{1, 0, 6, 4});
     for (int y = 0; y < 4; ++y)
       for (int x = 0; x < 6; ++x) {
-        const bool inside = Rect{1, 1, 5, 4}.contains(x, y);
+        const bool inside = m.drawn.contains(x, y);
         CHECK(dst.key(x, y) == (inside ? a.key(x, y) : kClearKey));
       }
   }
@@ -40,12 +54,18 @@ TEST_CASE("Compositor: full and sparse messages carry the same pixels") {
 TEST_CASE("Compositor: merging keeps the nearer key in either order") {
   const RegionFramebuffer near = stripes(2, 0.25f, 1), far = stripes(1, 0.5f, 1);
   RegionFramebuffer ab(Rect{0, 0, 6, 4}), ba(Rect{0, 0, 6, 4});
-  mergePixels(packPixels(near, near.rect(), true), ab);
-  mergePixels(packPixels(far, far.rect(), false), ab);
-  mergePixels(packPixels(far, far.rect(), true), ba);
-  mergePixels(packPixels(near, near.rect(), false), ba);
-  CHECK(identical(ab, ba));
-  CHECK(identical(ab, near));
+  Rect abDrawn, baDrawn;
+  mergePixels(packPixels(near, near.rect(), near.rect(), true), ab, abDrawn);
+  mergePixels(packPixels(far, far.rect(), far.rect(), false), ab, abDrawn);
+  mergePixels(packPixels(far, far.rect(), far.rect(), true), ba, baDrawn);
+  mergePixels(packPixels(near, near.rect(), near.rect(), false), ba, baDrawn);
+  // Keys travel, colours do not (the owner shades after compositing).
+  auto sameKeys = [](const RegionFramebuffer& a, const RegionFramebuffer& b) {
+    return std::equal(a.keys(), a.keys() + a.rect().area(), b.keys());
+  };
+  CHECK(sameKeys(ab, ba));
+  CHECK(sameKeys(ab, near));
+  CHECK(abDrawn == near.rect());
 }
 
 TEST_CASE("Compositor: names") {

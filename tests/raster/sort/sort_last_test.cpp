@@ -1,6 +1,8 @@
 // Sort-last: full-frame compositing moves exactly the analytic volume — direct-send and
 // binary-swap each send b * A * (1 - 1/P) bytes per PE, in P - 1 and log2 P messages — the
-// sparse variant sends only covered pixels, and every stage's bytes sent equal bytes received.
+// sparse variant sends only the bounding rectangle of what a PE drew in each region, every
+// stage's bytes sent equal bytes received, and a PE's buffer is cleared only where it held
+// something without the next frame seeing any of it.
 #include <doctest/doctest.h>
 
 #include <bit>
@@ -12,6 +14,8 @@
 #include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
 #include "raster/sort/sort_test_support.h"
+#include "raster/stages/geometry.h"
+#include "raster/stages/setup.h"
 
 namespace pr::raster {
 namespace {
@@ -32,7 +36,7 @@ void checkAnalyticVolume(const char* compositor, int pes) {
   CHECK(identical(image, renderSequential(s, view)));
   test::CounterTotals c = test::counterTotals(rt.record());
   const uint64_t area = uint64_t(kW) * kH;
-  const uint64_t perPeBytes = kFullPixelBytes * area * (pes - 1) / pes;  // b A (1 - 1/P)
+  const uint64_t perPeBytes = kPixelBytes * area * (pes - 1) / pes;  // b A (1 - 1/P)
   const uint64_t perPeMessages =
       std::string(compositor) == "direct-send" ? uint64_t(pes - 1) : uint64_t(std::countr_zero(unsigned(pes)));
   for (int p = 0; p < pes; ++p) {
@@ -77,9 +81,16 @@ TEST_CASE("SortLast: full-frame binary-swap moves b*A*(1-1/P) bytes in log2(P) m
   for (int pes : {1, 2, 4, 8}) checkAnalyticVolume("binary-swap", pes);
 }
 
-TEST_CASE("SortLast: sparse compositing sends only covered pixels, with their index") {
+TEST_CASE("SortLast: sparse compositing sends the bounding rectangle of what the PE drew in each region") {
   const scene::Scene s = test::threeTriangles();
   const FrameView view = test::tinyView();
+  const Rect screen{0, 0, test::kTinySize, test::kTinySize};
+  // PE 0 renders all three triangles (one batch of 4096): what it drew is the union of their
+  // pixel bounds; PE 1 drew nothing, so it sends nothing.
+  std::vector<ScreenTriangle> tris;
+  processTriangles(s, view, 0, uint32_t(s.triangles.size()), tris);
+  Rect drawn;
+  for (const ScreenTriangle& t : tris) drawn = enclose(drawn, intersect(pixelBounds(t), screen));
   for (const char* compositor : {"direct-send", "binary-swap"}) {
     CAPTURE(compositor);
     SortOptions options;
@@ -89,22 +100,60 @@ TEST_CASE("SortLast: sparse compositing sends only covered pixels, with their in
     RegionFramebuffer image = renderParallel(s, view, "sort-last", options, rt);
     test::CounterTotals c = test::counterTotals(rt.record());
     CHECK(identical(image, renderSequential(s, view)));
-    // batchSize 4096: PE 0 renders all three triangles and PE 1 none, so PE 0 sends its
-    // covered pixels of PE 1's half and PE 1 sends nothing.
-    const size_t coveredInLower = [&] {
-      size_t n = 0;
-      for (int y = test::kTinySize / 2; y < test::kTinySize; ++y)
-        for (int x = 0; x < test::kTinySize; ++x) n += keyCovered(image.key(x, y));
-      return n;
-    }();
-    CHECK(coveredInLower > 0);
-    CHECK(c["Sort/pixels_sent"] == coveredInLower);
+    // Both compositors give PE 1 the lower half at P = 2.
+    const Rect lower{0, test::kTinySize / 2, test::kTinySize, test::kTinySize};
+    const Rect sent = intersect(lower, drawn);
+    REQUIRE(sent.area() > 0);
+    REQUIRE(sent.area() < lower.area());
+    Rect covered;  // every covered pixel of the lower half lies in what was sent
+    for (int y = lower.y0; y < lower.y1; ++y)
+      for (int x = lower.x0; x < lower.x1; ++x)
+        if (keyCovered(image.key(x, y))) covered = enclose(covered, Rect{x, y, x + 1, y + 1});
+    CHECK(intersect(covered, sent) == covered);
+    CHECK(c["Sort/pixels_sent"] == uint64_t(sent.area()));
     CHECK(c["Sort/composite_messages"] == 1);
-    CHECK(c["Sort/composite_bytes"] == coveredInLower * kSparsePixelBytes);
+    CHECK(c["Sort/composite_bytes"] == uint64_t(sent.area()) * kPixelBytes);
     const test::StageTraffic t = test::stageTraffic(rt.record(), compositor);
     CHECK(t.bytesSent == c["Sort/composite_bytes"]);
     CHECK(t.bytesReceived == t.bytesSent);
   }
+}
+
+TEST_CASE("SortLast: frames that cover different pixels leave nothing behind in the PEs' kept buffers") {
+  const scene::Scene s = test::threeTriangles();
+  const scene::Camera front = test::pixelOrthoCamera(test::kTinySize);
+  // The camera moved 5 units to the right: the triangles move left, partly off the screen.
+  scene::Camera right = front;
+  right.cameraToWorld[3].x = 5.0f;
+  const FrameView wide = makeFrameView(front, test::kTinySize, test::kTinySize);
+  const FrameView narrow = makeFrameView(right, test::kTinySize, test::kTinySize);
+  const RegionFramebuffer wideImage = renderSequential(s, wide), narrowImage = renderSequential(s, narrow);
+  REQUIRE(wideImage.coveredPixels() > narrowImage.coveredPixels());
+  REQUIRE(narrowImage.coveredPixels() > 0);
+  size_t leftBehind = 0;  // covered in the wide frame, not in the narrow one
+  for (int y = 0; y < test::kTinySize; ++y)
+    for (int x = 0; x < test::kTinySize; ++x)
+      leftBehind += keyCovered(wideImage.key(x, y)) && !keyCovered(narrowImage.key(x, y));
+  REQUIRE(leftBehind > 0);
+  for (const char* compositor : {"direct-send", "binary-swap"})
+    for (bool sparse : {false, true})
+      for (int pes : {1, 2, 4}) {
+        CAPTURE(compositor);
+        CAPTURE(sparse);
+        CAPTURE(pes);
+        SortOptions options;
+        options.compositor = compositor;
+        options.sparse = sparse;
+        options.batchSize = 1;  // every PE draws some triangles
+        par::Runtime rt(pes, "balanced");
+        std::unique_ptr<SortPoint> sortPoint = makeSortPoint("sort-last");
+        RegionFramebuffer image;
+        for (int frame = 0; frame < 4; ++frame) {
+          const bool isWide = frame % 2 == 0;
+          renderFrame(*sortPoint, s, isWide ? wide : narrow, options, rt, image);
+          CHECK(identical(image, isWide ? wideImage : narrowImage));
+        }
+      }
 }
 
 TEST_CASE("SortLast: binary-swap on a PE count that is not a power of two is an input error") {
