@@ -39,6 +39,9 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   options.cacheBytes = std::size_t(r.settings.ray.cacheMb * 1048576.0);
   options.dataLatencySeconds = r.settings.ray.dataLatencyUs * 1e-6;
   options.hideLatency = !r.settings.ray.noLatencyHiding;
+  options.prefetch = r.settings.ray.prefetch == "none"     ? rt::TraceOptions::Prefetch::None
+                     : r.settings.ray.prefetch == "camera" ? rt::TraceOptions::Prefetch::CameraRays
+                                                           : rt::TraceOptions::Prefetch::Profile;
   options.progress = r.progress;
   rt::TraceJob job{r.scene, r.camera, r.width, r.height, options};
   const bool photonmap = r.settings.ray.integrator == "photonmap";
@@ -240,6 +243,10 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
                           ->capture_default_str(),
                       MethodFamily::Ray);
   family.emplace_back(command.add_flag("--no-latency-hiding", ray.noLatencyHiding, "image-space-cached: a ray that needs a remote item waits for it (by default it yields to the tile's other rays)"),
+                      MethodFamily::Ray);
+  family.emplace_back(command.add_option("--prefetch", ray.prefetch, "image-space-cached: before a tile, fetch what the PE's finished neighbouring tiles used (profile), what the tile's camera rays reach first (camera), or nothing (none)")
+                          ->check(CLI::IsMember({"profile", "camera", "none"}))
+                          ->capture_default_str(),
                       MethodFamily::Ray);
   family.emplace_back(command.add_option("--ray-batch", ray.rayBatch, "object-space, object: rays per message to one PE (a partial batch goes when its PE runs dry)")
                           ->check(CLI::Range(1, rt::kMaxRayBatch))

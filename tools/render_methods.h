@@ -41,6 +41,7 @@ struct RayOptions {
   double cacheMb = double(rt::kDefaultCacheBytes) / 1048576.0;
   double dataLatencyUs = 0.0;
   bool noLatencyHiding = false;
+  std::string prefetch = "profile";
   // --integrator photonmap's settings (--photons, --gather, --view, ...), and the options
   // that set them: giving one with another integrator is an input error.
   pm::PhotonMapSettings photonmap;

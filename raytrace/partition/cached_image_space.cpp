@@ -8,6 +8,13 @@
 // that holds the hit, so no PE reads geometry it neither owns nor fetched (the poisoned-view
 // check of the tests). Finished tiles travel to the assembler as in image-space.
 //
+// Profiling (seed section 4.5.3): a PE notes the items each of its tiles used, and before a tile
+// prefetches what its own finished tiles next to it used (spatial coherence), falling back to
+// the items every 16th camera ray reaches first when it has none nearby. Under a schedule that
+// needs cost estimates (unbalanced, hot-spots) a low-resolution profile pre-pass traces every
+// fourth pixel of each tile through the data manager first: its rays per tile are the costs,
+// and each PE keeps the items its pre-pass tiles used as the start of its profile.
+//
 // A fetched item is the owner's immutable item handed over by reference and counted as its
 // bytes (the copy a distributed machine would send); the cache bounds how many bytes of other
 // PEs' items a PE may use without asking again.
@@ -21,6 +28,7 @@
 #include <vector>
 
 #include "common/parallel/data_manager.h"
+#include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/object_assignment.h"
 #include "raytrace/partition/owner_directory.h"
@@ -147,6 +155,10 @@ class CachedImageSpaceFrame {
     data_ = &data;
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    for (PeState& st : state_) st.profile.assign(tiles.size(), {});
+    par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx);
+    // A pre-pass program gets no profile pre-pass: it would run the program's side effects twice.
+    if (job_.assembleImage && par::scheduleNeedsCostEstimates(rt_.options().schedule)) profilePrePass(tiles, tasks);
     Film film(job_.filmWidth(), job_.filmHeight(), integrator_->options().spp);
     FilmAssembly assembly(rt_, film);
     // Materials, textures, lights, the emitters and the item directory (bounds, owner and size
@@ -156,14 +168,15 @@ class CachedImageSpaceFrame {
                            directory_.bytes() + specs_.size() * (sizeof(int) + sizeof(uint64_t)));
     std::atomic<int64_t> done{0};
     const auto total = int64_t(tiles.size());
-    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[size_t(pe.id())];
       const PixelRect& rect = tiles[size_t(id)];
       Film tile(rect, job_.width, job_.height, integrator_->options().spp);
       integrator_->cameraRays(rect, st.queue);
       countStartRays(st.stats, st.queue);
-      prefetch(pe, st);
-      traceTile(pe, st, tile);
+      prefetch(pe, st, tiles, size_t(id));
+      traceTile(pe, st, tile, st.stats);
+      noteProfile(st, size_t(id), true);
       if (job_.assembleImage) assembly.deliver(pe, tile, rect, false);
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
       if (job_.options.progress) job_.options.progress(n, total);
@@ -191,6 +204,8 @@ class CachedImageSpaceFrame {
       rt_.addCounter("Cache/misses", p, double(data.misses(p)));
       rt_.addCounter("Cache/misses_joined", p, double(data.joined(p)));
       rt_.addCounter("Cache/prefetches", p, double(st.prefetched));
+      rt_.addCounter("Cache/prefetches_from_profile", p, double(st.prefetchedFromProfile));
+      rt_.addCounter("Cache/prefetches_used", p, double(st.prefetchesUsed));
       rt_.addCounter("Cache/own_item_uses", p, double(st.ownUses));
       rt_.addCounter("Cache/bytes_held_at_end", p, double(data.cache(p).usedBytes()));
     }
@@ -203,9 +218,13 @@ class CachedImageSpaceFrame {
   struct alignas(64) PeState {
     std::vector<RayMessage> queue;
     std::vector<OwnerDirectory::NodeEntry> heap;
-    std::vector<par::ItemId> wanted;
+    std::vector<par::ItemId> wanted;   // the current tile's prefetch
+    std::vector<par::ItemId> touched;  // items the current tile used, own ones included
+    // Per tile, if this PE ran it: the items it used and how often, by item.
+    std::vector<std::vector<std::pair<par::ItemId, uint32_t>>> profile;
+    std::vector<std::pair<par::ItemId, uint32_t>> votes;  // scratch of the prediction
     TraceStats stats;
-    uint64_t prefetched = 0, ownUses = 0;
+    uint64_t prefetched = 0, prefetchedFromProfile = 0, prefetchesUsed = 0, ownUses = 0;
   };
 
   static std::vector<scene::Bounds> itemBounds(const std::vector<ItemSpec>& items) {
@@ -214,25 +233,109 @@ class CachedImageSpaceFrame {
     return boxes;
   }
 
-  // Before a tile: the items that every 16th of its camera rays reaches first, fetched at once
-  // (one request each, the replies awaited together) so that the tile's rays find them cached.
-  void prefetch(par::Pe& pe, PeState& st) {
-    constexpr size_t kStride = 16;
+  // Before tile `id`: the items the PE's own finished tiles around it used most (its profile),
+  // as many as fill half its cache (a prediction that evicts what the tile needs costs more
+  // than it saves), or without any, the items every 16th of its camera rays reaches first;
+  // fetched at once (one request each, the replies awaited together).
+  void prefetch(par::Pe& pe, PeState& st, const std::vector<PixelRect>& tiles, size_t id) {
+    const int ts = job_.options.tileSizePx;
+    const int cols = (job_.width + ts - 1) / ts;
+    const int col = tiles[id].x0 / ts, row = tiles[id].y0 / ts;
     st.wanted.clear();
-    for (size_t i = 0; i < st.queue.size(); i += kStride) {
-      OwnerDirectory::NearestFirst walk(directory_, st.queue[i].ray, -1, st.heap);
-      OwnerEntry e;
-      if (walk.next(kInfinity, e)) st.wanted.push_back(par::ItemId(e.owner));
-    }
-    std::sort(st.wanted.begin(), st.wanted.end());
-    st.wanted.erase(std::unique(st.wanted.begin(), st.wanted.end()), st.wanted.end());
+    st.touched.clear();
+    const TraceOptions::Prefetch mode = job_.options.prefetch;
+    if (mode == TraceOptions::Prefetch::None) return;
     // Not its own, not cached already, and small enough to be kept (a prefetched item the
     // cache cannot hold would be fetched again at its use).
-    std::erase_if(st.wanted, [&](par::ItemId id) {
-      return data_->owner(id) == pe.id() || data_->cache(pe.id()).contains(id) || itemBytes_[id] > job_.options.cacheBytes;
-    });
+    auto useless = [&](par::ItemId item) {
+      return data_->owner(item) == pe.id() || data_->cache(pe.id()).contains(item) ||
+             itemBytes_[item] > job_.options.cacheBytes;
+    };
+    st.votes.clear();
+    for (int r = row - 1; mode == TraceOptions::Prefetch::Profile && r <= row + 1; ++r)
+      for (int c = col - 1; c <= col + 1; ++c) {
+        const size_t n = size_t(r) * size_t(cols) + size_t(c);
+        if (r < 0 || c < 0 || c >= cols || n >= tiles.size()) continue;
+        st.votes.insert(st.votes.end(), st.profile[n].begin(), st.profile[n].end());
+      }
+    const bool profiled = !st.votes.empty();
+    if (profiled) {
+      std::sort(st.votes.begin(), st.votes.end());
+      std::vector<std::pair<uint64_t, par::ItemId>> ranked;  // (uses, item), most used first
+      for (size_t i = 0; i < st.votes.size();) {
+        uint64_t uses = 0;
+        const par::ItemId item = st.votes[i].first;
+        for (; i < st.votes.size() && st.votes[i].first == item; ++i) uses += st.votes[i].second;
+        if (!useless(item)) ranked.emplace_back(uses, item);
+      }
+      std::sort(ranked.begin(), ranked.end(), [](const auto& a, const auto& b) {
+        return a.first != b.first ? a.first > b.first : a.second < b.second;
+      });
+      uint64_t bytes = 0;
+      for (const auto& [uses, item] : ranked) {
+        if (bytes + itemBytes_[item] > job_.options.cacheBytes / 2) break;
+        bytes += itemBytes_[item];
+        st.wanted.push_back(item);
+      }
+    } else {
+      constexpr size_t kStride = 16;
+      for (size_t i = 0; i < st.queue.size(); i += kStride) {
+        OwnerDirectory::NearestFirst walk(directory_, st.queue[i].ray, -1, st.heap);
+        OwnerEntry e;
+        if (walk.next(kInfinity, e)) st.wanted.push_back(par::ItemId(e.owner));
+      }
+      std::sort(st.wanted.begin(), st.wanted.end());
+      st.wanted.erase(std::unique(st.wanted.begin(), st.wanted.end()), st.wanted.end());
+      std::erase_if(st.wanted, useless);
+    }
     st.prefetched += st.wanted.size();
+    if (profiled) st.prefetchedFromProfile += st.wanted.size();
     data_->prefetch(pe, st.wanted);
+  }
+
+  // After tile `id`: the items it used, with their use counts, become its profile entry; with
+  // `countPrefetches`, the prefetched items it used are counted (Cache/prefetches_used).
+  static void noteProfile(PeState& st, size_t id, bool countPrefetches) {
+    std::sort(st.touched.begin(), st.touched.end());
+    std::vector<std::pair<par::ItemId, uint32_t>>& entry = st.profile[id];
+    entry.clear();
+    for (par::ItemId item : st.touched) {
+      if (!entry.empty() && entry.back().first == item) ++entry.back().second;
+      else entry.emplace_back(item, 1);
+    }
+    if (countPrefetches)
+      for (par::ItemId w : st.wanted)
+        st.prefetchesUsed += std::binary_search(st.touched.begin(), st.touched.end(), w);
+  }
+
+  // The profile pre-pass (its own stage, balanced split, measured with the render): every
+  // fourth pixel in x and y of each tile, one sample, traced through the data manager into a
+  // scratch film. Rays traced per sampled pixel, scaled to the tile's pixel count, become the
+  // tile's cost for the schedule; the items it used start the PE's profile. Its rays are not
+  // the render's: they are not in the ray counters.
+  void profilePrePass(const std::vector<PixelRect>& tiles, par::TaskSet& tasks) {
+    constexpr int kStride = 4;
+    const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
+    rt_.runStage(job_.stage("profile pre-pass"), par::TaskSet::uniform(tiles.size()), *balanced,
+                 [&](par::Pe& pe, par::TaskId id) {
+                   PeState& st = state_[size_t(pe.id())];
+                   const PixelRect& rect = tiles[size_t(id)];
+                   Film scratch(rect, job_.width, job_.height, 1);
+                   TraceStats stats;
+                   int64_t sampled = 0;
+                   for (int y = rect.y0; y < rect.y1; y += kStride)
+                     for (int x = rect.x0; x < rect.x1; x += kStride) {
+                       integrator_->cameraRays(PixelRect{x, y, x + 1, y + 1}, 1, st.queue);
+                       ++sampled;
+                     }
+                   countStartRays(stats, st.queue);
+                   st.wanted.clear();
+                   st.touched.clear();
+                   traceTile(pe, st, scratch, stats);
+                   noteProfile(st, size_t(id), false);
+                   const double cost = sampled > 0 ? double(stats.total()) * double(rect.pixels()) / double(sampled) : 1.0;
+                   tasks.tasks[size_t(id)].costEstimate = std::max(cost, 1.0);
+                 });
   }
 
   // A ray of the tile, with its walk through the item directory so far: parked at an item that
@@ -254,14 +357,14 @@ class CachedImageSpaceFrame {
   // section 4.5.2): a ray that needs an item on its way is parked and the PE goes on with the
   // tile's other rays; only when every ray waits does it wait for the next arrival, and then
   // resumes the rays that waited for that item. Without, a ray waits for its item in place.
-  void traceTile(par::Pe& pe, PeState& st, Film& film) {
+  void traceTile(par::Pe& pe, PeState& st, Film& film, TraceStats& stats) {
     std::vector<WalkingRay> ready;
     std::unordered_map<par::ItemId, std::vector<WalkingRay>> parked;
     size_t waiting = 0;
     for (const RayMessage& m : st.queue) ready.emplace_back(m);
     st.queue.clear();
     std::vector<RayMessage> spawned;
-    Emit emit(film, spawned, st.stats, pe.id());
+    Emit emit(film, spawned, stats, pe.id());
     for (;;) {
       if (ready.empty()) {
         if (waiting == 0) return;
@@ -290,7 +393,7 @@ class CachedImageSpaceFrame {
         integrator_->miss(m, emit);
       }
       for (const RayMessage& r : spawned) {
-        ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
+        ++(r.kind == RayKind::Shadow ? stats.shadowRays : stats.continuationRays);
         ready.emplace_back(r);
       }
       spawned.clear();
@@ -325,6 +428,7 @@ class CachedImageSpaceFrame {
         w.parked = true;
         return false;
       }
+      st.touched.push_back(id);
       if (shadow) {
         if (g->bvh.occluded(w.message.ray)) {
           w.found = true;

@@ -5,12 +5,15 @@
 // items' bounds nearest first and takes each item it needs from its own partition, from its
 // cache, or from the owner through the DataManager (a request and a reply message, served by
 // the owner's PE), keeping fetched items in an LRU cache of --cache-mb. Before a tile it
-// prefetches the items the tile's camera rays reach first. A ray that needs an item on its way
+// prefetches (--prefetch) what its profile predicts: the items its own finished neighbouring
+// tiles used (seed section 4.5.3), or the items the tile's camera rays reach first; schedules
+// that need cost estimates get them from a profile pre-pass. A ray that needs an item on its way
 // is parked and the PE goes on with the tile's other rays (latency hiding, seed section 4.5.2;
 // --no-latency-hiding waits instead); --data-latency-us simulates a network's latency. Run record: cache hits, misses and
 // prefetches per PE (PeStageRecord), the fetched bytes as "data" traffic, the time spent
 // waiting for items as message waiting, and Cache/... counters (a miss is one request; a use
-// that finds its item already requested counts as Cache/misses_joined).
+// that finds its item already requested counts as Cache/misses_joined; prefetches, those
+// predicted by the profile, and those the tile then used).
 #pragma once
 
 #include <cstddef>

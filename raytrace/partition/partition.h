@@ -45,6 +45,11 @@ struct TraceOptions {
   // section 4.5.2) instead of the PE waiting for the reply.
   double dataLatencySeconds = 0.0;
   bool hideLatency = true;
+  // image-space-cached: what a PE prefetches before a tile (cached_image_space.cpp): the items
+  // its own finished neighbouring tiles used, falling back to the camera rays' first items
+  // (profile); the camera rays' first items only (camera); nothing (none).
+  enum class Prefetch { Profile, CameraRays, None };
+  Prefetch prefetch = Prefetch::Profile;
   BvhBuildOptions bvh;
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.

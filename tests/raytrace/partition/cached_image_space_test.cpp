@@ -145,3 +145,59 @@ TEST_CASE("CachedImageSpace: latency hiding and a simulated latency keep the seq
           CHECK(counterMax(run.record, "Cache/bytes_held_at_end") <= double(bytes));
         }
 }
+
+TEST_CASE("CachedImageSpace: profiling predicts a tile's items from its neighbours and gives the cost schedules estimates") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Path, 1, 4);
+  opt.tileSizePx = 8;  // 16 tiles of 32 x 32: most have finished neighbours on their PE
+  par::Runtime one(1, "demand");
+  const rt::TraceResult sequential = rt::renderRays(s, cam, 32, 32, opt, "sequential", one);
+  rt::CachedImageSpacePartition partition;
+  const std::size_t largest =
+      std::size_t(counterMax(test::renderPartitioned(partition, s, cam, 32, 32, opt, 2).record, "Cache/largest_item_bytes"));
+  opt.cacheBytes = 4 * largest;  // a profile prediction may take two items
+  using Prefetch = rt::TraceOptions::Prefetch;
+  for (const Prefetch mode : {Prefetch::None, Prefetch::CameraRays, Prefetch::Profile}) {
+    CAPTURE(int(mode));
+    opt.prefetch = mode;
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 32, 32, opt, 2);
+    CHECK(run.image.pixels == sequential.image.pixels);
+    CHECK(run.result.rays.total() == sequential.rays.total());
+    const double prefetches = counterTotal(run.record, "Cache/prefetches");
+    const double fromProfile = counterTotal(run.record, "Cache/prefetches_from_profile");
+    const double used = counterTotal(run.record, "Cache/prefetches_used");
+    CHECK(double(channelMessages(run.record, "data")) == counterTotal(run.record, "Cache/misses") + prefetches);
+    CHECK(used <= prefetches);
+    if (mode == Prefetch::None) CHECK(prefetches == 0.0);
+    if (mode == Prefetch::CameraRays) CHECK(fromProfile == 0.0);
+    if (mode == Prefetch::Profile) {
+      CHECK(fromProfile > 0.0);
+      CHECK(used > 0.0);  // the neighbours' items were the tile's too
+    }
+    for (const par::StageRecord& st : run.record.stages) CHECK(st.name.find("profile pre-pass") == std::string::npos);
+  }
+  // The cost schedules get a profile pre-pass; its rays are not the render's.
+  opt.prefetch = Prefetch::Profile;
+  for (const char* schedule : {"unbalanced", "hot-spots"}) {
+    CAPTURE(schedule);
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 32, 32, opt, 2, schedule);
+    CHECK(run.image.pixels == sequential.image.pixels);
+    CHECK(run.result.rays.cameraRays == sequential.rays.cameraRays);
+    CHECK(run.result.rays.total() == sequential.rays.total());
+    const auto prePass = std::find_if(run.record.stages.begin(), run.record.stages.end(), [](const par::StageRecord& st) {
+      return st.name.find("profile pre-pass") != std::string::npos;
+    });
+    REQUIRE(prePass != run.record.stages.end());
+    CHECK(prePass->tasks.size() == 16u);
+    // The trace stage's tasks carry the profile's costs (rays per tile), not pixel counts.
+    const auto trace = std::find_if(run.record.stages.begin(), run.record.stages.end(),
+                                    [](const par::StageRecord& st) { return st.name == "trace"; });
+    REQUIRE(trace != run.record.stages.end());
+    REQUIRE(trace->tasks.size() == 16u);
+    const auto [low, high] = std::minmax_element(trace->tasks.begin(), trace->tasks.end(),
+                                                 [](const auto& a, const auto& b) { return a.costEstimate < b.costEstimate; });
+    CHECK(high->costEstimate > low->costEstimate);
+    CHECK(low->costEstimate >= 64.0);  // at least one ray per pixel of an 8 x 8 tile
+  }
+}
