@@ -210,9 +210,13 @@ bool Bvh::occludedK(const Ray& ray) const {
   for (;;) {
     if (!BvhRef::isLeaf(ref)) {
       __m128 tEntry[kGroups];
-      const int mask = slab(nodes[ref], boxRay, tMax, tEntry);
+      int mask = slab(nodes[ref], boxRay, tMax, tEntry);
       if (mask != 0) {
-        ref = orderChildren(nodes[ref], mask, tEntry, stack, sp);
+        // Any hit ends the query, so the order of the children only matters for how soon one
+        // is found: no sort, the first hit lane goes on, the others wait on the stack.
+        const BvhNode& node = nodes[ref];
+        ref = node.child[__builtin_ctz(unsigned(mask))];
+        for (mask &= mask - 1; mask != 0; mask &= mask - 1) stack[sp++] = {node.child[__builtin_ctz(unsigned(mask))], 0.0f};
         continue;
       }
     } else {
