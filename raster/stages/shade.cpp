@@ -1,11 +1,12 @@
 // Shading stage: perspective-correct attribute interpolation and the metallic-roughness BRDF
 // under the scene's punctual lights (no shadows). Deferred: called once per visible pixel by
 // shadeRegion on the framebuffer owner, after all its triangles were rasterized, so overdraw
-// costs only depth tests. Headlit untextured pixels go through four SSE lanes per step, each
-// lane repeating the scalar operations exactly, so the images do not change.
+// costs only depth tests. Headlit untextured pixels go through SIMD lanes (shade_lanes.inc:
+// eight AVX2 lanes where the processor has them, else four SSE lanes), each lane repeating the
+// scalar operations exactly, so the images do not change.
 #include "raster/stages/shade.h"
 
-#include <xmmintrin.h>
+#include <immintrin.h>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include <numbers>
 
 #include "common/scene/material_layers.h"
+#include "common/util/error.h"
 #include "common/scene/surface_material.h"
 #include "common/scene/texture.h"
 #include "raster/framebuffer.h"
@@ -105,6 +107,7 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
   ctx.textures = effects.has(scene::Effect::Textures);
   ctx.emission = effects.has(scene::Effect::Emission);
   ctx.direct = effects.has(scene::Effect::DirectLight);
+  ctx.lanes = shadeLanes();
   return ctx;
 }
 
@@ -270,31 +273,9 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeC
 
 namespace {
 
-// ---- Four pixels at a time ------------------------------------------------------------------
-// The common case (headlight, untextured materials, no vertex colours) is shaded in SSE lanes.
-// Each lane performs exactly the scalar operations of barycentricsFromEdges, surfaceAt and
-// shadeSurface, in the same order and without contraction (IEEE add, mul, div and sqrt are
-// correctly rounded in scalar and vector form alike), so a pixel's colour does not depend on
-// which pixels share its batch, nor on the region split: the images stay bit-identical to the
-// scalar path. SSE2 is part of x86-64, so no -march is needed.
-constexpr int kLanes = 4;
-using F4 = float __attribute__((vector_size(16)));
-using I4 = int32_t __attribute__((vector_size(16)));
-
-inline F4 splat(float v) { return F4{v, v, v, v}; }
-inline F4 load(const float* p) {
-  F4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline F4 sqrt4(F4 v) { return (F4)_mm_sqrt_ps((__m128)v); }
-// std::max(a, b) is (a < b) ? b : a; the same comparison keeps NaN and -0 behaviour.
-inline F4 max4(F4 a, F4 b) { return (a < b) ? b : a; }
-
-struct V3 {
-  F4 x, y, z;
-};
-inline F4 dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+// ---- Several pixels at a time -------------------------------------------------------------
+// The common case (headlight, untextured materials, no vertex colours) is shaded in SIMD lanes
+// (shade_lanes.inc); what the lanes need of a triangle and a material is computed here.
 
 // Shading constants of one material under the headlight (headlightBrdf's per-material terms).
 struct HeadlightMaterial {
@@ -329,14 +310,6 @@ enum Field : int {
   kN0X, kN0Y, kN0Z, kN1X, kN1Y, kN1Z, kN2X, kN2Y, kN2Z,
   kBack, kAlpha2, kK, kOneMinusK, kF0X, kF0Y, kF0Z, kDiffX, kDiffY, kDiffZ, kEmitX, kEmitY, kEmitZ,
   kTriangleFields
-};
-
-// kLanes pixels waiting to be shaded: their edge values and where their triangle's fields are.
-struct LaneBatch {
-  alignas(16) float e[3][kLanes];
-  const float* tri[kLanes];
-  size_t pixel[kLanes];
-  int count = 0;
 };
 
 // The lane fields of one screen triangle: its vertices' attributes and its material's constants.
@@ -380,181 +353,46 @@ void triangleFields(const scene::Scene& scene, const ScreenTriangle& tri, const 
   for (int k = 0; k < 3; ++k) *o++ = hm.emission[k];
 }
 
-// barycentricsFromEdges + surfaceAt + shadeSurface (headlight) on kLanes pixels.
-// kUniform: all lanes show one triangle, whose fields are then broadcast instead of gathered.
-template <bool kVertexNormals, bool kUniform>
-void shadeBatch(const ShadingContext& ctx, const LaneBatch& b, glm::vec3* colours) {
-  auto f = [&b](int k) {
-    if constexpr (kUniform) return splat(b.tri[0][k]);
-    else return F4{b.tri[0][k], b.tri[1][k], b.tri[2][k], b.tri[3][k]};
-  };
-  // Perspective-correct barycentrics (barycentricsFromEdges).
-  F4 w0 = load(b.e[0]) * f(kInvW0), w1 = load(b.e[1]) * f(kInvW1), w2 = load(b.e[2]) * f(kInvW2);
-  F4 inv = splat(1.0f) / (w0 + w1 + w2);
-  F4 s0 = w0 * inv, s1 = w1 * inv, s2 = w2 * inv;
-  F4 bx = s0 * f(kBary0X) + s1 * f(kBary1X) + s2 * f(kBary2X);
-  F4 by = s0 * f(kBary0Y) + s1 * f(kBary1Y) + s2 * f(kBary2Y);
-  F4 c0 = splat(1.0f) - bx - by, c1 = bx, c2 = by;
-  // Surface point (surfaceAt).
-  V3 p{c0 * f(kP0X) + c1 * f(kP1X) + c2 * f(kP2X), c0 * f(kP0Y) + c1 * f(kP1Y) + c2 * f(kP2Y),
-       c0 * f(kP0Z) + c1 * f(kP1Z) + c2 * f(kP2Z)};
-  V3 n{f(kN0X), f(kN0Y), f(kN0Z)};
-  if constexpr (kVertexNormals) {
-    V3 m{c0 * f(kN0X) + c1 * f(kN1X) + c2 * f(kN2X), c0 * f(kN0Y) + c1 * f(kN1Y) + c2 * f(kN2Y),
-         c0 * f(kN0Z) + c1 * f(kN1Z) + c2 * f(kN2Z)};
-    F4 len2 = dot(m, m);
-    F4 len = sqrt4(len2);
-    I4 ok = len2 > splat(0.0f);
-    n = V3{ok ? m.x / len : splat(0.0f), ok ? m.y / len : splat(0.0f), ok ? m.z / len : splat(1.0f)};
-    I4 back = f(kBack) != splat(0.0f);
-    n = V3{back ? -n.x : n.x, back ? -n.y : n.y, back ? -n.z : n.z};
-  }
-  // View vector (shadeSurface): normalize(eye - p) = d * (1 / sqrt(dot(d, d))), as glm does.
-  V3 v;
-  if (ctx.view.perspective) {
-    V3 d{splat(ctx.view.eye.x) - p.x, splat(ctx.view.eye.y) - p.y, splat(ctx.view.eye.z) - p.z};
-    F4 is = splat(1.0f) / sqrt4(dot(d, d));
-    v = V3{d.x * is, d.y * is, d.z * is};
-  } else {
-    v = V3{splat(-ctx.view.forward.x), splat(-ctx.view.forward.y), splat(-ctx.view.forward.z)};
-  }
-  // headlightBrdf.
-  F4 ndotv = dot(n, v);
-  F4 c = max4(ndotv, splat(1e-4f));
-  V3 nxv{n.y * v.z - v.y * n.z, n.z * v.x - v.z * n.x, n.x * v.y - v.x * n.y};
-  F4 alpha2 = f(kAlpha2);
-  F4 denom = dot(nxv, nxv) + c * c * alpha2;
-  F4 g = c * f(kOneMinusK) + f(kK);
-  F4 spec = alpha2 / (splat(4.0f * kPi) * denom * denom * g * g);
-  F4 scale = splat(kHeadlightLux) * ndotv;
-  I4 lit = ndotv > splat(0.0f);
-  F4 rx = f(kEmitX), ry = f(kEmitY), rz = f(kEmitZ);
-  rx = lit ? rx + (f(kDiffX) + f(kF0X) * spec) * scale : rx;
-  ry = lit ? ry + (f(kDiffY) + f(kF0Y) * spec) * scale : ry;
-  rz = lit ? rz + (f(kDiffZ) + f(kF0Z) * spec) * scale : rz;
-  for (int l = 0; l < b.count; ++l) colours[b.pixel[l]] = glm::vec3(rx[l], ry[l], rz[l]);
+namespace sse {
+#define PR_SHADE_LANES 4
+#include "raster/stages/shade_lanes.inc"
+#undef PR_SHADE_LANES
+}  // namespace sse
+
+// The same kernel eight lanes wide, compiled for AVX2 (and only run where the processor has
+// it). Everything it defines has internal linkage, so no AVX code reaches other callers.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+namespace avx2 {
+#define PR_SHADE_LANES 8
+#include "raster/stages/shade_lanes.inc"
+#undef PR_SHADE_LANES
+}  // namespace avx2
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+
+bool hasAvx2() {
+  static const bool avx2 = __builtin_cpu_supports("avx2");
+  return avx2;
 }
 
 }  // namespace
 
+int shadeLanes() { return hasAvx2() ? avx2::kLanes : sse::kLanes; }
+
 void shadeRegion(const ShadingContext& ctx, std::span<const ScreenTriangle> tris, const PixelWindow& fb,
                  ShadeCounters* counters) {
-  const scene::Scene& scene = *ctx.scene;
-  const Rect rect = fb.rect;
-  const uint64_t* keys = fb.keys;
-  const uint32_t* triangles = fb.triangles;
-  glm::vec3* colours = fb.colours;
-
-  // Lanes take the headlight path with per-material constants; anything else (punctual lights,
-  // textures, vertex colours) is shaded one pixel at a time by shadeSurface.
-  // The plan's skips are handled (and counted) by shadeSurface.
-  const bool lanes = ctx.usesHeadlight && scene.colors.empty() && ctx.textures && ctx.emission && ctx.direct;
-  std::vector<HeadlightMaterial> materials;
-  if (lanes) {
-    materials.reserve(scene.materials.size());
-    for (uint32_t m = 0; m < scene.materials.size(); ++m) materials.push_back(headlightMaterial(scene, m));
-  }
-  const bool vertexNormals = !scene.normals.empty();
-  LaneBatch batch;
-  auto flush = [&] {
-    if (batch.count == 0) return;
-    // Unused lanes repeat lane 0 (finite inputs); only batch.count colours are written.
-    for (int l = batch.count; l < kLanes; ++l) {
-      for (int k = 0; k < 3; ++k) batch.e[k][l] = batch.e[k][0];
-      batch.tri[l] = batch.tri[0];
-    }
-    const bool uniform = batch.tri[1] == batch.tri[0] && batch.tri[2] == batch.tri[0] && batch.tri[3] == batch.tri[0];
-    static_assert(kLanes == 4);
-    if (vertexNormals) {
-      if (uniform) shadeBatch<true, true>(ctx, batch, colours);
-      else shadeBatch<true, false>(ctx, batch, colours);
-    } else {
-      if (uniform) shadeBatch<false, true>(ctx, batch, colours);
-      else shadeBatch<false, false>(ctx, batch, colours);
-    }
-    batch.count = 0;
-  };
-
-  // Neighbouring pixels mostly show the same triangle: keep its setup and lane fields. The
-  // fields live in a ring of kLanes + 1 slots: a batch's lanes refer to at most the kLanes most
-  // recent triangles, so the slot overwritten next is never one the pending batch reads.
-  uint32_t cached = kNoTriangle;
-  const float* cachedFields = nullptr;
-  EdgeFunctions s{};
-  float ring[kLanes + 1][kTriangleFields];
-  int slot = 0;
-  // Pixels i + 1 .. i + kLanes - 1 are covered by the triangle of pixel i.
-  auto sameTriangleRun = [&](size_t i) {
-    for (int l = 1; l < kLanes; ++l) {
-      if (!keyCovered(keys[i + l]) || triangles[i + l] != triangles[i]) return false;
-    }
-    return true;
-  };
-  uint32_t runTriangle = kNoTriangle;
-  int runX = 0, runY = 0;
-  int64_t e[3] = {0, 0, 0};
-  uint64_t shaded = 0;
-  for (int y = rect.y0; y < rect.y1; ++y) {
-    size_t i = fb.index(rect.x0, y);
-    for (int x = rect.x0; x < rect.x1; ++x, ++i) {
-      if (!keyCovered(keys[i]) || triangles[i] == kNoTriangle) continue;
-      const ScreenTriangle& tri = tris[triangles[i]];
-      if (triangles[i] != cached) {
-        edgeFunctions(tri, s);
-        cached = triangles[i];
-        cachedFields = nullptr;
-        if (lanes) {
-          const HeadlightMaterial& hm = materials[scene.triangles[tri.primitive].material];
-          if (hm.fast) {
-            slot = slot == kLanes ? 0 : slot + 1;
-            triangleFields(scene, tri, hm, ring[slot]);
-            cachedFields = ring[slot];
-          }
-        }
-      }
-      // Along a run of one triangle the edge values step by a * 256 (exact integers, equal to
-      // edgeAt); a new triangle or row starts from edgeAt.
-      if (triangles[i] == runTriangle && y == runY && x == runX + 1) {
-        for (int k = 0; k < 3; ++k) e[k] += s.a[k] * kSubpixelScale;
-      } else {
-        for (int k = 0; k < 3; ++k) e[k] = edgeAt(s, k, x, y);
-        runTriangle = triangles[i];
-        runY = y;
-      }
-      runX = x;
-      const int64_t e0 = e[0], e1 = e[1], e2 = e[2];
-      ++shaded;
-      if (!cachedFields) {
-        colours[i] = shadeSurface(ctx, surfaceAt(scene, tri, barycentricsFromEdges(tri, e0, e1, e2)), counters);
-        continue;
-      }
-      // A run of kLanes pixels of this triangle starting a batch fills it at once.
-      if (batch.count == 0 && x + kLanes <= rect.x1 && sameTriangleRun(i)) {
-        for (int l = 0; l < kLanes; ++l) {
-          for (int k = 0; k < 3; ++k) batch.e[k][l] = float(e[k] + l * s.a[k] * kSubpixelScale);
-          batch.tri[l] = cachedFields;
-          batch.pixel[l] = i + static_cast<size_t>(l);
-        }
-        batch.count = kLanes;
-        flush();
-        for (int k = 0; k < 3; ++k) e[k] += (kLanes - 1) * s.a[k] * kSubpixelScale;
-        x += kLanes - 1;
-        i += kLanes - 1;
-        runX = x;
-        shaded += kLanes - 1;
-        continue;
-      }
-      const int l = batch.count;
-      batch.e[0][l] = float(e0);
-      batch.e[1][l] = float(e1);
-      batch.e[2][l] = float(e2);
-      batch.tri[l] = cachedFields;
-      batch.pixel[l] = i;
-      if (++batch.count == kLanes) flush();
-    }
-  }
-  flush();
-  if (counters) counters->pixelsShaded += shaded;
+  PR_CHECK(ctx.lanes == sse::kLanes || (ctx.lanes == avx2::kLanes && hasAvx2()),
+           "shadeRegion: no kernel of that many lanes on this processor");
+  if (ctx.lanes == avx2::kLanes) avx2::shadeRegionLanes(ctx, tris, fb, counters);
+  else sse::shadeRegionLanes(ctx, tris, fb, counters);
 }
 
 }  // namespace pr::raster

@@ -59,6 +59,9 @@ struct ShadingContext {
   // shades from the material factors, emission off adds no emitted radiance, direct off adds
   // no light (punctual or headlight). The work not done is counted in ShadeCounters.
   bool textures = true, emission = true, direct = true;
+  // Pixels per SIMD step of the headlit kernel: 8 (AVX2) or 4 (SSE2), chosen once per run for
+  // the processor (shadeLanes()); either gives the same bits.
+  int lanes = 4;
 };
 
 // Whether the rasterizer lights this scene by its headlight: it has no punctual lights, and
@@ -94,6 +97,9 @@ struct ShadeCounters {
 // Outgoing radiance towards the camera: emission + sum over lights of f_r * E * cos(theta),
 // less what the plan turned off (counted in counters when given).
 glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& point, ShadeCounters* counters = nullptr);
+
+// Pixels per SIMD step of the headlit kernel on this processor: 8 where it has AVX2, else 4.
+int shadeLanes();
 
 // Shades every covered pixel of the window from tris[triangle index there] (the list it was
 // rasterized from) and writes its colour. Uncovered pixels keep the background colour 0.

@@ -260,21 +260,27 @@ void benchScene(const std::string& label, const std::string& path, const Options
   std::printf("sequential P=1: %.1f ms (cpu %.1f ms)%s\n", ms, cpuMs, ratio(0, ms, cpuMs).c_str());
 
   struct Variant {
-    const raster::SortPointInfo* info;
+    const raster::SortPointInfo* info = nullptr;
     std::string label;
     raster::SortOptions options;
     std::string schedule = "demand";
   };
   std::vector<Variant> variants;
+  auto add = [&variants](const raster::SortPointInfo& info, std::string label, bool sparse, std::string schedule) {
+    Variant v;
+    v.info = &info;
+    v.label = std::move(label);
+    v.options.sparse = sparse;
+    v.schedule = std::move(schedule);
+    variants.push_back(std::move(v));
+  };
   for (const raster::SortPointInfo& info : raster::sortPoints()) {
-    variants.push_back({&info, std::string(info.name), {}});
+    add(info, std::string(info.name), false, "demand");
     if (info.name == "sort-last") {
       // Sparse compositing (bounding rectangles), with geometry batches on demand and in equal
       // contiguous portions (each PE's primitives then cover a part of the screen).
-      raster::SortOptions sparse;
-      sparse.sparse = true;
-      variants.push_back({&info, "sort-last --sparse", sparse});
-      variants.push_back({&info, "sort-last --sparse --schedule balanced", sparse, "balanced"});
+      add(info, "sort-last --sparse", true, "demand");
+      add(info, "sort-last --sparse --schedule balanced", true, "balanced");
     }
   }
   for (const Variant& v : variants) {

@@ -210,13 +210,19 @@ TEST_CASE("Shade: base colour textures use the sampler's wrap mode and bilinear 
   CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.26f, 0.51f, 0.01f), 1e-5f));
 }
 
-// shadeRegion shades headlit, untextured pixels four at a time; each lane must compute exactly
-// the per-pixel function (barycentrics, surface point, BRDF), whichever pixels share its batch.
-TEST_CASE("Shade: four-pixel lanes give the per-pixel colours bit for bit") {
+// shadeRegion shades headlit, untextured pixels four (SSE2) or eight (AVX2) at a time; each
+// lane must compute exactly the per-pixel function (barycentrics, surface point, BRDF),
+// whichever pixels share its batch and whichever kernel runs.
+TEST_CASE("Shade: four- and eight-pixel lanes give the per-pixel colours bit for bit") {
   constexpr int kW = 61, kH = 37;  // odd sizes: rows end with partial batches
-  for (int variant = 0; variant < 4; ++variant) {
+  CHECK((shadeLanes() == 4 || shadeLanes() == 8));
+  if (shadeLanes() != 8) MESSAGE("this processor has no AVX2: the eight-lane kernel is not checked");
+  const int variants = shadeLanes() == 8 ? 8 : 4;  // four scenes, through each kernel there is
+  for (int variant = 0; variant < variants; ++variant) {
+    const int lanes = variant < 4 ? 4 : 8;
     const bool vertexNormals = variant & 1, ortho = variant & 2;
     CAPTURE(variant);
+    CAPTURE(lanes);
     scene::Scene s = test::emptyScene();
     scene::Material metal;
     metal.metallicFactor = 0.8f;
@@ -247,8 +253,9 @@ TEST_CASE("Shade: four-pixel lanes give the per-pixel colours bit for bit") {
     processTriangles(s, view, 0, uint32_t(s.triangles.size()), tris);
     RegionFramebuffer fb(Rect{0, 0, kW, kH});
     rasterizeTriangles(tris, fb);
-    const ShadingContext ctx = makeShadingContext(s, view);
+    ShadingContext ctx = makeShadingContext(s, view);
     REQUIRE(ctx.usesHeadlight);
+    ctx.lanes = lanes;
     ShadeCounters counters;
     shadeRegion(ctx, tris, fb, &counters);
     CHECK(counters.pixelsShaded == fb.coveredPixels());
