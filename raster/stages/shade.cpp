@@ -379,8 +379,8 @@ namespace avx2 {
 #endif
 
 bool hasAvx2() {
-  static const bool avx2 = __builtin_cpu_supports("avx2");
-  return avx2;
+  static const bool has = __builtin_cpu_supports("avx2");
+  return has;
 }
 
 }  // namespace

@@ -314,7 +314,6 @@ class CachedImageSpaceFrame {
   // tile's cost for the schedule; the items it used start the PE's profile. Its rays are not
   // the render's: they are not in the ray counters.
   void profilePrePass(const std::vector<PixelRect>& tiles, par::TaskSet& tasks) {
-    constexpr int kStride = 4;
     const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
     rt_.runStage(job_.stage("profile pre-pass"), par::TaskSet::uniform(tiles.size()), *balanced,
                  [&](par::Pe& pe, par::TaskId id) {
@@ -323,8 +322,8 @@ class CachedImageSpaceFrame {
                    Film scratch(rect, job_.width, job_.height, 1);
                    TraceStats stats;
                    int64_t sampled = 0;
-                   for (int y = rect.y0; y < rect.y1; y += kStride)
-                     for (int x = rect.x0; x < rect.x1; x += kStride) {
+                   for (int y = rect.y0; y < rect.y1; y += kCostPrePassStride)
+                     for (int x = rect.x0; x < rect.x1; x += kCostPrePassStride) {
                        integrator_->cameraRays(PixelRect{x, y, x + 1, y + 1}, 1, st.queue);
                        ++sampled;
                      }
@@ -333,8 +332,7 @@ class CachedImageSpaceFrame {
                    st.touched.clear();
                    traceTile(pe, st, scratch, stats);
                    noteProfile(st, size_t(id), false);
-                   const double cost = sampled > 0 ? double(stats.total()) * double(rect.pixels()) / double(sampled) : 1.0;
-                   tasks.tasks[size_t(id)].costEstimate = std::max(cost, 1.0);
+                   tasks.tasks[size_t(id)].costEstimate = tileCostEstimate(stats.total(), rect, sampled);
                  });
   }
 

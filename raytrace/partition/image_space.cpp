@@ -11,15 +11,12 @@
 #include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/partition.h"
+#include "raytrace/partition/partitioned.h"
 
 namespace pr::rt {
 
 namespace {
 
-// The pre-pass traces one pixel in kPrePassStride x kPrePassStride (1/16 of the pixels), one
-// sample each: rays traced per tile is the cost estimate, a pure count, so the estimates (and
-// any schedule built on them) do not depend on timing.
-constexpr int kPrePassStride = 4;
 // Adaptive subdivision: a tile estimated at more than this many times the mean tile cost is
 // split into four, so no single task dominates the end of the stage.
 constexpr double kAdaptiveSplitFactor = 2.0;
@@ -106,14 +103,13 @@ class ImageSpacePartition final : public Partition {
       std::vector<RayMessage> queue;
       TraceStats stats;
       int64_t sampled = 0;
-      for (int y = t.rect.y0; y < t.rect.y1; y += kPrePassStride)
-        for (int x = t.rect.x0; x < t.rect.x1; x += kPrePassStride) {
+      for (int y = t.rect.y0; y < t.rect.y1; y += kCostPrePassStride)
+        for (int x = t.rect.x0; x < t.rect.x1; x += kCostPrePassStride) {
           integrator.cameraRays(PixelRect{x, y, x + 1, y + 1}, 1, queue);
           integrator.traceToCompletion(bvh, queue, scratch, stats, 0);
           ++sampled;
         }
-      t.cost = sampled > 0 ? double(stats.total()) * double(t.rect.pixels()) / double(sampled) : 1.0;
-      t.cost = std::max(t.cost, 1.0);
+      t.cost = tileCostEstimate(stats.total(), t.rect, sampled);
     });
   }
 

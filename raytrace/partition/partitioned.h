@@ -119,6 +119,17 @@ inline std::vector<std::unique_ptr<Film>> makeFilms(const TraceJob& job, int pes
   return films;
 }
 
+// The cost pre-pass of the tile tracers (image-space, image-space-cached): one pixel in
+// kCostPrePassStride x kCostPrePassStride (1/16 of the pixels), one sample each. Rays traced
+// per tile is the estimate, a pure count, so the estimates (and any schedule built on them)
+// do not depend on timing.
+constexpr int kCostPrePassStride = 4;
+// Rays traced for `sampled` pixels of rect, scaled to its pixel count; at least 1.
+inline double tileCostEstimate(uint64_t raysTraced, const PixelRect& rect, int64_t sampled) {
+  const double cost = sampled > 0 ? double(raysTraced) * double(rect.pixels()) / double(sampled) : 1.0;
+  return std::max(cost, 1.0);
+}
+
 inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx) {
   par::TaskSet set;
   for (const PixelRect& r : tiles)
