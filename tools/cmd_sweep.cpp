@@ -5,10 +5,7 @@
 // and prints, and writes as CSV and JSON, one row per render: setting, CPU and wall seconds,
 // RMSE, relative MSE, maximum error and the RMSE inside the caustic region; then the CPU time
 // each integrator needs to reach a target RMSE, interpolated on its curve.
-#include <sys/resource.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -35,15 +32,13 @@
 #include "tools/lighting.h"
 #include "tools/render_methods.h"
 #include "tools/sweep/image_error.h"
-#include "tools/sweep/reference_cache.h"
+#include "tools/sweep/path_reference.h"
+#include "tools/timed_render.h"
 
 namespace pr::cli {
 
 namespace {
 
-// The reference's own random stream: apart from every render of the series, so that the
-// path tracer's error at spp N is not shrunk by sharing the reference's first N samples.
-constexpr std::uint64_t kReferenceSeedOffset = 0x5eed0f4e4e4e4e4eull;
 // A pixel is in the caustic region when the caustic map gives at least this share of the
 // reference's radiance there: the pixels whose light the caustic map carries.
 constexpr double kCausticShare = 0.25;
@@ -78,32 +73,15 @@ struct Timed {
   double cpuSeconds = 0.0, wallSeconds = 0.0;
 };
 
-double processCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
-
 struct Context {
   const SweepArgs& args;
-  const scene::Scene& scene;
-  const scene::Camera& camera;
-  const scene::RenderPlan& plan;
+  RenderInput input;
 };
 
 // One timed render of the series: a fresh runtime, CPU time of the whole process (every PE).
 Timed render(const Context& c, const RenderSettings& settings) {
-  const RenderMethod& method = findRenderMethod(c.args.method);
-  par::Runtime runtime(par::RuntimeOptions{c.args.threads, c.args.schedule.schedule, c.args.schedule.params, true});
-  const RenderRequest request{c.scene, c.camera, c.args.width, c.args.height, settings, c.plan, runtime, {}};
-  const double cpu0 = processCpuSeconds();
-  const auto t0 = std::chrono::steady_clock::now();
-  RenderOutcome outcome = method.make(method.name, request);
-  Timed t;
-  t.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  t.cpuSeconds = processCpuSeconds() - cpu0;
-  t.image = std::move(outcome.image);
-  return t;
+  TimedRender t = timedRender(findRenderMethod(c.args.method), c.input, settings, c.args.threads, c.args.schedule);
+  return Timed{std::move(t.outcome.image), t.cpuSeconds, t.wallSeconds};
 }
 
 RenderSettings baseSettings(const SweepArgs& a, const std::string& integrator, int spp, std::uint64_t seed, int depth) {
@@ -193,36 +171,16 @@ void run(SweepArgs& a) {
     if (!(v > 0.0) || !std::isfinite(v) || v > most || (integral && v != std::floor(v)))
       throw InputError("--values: " + format(v) + " is not a valid " + a.vary + " (" + (integral ? "an integer " : "a number ") +
                        "in (0, " + format(most) + "])");
-  const Context ctx{a, scene, camera, plan};
+  const Context ctx{a, RenderInput{scene, camera, plan, a.width, a.height}};
   if (!a.images.empty()) std::filesystem::create_directories(a.images);
 
   // The reference: reused when a render with exactly these settings is on disk.
-  std::error_code ec;
-  const std::filesystem::path scenePath = std::filesystem::canonical(a.scene, ec);
-  nlohmann::json key = {{"kind", "path-traced reference"}, {"scene", scenePath.string()},
-                        {"sceneBytes", std::filesystem::file_size(a.scene)},
-                        {"sceneTime", std::filesystem::last_write_time(a.scene).time_since_epoch().count()},
-                        {"camera", a.camera}, {"width", a.width}, {"height", a.height}, {"spp", a.referenceSpp},
-                        {"maxDepth", a.referenceDepth}, {"seed", a.seed ^ kReferenceSeedOffset}, {"effects", a.effects},
-                        {"env", a.lighting.env}, {"envStrength", a.lighting.strength},
-                        {"envRotate", a.lighting.rotateDegrees}, {"noDefaultLight", a.lighting.noDefault}};
-  const ReferenceCache cache(a.referenceDir.empty() ? ReferenceCache::defaultDir() : std::filesystem::path(a.referenceDir));
-  std::optional<image::Image> cached = a.noCache ? std::nullopt : cache.find(key);
-  image::Image reference;
-  double referenceCpu = 0.0;
-  std::string referenceFile;
-  if (cached) {
-    reference = std::move(*cached);
-    std::fprintf(stderr, "reference: cached (path, spp %d) in %s\n", a.referenceSpp, cache.dir().string().c_str());
-  } else {
-    std::fprintf(stderr, "reference: rendering (path, spp %d, depth %d) ...\n", a.referenceSpp, a.referenceDepth);
-    Timed t = render(ctx, baseSettings(a, "path", a.referenceSpp, a.seed ^ kReferenceSeedOffset, a.referenceDepth));
-    referenceCpu = t.cpuSeconds;
-    reference = std::move(t.image);
-    if (!a.noCache) referenceFile = cache.store(key, reference).string();
-    std::fprintf(stderr, "reference: %.1f CPU s%s%s\n", referenceCpu, referenceFile.empty() ? "" : ", stored as ",
-                 referenceFile.c_str());
-  }
+  ReferenceSettings referenceSettings{a.scene, a.camera, a.effects, a.lighting, a.referenceSpp, a.referenceDepth, a.seed,
+                                      a.referenceDir, a.noCache, a.method, a.threads, a.schedule};
+  const Reference ref = pathReference(referenceSettings, ctx.input);
+  const image::Image& reference = ref.image;
+  const bool cached = ref.cached;
+  const double referenceCpu = ref.cpuSeconds;
 
   // The caustic region: where the caustic map carries a good share of the reference's light.
   std::vector<bool> causticMask;

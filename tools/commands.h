@@ -7,6 +7,7 @@
 namespace pr::cli {
 
 // One declaration per subcommand, each defined in its cmd_*.cpp.
+void addCompareCommand(CLI::App& app);
 void addGalleryCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);

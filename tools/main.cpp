@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
           "SIZE"))
       ->trigger_on_parse();
   // One line per subcommand (tools/commands.h).
+  pr::cli::addCompareCommand(app);
   pr::cli::addGalleryCommand(app);
   pr::cli::addGenerateCommand(app);
   pr::cli::addInfoCommand(app);

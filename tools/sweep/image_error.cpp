@@ -3,6 +3,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <string>
 
 #include "common/util/error.h"
@@ -45,6 +47,22 @@ image::Image differenceImage(const image::Image& image, const image::Image& refe
   for (std::size_t i = 0; i < image.pixels.size(); ++i)
     out.pixels[i] = glm::abs(image.pixels[i] - reference.pixels[i]) * scale;
   return out;
+}
+
+std::string bitDifference(const image::Image& a, const image::Image& b) {
+  if (a.width != b.width || a.height != b.height) return "a different size";
+  std::size_t pixels = 0;
+  float largest = 0.0f;
+  for (std::size_t i = 0; i < a.pixels.size(); ++i)
+    if (std::memcmp(&a.pixels[i], &b.pixels[i], sizeof(glm::vec3)) != 0) {
+      ++pixels;
+      const glm::vec3 d = glm::abs(a.pixels[i] - b.pixels[i]);
+      largest = std::max({largest, d.x, d.y, d.z});
+    }
+  if (pixels == 0) return {};
+  char text[96];
+  std::snprintf(text, sizeof text, "%zu pixels differ, largest by %.3g", pixels, double(largest));
+  return text;
 }
 
 }  // namespace pr::cli

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "common/image/image.h"
@@ -20,6 +21,10 @@ struct ImageError {
 
 // mask: one flag per pixel (empty = no mask). Images must have the same size (InputError).
 ImageError imageError(const image::Image& image, const image::Image& reference, const std::vector<bool>& mask = {});
+
+// "" when the images are bit-identical (every float of every pixel), else how they differ:
+// "N pixels differ, largest by D" or "a different size".
+std::string bitDifference(const image::Image& a, const image::Image& b);
 
 // |image - reference| x scale per channel: the seed's "difference image multiplied by 8".
 image::Image differenceImage(const image::Image& image, const image::Image& reference, float scale = 8.0f);

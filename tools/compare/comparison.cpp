@@ -1,0 +1,200 @@
+// The comparison run (see comparison.h).
+#include "tools/compare/comparison.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <numeric>
+#include <tuple>
+
+#include "common/parallel/schedulers/scheduler.h"
+#include "common/util/error.h"
+#include "raster/composite/compositor.h"
+#include "tools/integrators.h"
+#include "tools/sweep/image_error.h"
+
+namespace pr::cli {
+
+std::string Combination::label() const {
+  std::string out = method + " " + schedule;
+  if (integrator != kNotApplicable) out += " " + integrator;
+  if (compositor != kNotApplicable) out += " " + compositor;
+  return out + " P=" + std::to_string(pes);
+}
+
+const std::vector<std::string>& comparisonKinds() {
+  static const std::vector<std::string> kKinds = {"tasks", "primitives", "rays", "pixels", "broadcasts", "results",
+                                                  "requests", "data"};
+  return kKinds;
+}
+
+namespace {
+
+bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
+
+// Why the combination cannot run, or empty.
+std::string whyInvalid(const Combination& c, const ComparisonSpec& spec) {
+  if (c.method == "sequential" && c.pes > 1) return "sequential is the one-PE reference; it runs at P = 1 only";
+  if (c.method == "sequential" && c.schedule != spec.schedules.front())
+    return "sequential runs one task on one PE: every schedule gives the run measured under " + spec.schedules.front();
+  if (c.compositor == "binary-swap" && !isPowerOfTwo(c.pes)) return "binary-swap needs P a power of two";
+  return {};
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 == 1 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+// The share of a data manager's cache uses that hit, from the Cache/ counters; < 0 when none.
+double cacheHitRatio(const par::RunSummary& summary) {
+  double hits = -1.0, uses = 0.0;
+  for (const par::CounterSummary& c : summary.counters) {
+    if (c.name == "Cache/hits") hits = c.total, uses += c.total;
+    if (c.name == "Cache/misses" || c.name == "Cache/misses_joined") uses += c.total;
+  }
+  return hits < 0.0 ? -1.0 : uses > 0.0 ? hits / uses : 1.0;
+}
+
+void checkNames(const std::vector<std::string>& names, const char* option, const auto& registry) {
+  if (names.empty()) throw InputError(std::string(option) + ": give at least one value");
+  for (const std::string& n : names)
+    if (std::string problem = registry.problem(n); !problem.empty()) throw InputError(std::string(option) + ": " + problem);
+}
+
+}  // namespace
+
+Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input) {
+  checkNames(spec.methods, "--methods", renderMethods());
+  checkNames(spec.schedules, "--schedules", par::schedules());
+  checkNames(spec.integrators, "--integrators", integrators());
+  checkNames(spec.compositors, "--compositors", raster::compositors());
+  if (spec.threads.empty()) throw InputError("--threads: give at least one value");
+  if (spec.repeat < 1) throw InputError("--repeat: at least one run per combination");
+
+  // The combinations, in table order: method, integrator, compositor, schedule, P.
+  std::vector<Combination> combinations;
+  Comparison out;
+  std::vector<int> threads = spec.threads;
+  std::sort(threads.begin(), threads.end());
+  threads.erase(std::unique(threads.begin(), threads.end()), threads.end());
+  for (const std::string& name : spec.methods) {
+    const RenderMethod& method = findRenderMethod(name);
+    const bool ray = method.properties.family == MethodFamily::Ray;
+    const std::vector<std::string> integratorList = ray ? spec.integrators : std::vector<std::string>{kNotApplicable};
+    const std::vector<std::string> compositorList =
+        name == "sort-last" ? spec.compositors : std::vector<std::string>{kNotApplicable};
+    for (const std::string& integrator : integratorList)
+      for (const std::string& compositor : compositorList)
+        for (const std::string& schedule : spec.schedules)
+          for (int p : threads) {
+            Combination c{name, method.properties.family, schedule, integrator, compositor, p};
+            std::string reason = whyInvalid(c, spec);
+            if (reason.empty()) {
+              try {
+                checkRenderMemory(method, input.width, input.height, p, spec.settings.ray.spp);
+              } catch (const InputError& e) {
+                reason = e.what();
+              }
+            }
+            if (reason.empty()) combinations.push_back(c);
+            else out.skipped.push_back({c.label(), reason});
+          }
+  }
+  for (const std::string& note : spec.notes) out.skipped.push_back({"option", note});
+
+  if (spec.reference) out.reference = pathReference(spec.referenceSettings, input);
+
+  const int total = int(combinations.size()) * spec.repeat;
+  int done = 0;
+  // The first image of each family and integrator: every other must equal it bit for bit.
+  std::map<std::pair<MethodFamily, std::string>, std::size_t> familyFirst;
+  for (const Combination& c : combinations) {
+    RenderSettings settings = spec.settings;
+    if (c.integrator != kNotApplicable) settings.ray.integrator = c.integrator;
+    if (c.compositor != kNotApplicable) settings.raster.compositor = c.compositor;
+    const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
+    const RenderMethod& method = findRenderMethod(c.method);
+    ComparisonRow row;
+    row.what = c;
+    std::vector<TimedRender> runs;
+    for (int r = 0; r < spec.repeat; ++r) {
+      TimedRender t = timedRender(method, input, settings, c.pes, schedule);
+      ++done;
+      if (spec.progress)
+        std::fprintf(stderr, "[%d/%d] %s run %d/%d: %.3f s\n", done, total, c.label().c_str(), r + 1, spec.repeat,
+                     t.wallSeconds);
+      // Every repeat renders the same image (the renders are deterministic).
+      if (!runs.empty())
+        if (std::string d = bitDifference(t.outcome.image, runs.front().outcome.image); !d.empty()) {
+          row.agrees = false;
+          row.agreement = "run " + std::to_string(r + 1) + " differs from run 1: " + d;
+        }
+      row.wallSeconds.push_back(t.wallSeconds);
+      row.cpuSeconds.push_back(t.cpuSeconds);
+      runs.push_back(std::move(t));
+    }
+    row.wall = median(row.wallSeconds);
+    row.wallMin = *std::min_element(row.wallSeconds.begin(), row.wallSeconds.end());
+    row.wallMax = *std::max_element(row.wallSeconds.begin(), row.wallSeconds.end());
+    row.cpu = median(row.cpuSeconds);
+    // The run whose wall time is the median (the lower middle for an even count).
+    std::vector<std::size_t> order(runs.size());
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) { return runs[a].wallSeconds < runs[b].wallSeconds; });
+    TimedRender& mid = runs[order[(order.size() - 1) / 2]];
+    row.record = std::move(mid.record);
+    row.summary = par::summarize(row.record);
+    row.cacheHitRatio = cacheHitRatio(row.summary);
+    row.rays = mid.outcome.rays;
+    if (!out.reference.image.empty()) row.rmse = imageError(mid.outcome.image, out.reference.image).rmse;
+    row.image = std::move(mid.outcome.image);
+
+    const auto key = std::make_pair(c.family, c.integrator);
+    if (auto first = familyFirst.find(key); first == familyFirst.end()) {
+      familyFirst[key] = out.rows.size();
+      if (row.agrees) row.agreement = "reference";
+    } else if (row.agrees) {
+      const ComparisonRow& ref = out.rows[first->second];
+      const std::string d = bitDifference(row.image, ref.image);
+      row.agrees = d.empty();
+      row.agreement = d.empty() ? "identical" : "differs from " + ref.what.label() + ": " + d;
+    }
+    if (!row.agrees) {
+      ++out.mismatches;
+      std::fprintf(stderr, "IMAGE MISMATCH: %s %s\n", c.label().c_str(), row.agreement.c_str());
+    }
+    out.rows.push_back(std::move(row));
+  }
+
+  // Speed-ups: T1 is the same combination at P = 1; Ts the family's serial reference for the
+  // integrator, the sequential tracer when it ran, else the family's fastest run at P = 1.
+  for (ComparisonRow& row : out.rows) {
+    const ComparisonRow* one = nullptr;
+    const ComparisonRow* serial = nullptr;
+    for (const ComparisonRow& other : out.rows) {
+      const Combination& o = other.what;
+      if (o.pes != 1 || o.family != row.what.family || o.integrator != row.what.integrator) continue;
+      if (o.method == row.what.method && o.schedule == row.what.schedule && o.compositor == row.what.compositor) one = &other;
+      const bool sequential = o.method == "sequential";
+      if (!serial || (sequential && serial->what.method != "sequential") ||
+          (sequential == (serial->what.method == "sequential") && other.wall < serial->wall))
+        serial = &other;
+    }
+    if (one && row.wall > 0.0) {
+      row.speedup = one->wall / row.wall;
+      row.efficiency = row.speedup / row.what.pes;
+    }
+    if (serial && row.wall > 0.0) {
+      row.speedupSerial = serial->wall / row.wall;
+      row.serialReference = serial->what.label();
+    }
+  }
+  if (!spec.keepImages)
+    for (ComparisonRow& row : out.rows) row.image = {};
+  return out;
+}
+
+}  // namespace pr::cli

@@ -1,0 +1,86 @@
+// A comparison run: every valid combination of methods, P, schedules, integrators (ray
+// tracers) and compositors (sort-last) rendered afresh and timed N times on one scene, each
+// checked against the other images of its family (the project promises them bit-identical:
+// a ray tracer's image depends only on its integrator and settings, a rasterizer's on nothing
+// but the scene) and measured against the path-traced reference. Every figure of a row is read
+// from the run record of its median run through common/parallel/metrics.h. Used by
+// `parrender compare` (cmd_compare.cpp) and `parrender report` (cmd_report.cpp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/image/image.h"
+#include "common/parallel/metrics.h"
+#include "common/parallel/run_options.h"
+#include "common/parallel/run_record.h"
+#include "tools/render_methods.h"
+#include "tools/sweep/path_reference.h"
+#include "tools/timed_render.h"
+
+namespace pr::cli {
+
+// "-" marks a dimension that does not apply to the method (integrator of a rasterizer,
+// compositor of anything but sort-last).
+inline constexpr const char* kNotApplicable = "-";
+
+struct Combination {
+  std::string method;
+  MethodFamily family = MethodFamily::Ray;
+  std::string schedule, integrator, compositor;
+  int pes = 1;
+  std::string label() const;  // "object-space demand path P=2"
+};
+
+struct ComparisonSpec {
+  std::vector<std::string> methods, schedules, integrators, compositors;
+  std::vector<int> threads;
+  int repeat = 3;
+  RenderSettings settings;       // every other option of the renders
+  par::ScheduleParams scheduleParams;
+  bool reference = true;         // measure RMSE against the path-traced reference
+  ReferenceSettings referenceSettings;
+  bool keepImages = true;        // keep each row's image (report); else only the figures
+  bool progress = true;          // a line on stderr per render
+  std::vector<std::string> notes;  // options given that some methods do not take (shown as skipped)
+};
+
+struct ComparisonRow {
+  Combination what;
+  std::vector<double> wallSeconds, cpuSeconds;  // one per repeat
+  double wall = 0.0, wallMin = 0.0, wallMax = 0.0, cpu = 0.0;  // median, spread
+  double speedup = 0.0;        // T1/Tn against the same combination at P = 1; 0 when not run
+  double speedupSerial = 0.0;  // Ts/Tn against the family's serial reference; 0 when not run
+  double efficiency = 0.0;     // speedup / P; 0 when T1 unknown
+  std::string serialReference; // the label of the run giving Ts
+  par::RunSummary summary;     // of the median run
+  par::RunRecord record;       // the median run's record
+  double cacheHitRatio = -1.0; // hits / uses of a data manager's cache; < 0 when none ran
+  std::uint64_t rays = 0;
+  double rmse = -1.0;          // against the path-traced reference; < 0 without one
+  bool agrees = true;          // bit-identical to its family's first image
+  std::string agreement;       // "reference", "identical", or what differs from which run
+  image::Image image;          // kept with keepImages
+};
+
+struct SkippedCombination {
+  std::string what, reason;
+};
+
+struct Comparison {
+  std::vector<ComparisonRow> rows;
+  std::vector<SkippedCombination> skipped;
+  Reference reference;  // empty image without one
+  int mismatches = 0;   // rows whose image differs from their family's
+};
+
+// Throws pr::InputError for an empty dimension or an unknown name; a combination that cannot
+// run (sequential at P > 1, binary-swap at P not a power of two, a request over the memory
+// limit) is skipped with the reason.
+Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input);
+
+// The message kinds in the order the table and files list them.
+const std::vector<std::string>& comparisonKinds();
+
+}  // namespace pr::cli
