@@ -49,10 +49,10 @@ struct CommandResult {
   std::string output;  // stdout and stderr together
 };
 
-// Runs `parrender ARGS` through the shell, capturing stdout+stderr and the exit status.
-inline CommandResult runParrender(const std::string& args) {
+// Runs a shell command line, capturing stdout+stderr and the exit status.
+inline CommandResult runCommand(const std::string& commandLine) {
   CommandResult result;
-  std::string command = std::string("\"") + PARRENDER_EXE + "\" " + args + " 2>&1";
+  const std::string command = commandLine + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (!pipe) return result;
   char buffer[4096];
@@ -61,6 +61,11 @@ inline CommandResult runParrender(const std::string& args) {
   int status = pclose(pipe);
   result.exitStatus = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
+}
+
+// Runs `parrender ARGS` through the shell, capturing stdout+stderr and the exit status.
+inline CommandResult runParrender(const std::string& args) {
+  return runCommand(std::string("\"") + PARRENDER_EXE + "\" " + args);
 }
 
 }  // namespace pr::test

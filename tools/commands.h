@@ -12,6 +12,7 @@ void addGalleryCommand(CLI::App& app);
 void addGenerateCommand(CLI::App& app);
 void addInfoCommand(CLI::App& app);
 void addRenderCommand(CLI::App& app);
+void addReportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addSweepCommand(CLI::App& app);
 

@@ -41,6 +41,7 @@ int main(int argc, char** argv) {
   pr::cli::addGenerateCommand(app);
   pr::cli::addInfoCommand(app);
   pr::cli::addRenderCommand(app);
+  pr::cli::addReportCommand(app);
   pr::cli::addSimulateCommand(app);
   pr::cli::addSweepCommand(app);
 

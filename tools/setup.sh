@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs every Debian package parrender needs to build, test and benchmark.
-# Idempotent: when everything is present it only checks and returns (no apt traffic).
+# Installs every Debian package parrender needs to build, test and benchmark, and the plotting
+# libraries of `parrender report` (vega, vega-lite, vega-embed from npm, pinned by
+# tools/report/package-lock.json, into tools/report/node_modules).
+# Idempotent: when everything is present it only checks and returns (no apt or npm traffic).
 #   tools/setup.sh          build and test dependencies
 #   tools/setup.sh --bench  also the benchmark anchors: Intel Embree 3, Mesa llvmpipe over EGL,
 #                           nanoflann (kd-tree, header-only)
@@ -24,7 +26,11 @@ packages=(
   libopenimageio-dev                             # EXR / PNG images
   libcli11-dev                                   # command-line parsing
   doctest-dev                                    # unit tests
+  chromium                                       # the report's test opens it headless
 )
+# npm installs the report's plotting libraries; the Debian package only where no node is present
+# (a node from elsewhere brings its own npm, and Debian's would conflict with it).
+command -v npm >/dev/null 2>&1 || packages+=(npm)
 if [ "$bench" -eq 1 ]; then
   packages+=(
     libembree-dev                                  # Embree 3 ray tracing anchor
@@ -45,11 +51,19 @@ done
 
 if [ ${#missing[@]} -eq 0 ]; then
   echo "setup: all ${#packages[@]} packages present"
-  exit 0
+else
+  echo "setup: installing ${missing[*]}"
+  if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
 fi
 
-echo "setup: installing ${missing[*]}"
-if [ "$(id -u)" -ne 0 ]; then SUDO=sudo; else SUDO=; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
+report=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)/report
+if [ -f "$report/node_modules/vega-embed/build/vega-embed.min.js" ] &&
+   [ "$report/node_modules/.package-lock.json" -nt "$report/package-lock.json" ]; then
+  echo "setup: report scripts present"
+else
+  echo "setup: installing the report's plotting libraries (npm ci)"
+  (cd "$report" && npm ci --no-audit --no-fund --loglevel=error)
+fi

@@ -1,0 +1,179 @@
+// Tests of `parrender report` (tools/cmd_report.cpp, tools/report/): every registered method
+// and schedule has its class, the Amdahl and Karp-Flatt fit recovers a known serial fraction,
+// and a small report made as a user would make it opens in headless Chromium with no script
+// error, every chart drawn and every image loaded (the screenshot is kept under
+// <build>/test-artifacts), and replaces an earlier report only once it is whole.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "common/image/image_io.h"
+#include "common/parallel/schedulers/scheduler.h"
+#include "common/util/error.h"
+#include "raster/sort/sort_point.h"
+#include "raytrace/partition/partition.h"
+#include "test_support.h"
+#include "tools/report/classification.h"
+#include "tools/report/scaling_model.h"
+
+using pr::test::join;
+using pr::test::quoted;
+using pr::test::runCommand;
+using pr::test::runParrender;
+
+namespace {
+
+std::string readText(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// The value of attribute `name` of the page's <body> after its scripts ran, or "".
+std::string bodyAttribute(const std::string& dom, const std::string& name) {
+  std::smatch m;
+  const std::regex body("<body[^>]*\\s" + name + "=\"([^\"]*)\"");
+  return std::regex_search(dom, m, body) ? m[1].str() : std::string();
+}
+
+bool haveChromium() {
+  if (runCommand("command -v chromium").exitStatus == 0) return true;
+  std::printf("SKIPPED: chromium not found (tools/setup.sh installs it)\n");
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("Report: every registered method and schedule has its place in the seed's classification") {
+  std::set<std::string> names;
+  for (const pr::rt::PartitionInfo& p : pr::rt::partitions()) names.insert(p.name);
+  for (const pr::raster::SortPointInfo& s : pr::raster::sortPoints()) names.insert(s.name);
+  CHECK(names.size() >= 8);
+  for (const std::string& n : names) {
+    CAPTURE(n);
+    const pr::cli::report::MethodClass k = pr::cli::report::classifyMethod(n);
+    CHECK_FALSE(k.subdivision.empty());
+    CHECK_FALSE(k.dataManagement.empty());
+    CHECK(k.seedSection.rfind("§", 0) == 0);
+  }
+  CHECK(pr::cli::report::classifyMethod("sort-middle").sortPoint.rfind("sort-middle", 0) == 0);
+  for (const pr::par::ScheduleInfo& s : pr::par::schedules()) {
+    CAPTURE(s.name);
+    CHECK_FALSE(pr::cli::report::classifySchedule(s.name).model.empty());
+  }
+  CHECK_THROWS_AS(pr::cli::report::classifyMethod("warp-drive"), pr::InputError);
+}
+
+TEST_CASE("Report: the Karp-Flatt fit recovers the serial fraction of speed-ups that follow Amdahl's law") {
+  using namespace pr::cli::report;
+  const double f = 0.15;
+  std::vector<std::pair<int, double>> points = {{1, 1.0}};
+  for (int p : {2, 4, 8}) points.emplace_back(p, amdahlSpeedup(f, p));
+  CHECK(fittedSerialFraction(points) == doctest::Approx(f));
+  CHECK(amdahlSpeedup(0.0, 16) == doctest::Approx(16.0));
+  CHECK(amdahlSpeedup(1.0, 16) == doctest::Approx(1.0));
+  CHECK(std::isnan(fittedSerialFraction({{1, 1.0}})));
+  CHECK(powersOfTwo(1024).size() == 11);
+}
+
+TEST_CASE("Report: a small report opens offline in headless Chromium with every chart and image drawn") {
+  const std::filesystem::path dir = pr::test::scratchDir("report");
+  const std::filesystem::path out = dir / "report";
+  const std::string args =
+      join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
+            " --width 32 --height 24 --threads 1,2 --schedules demand --repeat 1 --spp 1 --max-depth 3",
+            " --reference-spp 8 --photons 500,1000 --caustic-photons 200 --gather 8 --path-spp 1,2 --max-pes 64",
+            " --reference-dir ", quoted(dir / "refs")});
+  const auto r = runParrender(args);
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  for (const char* file : {"index.html", "page.js", "lib/vega.min.js", "lib/vega-lite.min.js", "lib/vega-embed.min.js",
+                           "cornell/comparison.csv", "cornell/comparison.json", "cornell/timeline.trace.json",
+                           "cornell/img/reference.png", "cornell/img/sort-last_diff8.png"}) {
+    CAPTURE(file);
+    CHECK(std::filesystem::exists(out / file));
+  }
+  const std::string html = readText(out / "index.html");
+  CHECK(html.find("src=\"http") == std::string::npos);  // nothing fetched from the network
+  CHECK(html.find("Classification") != std::string::npos);
+  CHECK(html.find("Verdict") != std::string::npos);
+  // The data beside every chart.
+  int charts = 0;
+  for (const char* name : {"speedup", "efficiency", "per_pe", "gantt", "communication", "composite_analytic", "accuracy"}) {
+    CAPTURE(name);
+    std::ifstream in(out / "cornell" / (std::string(name) + ".json"));
+    const nlohmann::json data = nlohmann::json::parse(in);
+    CHECK(data.is_array());
+    CHECK(data.size() > 0);
+    ++charts;
+  }
+  // The sort-last compositing bytes equal the analytic volume (full frame).
+  {
+    std::ifstream in(out / "cornell" / "composite_analytic.json");
+    const nlohmann::json data = nlohmann::json::parse(in);
+    REQUIRE(data.size() == 2);
+    CHECK(data[0]["bytes"].get<double>() == doctest::Approx(data[1]["bytes"].get<double>()));
+  }
+
+  if (!haveChromium()) return;
+  const std::string url = pr::test::quoted("file://" + std::filesystem::absolute(out / "index.html").string());
+  const std::string chromium = "chromium --headless --no-sandbox --disable-gpu --hide-scrollbars --virtual-time-budget=20000 ";
+  const auto dom = runCommand(join({chromium, "--dump-dom ", url, " 2>/dev/null"}));
+  REQUIRE(dom.exitStatus == 0);
+  INFO(dom.output.substr(0, 2000));
+  CHECK(bodyAttribute(dom.output, "data-errors") == "0");
+  CHECK(bodyAttribute(dom.output, "data-chart-total") == std::to_string(charts));
+  CHECK(bodyAttribute(dom.output, "data-charts") == std::to_string(charts));
+  const std::string images = bodyAttribute(dom.output, "data-image-total");
+  CHECK(std::stoi(images.empty() ? "0" : images) >= 10);
+  CHECK(bodyAttribute(dom.output, "data-images") == images);
+  std::size_t svgs = 0;
+  for (std::size_t at = dom.output.find("<svg"); at != std::string::npos; at = dom.output.find("<svg", at + 1)) ++svgs;
+  CHECK(svgs >= std::size_t(charts));
+
+  // The screenshot, kept as the test's artefact, is not blank.
+  const std::filesystem::path artefacts = pr::test::binaryDir() / "test-artifacts";
+  std::filesystem::create_directories(artefacts);
+  const std::filesystem::path shot = artefacts / "report.png";
+  std::filesystem::remove(shot);
+  runCommand(join({chromium, "--window-size=1400,3000 --screenshot=", quoted(shot), " ", url}));
+  REQUIRE(std::filesystem::exists(shot));
+  const pr::image::Image picture = pr::image::readImage(shot);
+  std::set<std::tuple<int, int, int>> colours;
+  for (const glm::vec3& p : picture.pixels) colours.insert({int(p.x * 255.0f), int(p.y * 255.0f), int(p.z * 255.0f)});
+  CHECK(colours.size() > 50);
+}
+
+TEST_CASE("Report: a report that fails leaves the earlier one in place and no half-written folder") {
+  const std::filesystem::path dir = pr::test::scratchDir("report_atomic");
+  const std::filesystem::path out = dir / "report";
+  std::filesystem::create_directories(out);
+  { std::ofstream(out / "index.html") << "the earlier report"; }
+  const std::string args = join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
+                                 " --width 8 --height 8 --threads 1 --repeat 1"});
+  const auto failed = runCommand(join({"PARRENDER_REPORT_SCRIPTS=", quoted(dir / "nowhere"), " \"", PARRENDER_EXE, "\" ", args}));
+  INFO(failed.output);
+  CHECK(failed.exitStatus == 2);
+  CHECK(failed.output.find("tools/setup.sh") != std::string::npos);
+  CHECK(readText(out / "index.html") == "the earlier report");
+  int entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  CHECK(entries == 1);  // only the earlier report
+
+  const auto bad = runParrender(join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
+                                      " --threads 2"}));
+  CHECK(bad.exitStatus == 2);
+  CHECK(bad.output.find("--threads must include 1") != std::string::npos);
+  const auto help = runParrender("report --help");
+  CHECK(help.exitStatus == 0);
+  CHECK(help.output.find("--network") != std::string::npos);
+}

@@ -1,0 +1,31 @@
+// Where each method and schedule sits in the seed course's classification (chapters 2 to 5 of
+// the SIGGRAPH 2000 notes): task subdivision (screen space or object space; for polygons where
+// the sort happens, after Molnar et al.; for ray tracing image space, object space or object
+// partitioning, §5.1), the computational model and task management of the schedule (§3.2-3.4),
+// and the data management (world model, replicated maps, data manager with caches, §4). The
+// report prints these classes beside the figures measured on the scene that define them.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+namespace pr::cli::report {
+
+struct MethodClass {
+  std::string subdivision;     // "screen space: image tiles" ...
+  std::string sortPoint;       // polygons: "sort-first" ...; ray tracing: "-"
+  std::string dataManagement;  // "world model: the scene replicated on every PE (§4.1)" ...
+  std::string definingFigure;  // which measured figure shows the class ("ray messages per ray")
+  std::string seedSection;     // "§5.1.2"
+};
+
+struct ScheduleClass {
+  std::string model;           // "demand driven (§3.2.2), serial order"
+  std::string taskManagement;  // "central task pool on PE 0" ...
+};
+
+// Throws pr::InputError for a name the registries do not know.
+MethodClass classifyMethod(std::string_view method);
+ScheduleClass classifySchedule(std::string_view schedule);
+
+}  // namespace pr::cli::report

@@ -1,0 +1,455 @@
+// One scene's section of the report (see scene_report.h).
+#include "tools/report/scene_report.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <map>
+#include <set>
+
+#include "common/image/image_io.h"
+#include "common/parallel/metrics.h"
+#include "common/scene/camera_select.h"
+#include "common/scene/effect_analysis.h"
+#include "common/util/atomic_file.h"
+#include "common/util/memory_limit.h"
+#include "raster/composite/compositor.h"
+#include "tools/compare/comparison.h"
+#include "tools/compare/comparison_output.h"
+#include "tools/report/classification.h"
+#include "tools/report/html.h"
+#include "tools/report/scaling_model.h"
+#include "tools/sweep/image_error.h"
+#include "tools/sweep/sweep.h"
+
+namespace pr::cli::report {
+
+namespace {
+
+// Gantt charts beyond this many spans draw the first ones only (and say so).
+constexpr std::size_t kMaxTimelineSpans = 20000;
+
+std::string fmt(double v, const char* format = "%.3g") {
+  char text[48];
+  std::snprintf(text, sizeof text, format, v);
+  return text;
+}
+
+std::uint64_t kindBytes(const ComparisonRow& r, const std::string& kind, bool messages = false) {
+  for (const par::KindTraffic& k : r.summary.total.byKind)
+    if (k.kind == kind) return messages ? k.messages : k.bytes;
+  return 0;
+}
+
+double counter(const ComparisonRow& r, const std::string& name) {
+  for (const par::CounterSummary& c : r.summary.counters)
+    if (c.name == name) return c.total;
+  return 0.0;
+}
+
+// The analytic compositing volume of sort-last over the full frame: b A (1 - 1/P) per PE.
+double analyticCompositeBytes(int width, int height, int pes) {
+  return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1);
+}
+
+// The figure that shows the method's class, measured on this scene.
+std::string measuredFigure(const ComparisonRow& r, int width, int height) {
+  const std::string& m = r.what.method;
+  const int p = r.what.pes;
+  if (m == "sequential") return "Ts = " + fmt(r.wall, "%.3f") + " s";
+  if (m == "image-space")
+    return "broadcast " + formatBytes(kindBytes(r, "broadcasts") / std::uint64_t(p)) + " per PE, " +
+           std::to_string(kindBytes(r, "rays", true)) + " ray messages (P=" + std::to_string(p) + ")";
+  if (m == "image-space-cached")
+    return "hit ratio " + fmt(r.cacheHitRatio, "%.3f") + ", " + std::to_string(kindBytes(r, "requests", true)) +
+           " requests, " + formatBytes(kindBytes(r, "data")) + " of data fetched (P=" + std::to_string(p) + ")";
+  if (m == "object-space" || m == "object")
+    return std::to_string(kindBytes(r, "rays", true)) + " ray messages (" + formatBytes(kindBytes(r, "rays")) + ") for " +
+           std::to_string(r.rays) + " rays, " + fmt(r.rays ? 1000.0 * double(kindBytes(r, "rays", true)) / double(r.rays) : 0.0) +
+           " per 1000 rays; imbalance " + fmt(r.summary.total.imbalance, "%.3f") + " (P=" + std::to_string(p) + ")";
+  if (m == "sort-first" || m == "sort-middle")
+    return std::to_string(kindBytes(r, "primitives", true)) + " primitive messages, " +
+           formatBytes(kindBytes(r, "primitives")) + " (P=" + std::to_string(p) + ")";
+  if (m == "sort-last")
+    return formatBytes(std::uint64_t(counter(r, "Sort/composite_bytes"))) + " composited, analytic " +
+           formatBytes(std::uint64_t(analyticCompositeBytes(width, height, p))) + " (P=" + std::to_string(p) + ")";
+  return "-";
+}
+
+struct MethodScaling {
+  std::string method;
+  std::vector<std::pair<int, double>> measured;  // (P, T1/Tn)
+  std::vector<PredictedPoint> predicted;
+  double serialFraction = std::numeric_limits<double>::quiet_NaN();
+  int bestPredictedPes = 1;
+  const ComparisonRow* largest = nullptr;  // the run at the largest P
+};
+
+// The rows that trace each method's curve: its first schedule and compositor.
+bool onCurve(const ComparisonRow& r, const ReportSpec& spec) {
+  return r.what.schedule == spec.schedules.front() &&
+         (r.what.compositor == kNotApplicable || r.what.compositor == raster::compositors().begin()->name);
+}
+
+}  // namespace
+
+std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
+                        const std::string& relDir) {
+  std::filesystem::create_directories(dir / "img");
+  const std::string stem = std::filesystem::path(sceneFile).stem().string();
+  std::fprintf(stderr, "report: %s: loading\n", stem.c_str());
+  scene::Scene scene = loadScene(sceneFile, spec.lighting);
+  const std::string lighting = applyLighting(scene, spec.lighting);
+  const scene::Camera camera = scene::selectCamera(scene, spec.camera, float(spec.width) / float(spec.height));
+  const scene::RenderPlan plan = scene::analyzeEffects(scene, &camera);
+  const RenderInput input{scene, camera, plan, spec.width, spec.height};
+  const int maxP = *std::max_element(spec.threads.begin(), spec.threads.end());
+
+  // The comparison.
+  ComparisonSpec cs;
+  cs.methods = spec.methods;
+  cs.schedules = spec.schedules;
+  cs.integrators = {"path"};
+  cs.compositors = {raster::compositors().begin()->name};
+  cs.threads = spec.threads;
+  cs.repeat = spec.repeat;
+  cs.settings = spec.settings;
+  cs.referenceSettings = ReferenceSettings{sceneFile, spec.camera, "", spec.lighting, spec.referenceSpp, 16,
+                                           spec.settings.ray.seed, spec.referenceDir, false, "image-space", maxP, {}};
+  std::fprintf(stderr, "report: %s: comparison run\n", stem.c_str());
+  const Comparison c = runComparison(cs, input);
+  writeFileAtomically(dir / "comparison.csv", comparisonCsv(c), "CSV file");
+  writeFileAtomically(dir / "comparison.json", comparisonJson(c).dump(1) + "\n", "JSON file");
+
+  std::string html = "<section><h2>" + escape(stem) + "</h2>\n<p>" + escape(sceneFile) + ": " +
+                     std::to_string(scene.triangles.size()) + " triangles, " + std::to_string(scene.lights.size()) +
+                     " punctual lights, " + std::to_string(scene.areaLights.size()) + " emissive triangles; " +
+                     escape(lighting) + ". " + std::to_string(spec.width) + "&times;" + std::to_string(spec.height) +
+                     " pixels, P in {";
+  for (std::size_t i = 0; i < spec.threads.size(); ++i) html += (i ? ", " : "") + std::to_string(spec.threads[i]);
+  html += "}, " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: <a href=\"" + relDir +
+          "/comparison.csv\">comparison.csv</a>, <a href=\"" + relDir + "/comparison.json\">comparison.json</a>.</p>\n";
+
+  // The render plan.
+  html += "<h3>Render plan</h3><ul>";
+  for (scene::Effect e : scene::allEffects()) html += "<li>" + escape(plan.line(e)) + "</li>";
+  html += "</ul>\n";
+
+  // Each method's run at its largest P.
+  std::map<std::string, MethodScaling> scaling;
+  for (const ComparisonRow& r : c.rows) {
+    if (!onCurve(r, spec)) continue;
+    MethodScaling& s = scaling[r.what.method];
+    s.method = r.what.method;
+    if (r.speedup > 0.0) s.measured.emplace_back(r.what.pes, r.speedup);
+    if (!s.largest || r.what.pes > s.largest->what.pes) s.largest = &r;
+  }
+
+  // The classification.
+  std::string models;
+  for (const std::string& sched : spec.schedules) {
+    const ScheduleClass k = classifySchedule(sched);
+    models += (models.empty() ? "" : "; ") + sched + ": " + k.model + ", " + k.taskManagement;
+  }
+  std::vector<std::vector<std::string>> classRows;
+  for (const std::string& m : spec.methods) {
+    const MethodClass k = classifyMethod(m);
+    const auto s = scaling.find(m);
+    classRows.push_back({m, std::string(toString(findRenderMethod(m).properties.family)), k.subdivision, k.sortPoint,
+                         k.dataManagement, k.definingFigure,
+                         s != scaling.end() && s->second.largest ? measuredFigure(*s->second.largest, spec.width, spec.height) : "-",
+                         k.seedSection});
+  }
+  html += "<h3>Classification</h3><p>After the seed course, chapters 2&ndash;5. Computational model and task "
+          "management of the schedules compared: " + escape(models) + ".</p>\n" +
+          table({"method", "family", "task subdivision", "sort point", "data management", "defining figure",
+                 "measured on this scene", "seed"},
+                classRows, "text");
+
+  // Images and their x8 error against the reference.
+  html += "<h3>Images</h3><p>Each method's image at its largest P, and beneath it |image &minus; reference| &times; 8; "
+          "the reference is a path-traced render at " + std::to_string(spec.referenceSpp) + " samples per pixel. " +
+          (c.mismatches == 0 ? std::string("Every render matched the first of its family bit for bit.")
+                             : "<b>" + std::to_string(c.mismatches) + " renders differ from their family's image.</b>") +
+          "</p>\n<div>";
+  image::writeImage(dir / "img" / "reference.png", c.reference.image);
+  html += image(relDir + "/img/reference.png", "reference (path, " + std::to_string(spec.referenceSpp) + " spp)");
+  for (const auto& [method, s] : scaling) {
+    if (!s.largest) continue;
+    image::writeImage(dir / "img" / (method + ".png"), s.largest->image);
+    image::writeImage(dir / "img" / (method + "_diff8.png"), differenceImage(s.largest->image, c.reference.image));
+    html += image(relDir + "/img/" + method + ".png", method + ", RMSE " + fmt(s.largest->rmse, "%.4f"));
+    html += image(relDir + "/img/" + method + "_diff8.png", method + ": error x8");
+  }
+  html += "</div>\n";
+
+  // The comparison table.
+  std::vector<std::vector<std::string>> rows;
+  for (const ComparisonRow& r : c.rows) {
+    const par::StageSummary& t = r.summary.total;
+    std::uint64_t messages = 0, bytes = 0;
+    for (const par::KindTraffic& k : t.byKind) messages += k.messages, bytes += k.bytes;
+    std::string kinds;
+    for (const par::KindTraffic& k : t.byKind)
+      if (k.messages) kinds += (kinds.empty() ? "" : ", ") + k.kind + " " + std::to_string(k.messages);
+    rows.push_back({r.what.method, r.what.schedule, r.what.integrator, std::to_string(r.what.pes), fmt(r.wall, "%.4f"),
+                    fmt(r.cpu, "%.4f"), r.speedup > 0 ? fmt(r.speedup, "%.2f") : "-",
+                    r.speedupSerial > 0 ? fmt(r.speedupSerial, "%.2f") : "-", r.efficiency > 0 ? fmt(r.efficiency, "%.2f") : "-",
+                    fmt(t.imbalance, "%.3f"), std::to_string(messages), formatBytes(bytes), kinds,
+                    t.computeToComm >= 0 ? fmt(t.computeToComm, "%.1f") : "-",
+                    r.cacheHitRatio >= 0 ? fmt(r.cacheHitRatio, "%.3f") : "-", fmt(r.rmse, "%.4f"),
+                    r.agrees ? r.agreement : "DIFFERS: " + r.agreement});
+  }
+  std::vector<std::vector<std::string>> skipped;
+  for (const SkippedCombination& s : c.skipped) skipped.push_back({s.what, s.reason});
+  html += "<h3>Comparison</h3>" +
+          table({"method", "schedule", "integrator", "P", "wall s", "CPU s", "T1/Tn", "Ts/Tn", "efficiency", "imbalance",
+                 "messages", "bytes", "messages by kind", "comp/comm", "cache hits", "RMSE", "image"},
+                rows) +
+          (skipped.empty() ? "" : "<p>Skipped:</p>" + table({"combination", "reason"}, skipped, "text"));
+
+  // Speed-up and efficiency against P: measured, predicted, Amdahl.
+  std::fprintf(stderr, "report: %s: predicting to %d PEs on %s\n", stem.c_str(), spec.maxPredictedPes, spec.network.c_str());
+  const par::NetworkModel& network = par::networkByName(spec.network);
+  const std::vector<int> predictedPes = powersOfTwo(spec.maxPredictedPes);
+  nlohmann::json scalingData = nlohmann::json::array();
+  for (auto& [method, s] : scaling) {
+    if (method == "sequential" || !s.largest) continue;
+    s.predicted = predictScaling(s.largest->record, network, predictedPes);
+    s.serialFraction = fittedSerialFraction(s.measured);
+    double best = 0.0;
+    for (const PredictedPoint& p : s.predicted) {
+      scalingData.push_back({{"method", method}, {"P", p.pes}, {"speedup", p.speedup}, {"efficiency", p.efficiency},
+                             {"series", "predicted (" + spec.network + ")"}});
+      if (p.speedup > best) best = p.speedup, s.bestPredictedPes = p.pes;
+    }
+    for (const auto& [p, speedup] : s.measured)
+      scalingData.push_back({{"method", method}, {"P", p}, {"speedup", speedup}, {"efficiency", speedup / p}, {"series", "measured"}});
+    if (std::isfinite(s.serialFraction))
+      for (int p : predictedPes)
+        scalingData.push_back({{"method", method}, {"P", p}, {"speedup", amdahlSpeedup(s.serialFraction, p)},
+                               {"efficiency", amdahlSpeedup(s.serialFraction, p) / p}, {"series", "Amdahl fit"}});
+    for (const PredictedPoint& p : s.predicted)
+      if (p.pes == s.bestPredictedPes)
+        scalingData.push_back({{"method", method}, {"P", p.pes}, {"speedup", p.speedup}, {"efficiency", p.efficiency},
+                               {"series", "best P"}});
+  }
+  auto scalingSpec = [](const char* field, bool logY) {
+    const nlohmann::json x = {{"field", "P"}, {"type", "quantitative"}, {"scale", {{"type", "log"}, {"base", 2}}}};
+    nlohmann::json y = {{"field", field}, {"type", "quantitative"}};
+    if (logY) y["scale"] = {{"type", "log"}};
+    const nlohmann::json color = {{"field", "method"}, {"type", "nominal"}};
+    return nlohmann::json{
+        {"layer",
+         {{{"transform", {{{"filter", "datum.series != 'measured' && datum.series != 'best P'"}}}},
+           {"mark", {{"type", "line"}, {"clip", true}}},
+           {"encoding", {{"x", x}, {"y", y}, {"color", color}, {"strokeDash", {{"field", "series"}, {"type", "nominal"}}}}}},
+          {{"transform", {{{"filter", "datum.series == 'measured'"}}}},
+           {"mark", {{"type", "point"}, {"filled", true}, {"size", 70}}},
+           {"encoding", {{"x", x}, {"y", y}, {"color", color}, {"tooltip", {{{"field", "method"}}, {{"field", "P"}}, {{"field", field}}}}}}},
+          {{"transform", {{{"filter", "datum.series == 'best P'"}}}},
+           {"mark", {{"type", "point"}, {"shape", "diamond"}, {"size", 160}, {"filled", true}}},
+           {"encoding", {{"x", x}, {"y", y}, {"color", color}, {"tooltip", {{{"field", "method"}}, {{"field", "P"}}}}}}}}}};
+  };
+  html += "<h3>Speed-up and efficiency against P</h3><p>Dots: measured (T1/Tn). Solid and dashed lines: the "
+          "simulator replaying each method's largest-P run at P = 1 &hellip; " + std::to_string(spec.maxPredictedPes) +
+          " on the " + escape(spec.network) + " network (" + escape(std::string(network.description)) +
+          "), and Amdahl's law with the Karp&ndash;Flatt serial fraction fitted to the measured points. Diamonds: the "
+          "best predicted P.</p>\n";
+  html += chart(dir, relDir, "speedup", scalingSpec("speedup", true), scalingData, "Speed-up against P");
+  html += chart(dir, relDir, "efficiency", scalingSpec("efficiency", false), scalingData, "Efficiency against P");
+  std::vector<std::vector<std::string>> fitRows;
+  for (const auto& [method, s] : scaling) {
+    if (method == "sequential" || s.predicted.empty()) continue;
+    fitRows.push_back({method, std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.4f") : "-",
+                       std::isfinite(s.serialFraction) && s.serialFraction > 0 ? fmt(1.0 / s.serialFraction, "%.1f") : "-",
+                       std::to_string(s.bestPredictedPes), fmt(s.predicted.back().speedup, "%.3g"),
+                       fmt(s.predicted.back().efficiency, "%.3f"), fmt(s.predicted.back().seconds, "%.4f")});
+  }
+  html += table({"method", "Karp-Flatt serial fraction", "Amdahl bound 1/f", "best predicted P",
+                 "predicted speed-up at " + std::to_string(spec.maxPredictedPes),
+                 "predicted efficiency", "predicted seconds"},
+                fitRows);
+
+  // Per-PE time and the timeline of the chosen run.
+  const ComparisonRow* chosen = nullptr;
+  if (auto s = scaling.find(spec.timelineMethod); s != scaling.end()) chosen = s->second.largest;
+  if (!chosen)
+    for (const auto& [method, s] : scaling)
+      if (s.largest && (!chosen || s.largest->what.pes > chosen->what.pes)) chosen = s.largest;
+  if (chosen) {
+    par::writeRunRecord(chosen->record, dir / "timeline_metrics.json");
+    par::writeChromeTrace(chosen->record, dir / "timeline.trace.json");
+    nlohmann::json perPe = nlohmann::json::array();
+    const std::vector<par::PeStageRecord> totals = par::peTotals(chosen->record);
+    for (std::size_t p = 0; p < totals.size(); ++p) {
+      const par::PeStageRecord& t = totals[p];
+      const double other = std::max(0.0, t.idleSeconds - t.syncWaitSeconds - t.messageWaitSeconds);
+      perPe.push_back({{"pe", p}, {"state", "computing"}, {"seconds", std::max(0.0, t.busySeconds - t.sendReceiveSeconds)}});
+      perPe.push_back({{"pe", p}, {"state", "communicating"}, {"seconds", t.sendReceiveSeconds + t.messageWaitSeconds}});
+      perPe.push_back({{"pe", p}, {"state", "waiting at synchronisation"}, {"seconds", t.syncWaitSeconds}});
+      perPe.push_back({{"pe", p}, {"state", "idle"}, {"seconds", other}});
+    }
+    nlohmann::json spans = nlohmann::json::array();
+    for (const par::TaskSpan& s : chosen->record.timeline) {
+      if (spans.size() >= kMaxTimelineSpans) break;
+      const std::string what = s.task == par::kMessageSpan ? std::string("message handler")
+                                                            : chosen->record.stages[std::size_t(s.stage)].name;
+      spans.push_back({{"pe", s.pe}, {"start", s.start}, {"end", s.end}, {"what", what}, {"task", s.task},
+                       {"messagesSent", s.messagesSent}});
+    }
+    const nlohmann::json peAxis = {{"field", "pe"}, {"type", "ordinal"}, {"title", "PE"}};
+    html += "<h3>Per-PE time and timeline: " + escape(chosen->what.label()) + "</h3><p>Busy, communicating (inside "
+            "channel calls or waiting on an empty mailbox), waiting at the end-of-stage synchronisation and otherwise idle, "
+            "per PE; then every task and message handler on its PE. The run's record: <a href=\"" + relDir +
+            "/timeline_metrics.json\">timeline_metrics.json</a>; its Chrome trace (Perfetto, chrome://tracing): <a href=\"" +
+            relDir + "/timeline.trace.json\">timeline.trace.json</a>.</p>\n";
+    html += chart(dir, relDir, "per_pe",
+                  {{"mark", "bar"},
+                   {"height", 40 + 24 * int(totals.size())},
+                   {"encoding", {{"y", peAxis}, {"x", {{"field", "seconds"}, {"type", "quantitative"}, {"stack", true}}},
+                                 {"color", {{"field", "state"}, {"type", "nominal"}}}, {"tooltip", {{{"field", "state"}}, {{"field", "seconds"}}}}}}},
+                  perPe, "Time per PE by state");
+    html += chart(dir, relDir, "gantt",
+                  {{"mark", "bar"},
+                   {"width", 900},
+                   {"height", 40 + 30 * int(totals.size())},
+                   {"encoding", {{"y", peAxis},
+                                 {"x", {{"field", "start"}, {"type", "quantitative"}, {"title", "seconds"}}},
+                                 {"x2", {{"field", "end"}}},
+                                 {"color", {{"field", "what"}, {"type", "nominal"}}},
+                                 {"tooltip", {{{"field", "what"}}, {{"field", "task"}}, {{"field", "start"}}, {{"field", "end"}}, {{"field", "messagesSent"}}}}}}},
+                  spans,
+                  "Timeline, one row per PE" + std::string(chosen->record.timeline.size() > kMaxTimelineSpans
+                                                               ? " (the first " + std::to_string(kMaxTimelineSpans) + " spans)"
+                                                               : ""));
+  }
+
+  // Communication volume by method and kind, and sort-last's against the analytic volume.
+  nlohmann::json volume = nlohmann::json::array(), analytic = nlohmann::json::array();
+  for (const ComparisonRow& r : c.rows) {
+    if (!onCurve(r, spec)) continue;
+    for (const par::KindTraffic& k : r.summary.total.byKind)
+      if (k.bytes > 0)
+        volume.push_back({{"run", r.what.method + " P=" + std::to_string(r.what.pes)}, {"kind", k.kind}, {"bytes", k.bytes},
+                          {"messages", k.messages}});
+    if (r.what.method == "sort-last" && r.what.pes > 1 && !spec.settings.raster.sparse) {
+      analytic.push_back({{"P", r.what.pes}, {"source", "measured"}, {"bytes", counter(r, "Sort/composite_bytes")}});
+      analytic.push_back({{"P", r.what.pes}, {"source", "analytic b A (P - 1)"},
+                          {"bytes", analyticCompositeBytes(spec.width, spec.height, r.what.pes)}});
+    }
+  }
+  html += "<h3>Communication volume</h3><p>Bytes between PEs by kind: tasks (scheduling), primitives, rays, pixels, "
+          "broadcasts (replicated data, once per receiving PE), results (image assembly), requests and data (the data "
+          "manager).</p>\n";
+  html += chart(dir, relDir, "communication",
+                {{"mark", "bar"},
+                 {"width", 700},
+                 {"encoding", {{"x", {{"field", "run"}, {"type", "nominal"}, {"sort", nullptr}}},
+                               {"y", {{"field", "bytes"}, {"type", "quantitative"}, {"stack", true}}},
+                               {"color", {{"field", "kind"}, {"type", "nominal"}}},
+                               {"tooltip", {{{"field", "run"}}, {{"field", "kind"}}, {{"field", "bytes"}}, {{"field", "messages"}}}}}}},
+                volume, "Bytes sent by kind");
+  if (!analytic.empty())
+    html += chart(dir, relDir, "composite_analytic",
+                  {{"mark", "bar"},
+                   {"width", 300},
+                   {"encoding", {{"x", {{"field", "P"}, {"type", "ordinal"}}},
+                                 {"xOffset", {{"field", "source"}}},
+                                 {"y", {{"field", "bytes"}, {"type", "quantitative"}}},
+                                 {"color", {{"field", "source"}, {"type", "nominal"}}},
+                                 {"tooltip", {{{"field", "source"}}, {{"field", "bytes"}}}}}}},
+                  analytic, "Sort-last compositing, measured against the analytic volume");
+
+  // Accuracy against time: the photon map against the path tracer.
+  std::fprintf(stderr, "report: %s: accuracy sweep\n", stem.c_str());
+  SweepSpec sweep;
+  sweep.scene = sceneFile;
+  sweep.width = spec.width;
+  sweep.height = spec.height;
+  sweep.camera = spec.camera;
+  sweep.threads = maxP;
+  sweep.vary = "photons";
+  sweep.values = spec.photons;
+  sweep.integrators = {"photonmap", "path"};
+  sweep.pathSpp = spec.pathSpp;
+  sweep.pathSppGiven = true;
+  sweep.spp = spec.settings.ray.spp;
+  sweep.maxDepth = spec.settings.ray.maxDepth;
+  sweep.seed = spec.settings.ray.seed;
+  sweep.referenceSpp = spec.referenceSpp;
+  sweep.referenceDepth = 16;
+  sweep.referenceDir = spec.referenceDir.string();
+  sweep.lighting = spec.lighting;
+  sweep.photonmap = spec.settings.ray.photonmap;
+  const SweepResult sw = runSweep(sweep);
+  nlohmann::json accuracy = nlohmann::json::array();
+  for (const Row& r : sw.rows)
+    accuracy.push_back({{"integrator", r.integrator}, {"setting", r.setting + " " + formatValue(r.value)},
+                        {"cpuSeconds", r.timed.cpuSeconds}, {"rmse", r.error.rmse}});
+  std::string toTarget;
+  for (const auto& [integrator, t] : sw.cpuSecondsToTarget)
+    toTarget += (toTarget.empty() ? "" : ", ") + integrator + " " + (t ? fmt(*t, "%.3g") + " CPU s" : std::string("not reached"));
+  html += "<h3>Accuracy against time</h3><p>The photon map (photons " + escape(formatValue(spec.photons.front())) +
+          " &hellip; " + escape(formatValue(spec.photons.back())) + ") against the path tracer (spp " +
+          std::to_string(spec.pathSpp.front()) + " &hellip; " + std::to_string(spec.pathSpp.back()) +
+          "), RMSE against the reference. Time each needs for RMSE " + fmt(sw.targetRmse, "%.4f") + ": " + escape(toTarget) +
+          ".</p>\n";
+  html += chart(dir, relDir, "accuracy",
+                {{"mark", {{"type", "line"}, {"point", true}}},
+                 {"encoding", {{"x", {{"field", "cpuSeconds"}, {"type", "quantitative"}, {"scale", {{"type", "log"}}}, {"title", "CPU seconds"}}},
+                               {"y", {{"field", "rmse"}, {"type", "quantitative"}, {"scale", {{"type", "log"}}}, {"title", "RMSE"}}},
+                               {"color", {{"field", "integrator"}, {"type", "nominal"}}},
+                               {"tooltip", {{{"field", "integrator"}}, {{"field", "setting"}}, {{"field", "cpuSeconds"}}, {{"field", "rmse"}}}}}}},
+                accuracy, "RMSE against CPU time");
+
+  // The verdict.
+  html += "<h3>Verdict</h3><div class=\"verdict\"><ul>";
+  std::set<int> measuredPes(spec.threads.begin(), spec.threads.end());
+  for (int p : measuredPes) {
+    const ComparisonRow* fastest = nullptr;
+    for (const ComparisonRow& r : c.rows)
+      if (r.what.pes == p && (!fastest || r.wall < fastest->wall)) fastest = &r;
+    if (!fastest) continue;
+    html += "<li>At P = " + std::to_string(p) + " the fastest is <b>" + escape(fastest->what.label()) + "</b>, " +
+            fmt(fastest->wall, "%.4f") + " s (efficiency " +
+            (fastest->efficiency > 0 ? fmt(fastest->efficiency, "%.2f") : std::string("-")) + ", imbalance " +
+            fmt(fastest->summary.total.imbalance, "%.3f") + ").";
+    for (MethodFamily family : {MethodFamily::Ray, MethodFamily::Raster}) {
+      const ComparisonRow* best = nullptr;
+      for (const ComparisonRow& r : c.rows)
+        if (r.what.pes == p && r.what.family == family && (!best || r.wall < best->wall)) best = &r;
+      if (best && best != fastest)
+        html += " Fastest " + escape(std::string(toString(family))) + ": " + escape(best->what.method) + ", " +
+                fmt(best->wall, "%.4f") + " s.";
+    }
+    html += "</li>";
+  }
+  const MethodScaling* at1024 = nullptr;
+  for (const auto& [method, s] : scaling)
+    if (!s.predicted.empty() && (!at1024 || s.predicted.back().seconds < at1024->predicted.back().seconds)) at1024 = &s;
+  if (at1024) {
+    const PredictedPoint& p = at1024->predicted.back();
+    const ComparisonRow& r = *at1024->largest;
+    std::uint64_t bytes = 0;
+    for (const par::KindTraffic& k : r.summary.total.byKind) bytes += k.bytes;
+    html += "<li>At " + std::to_string(p.pes) + " PEs on " + escape(spec.network) + " the simulator predicts <b>" +
+            escape(at1024->method) + "</b> fastest: " + fmt(p.seconds, "%.4f") + " s, speed-up " + fmt(p.speedup, "%.1f") +
+            " (efficiency " + fmt(p.efficiency, "%.3f") + ", imbalance " + fmt(p.imbalance, "%.2f") +
+            "); its best P is " + std::to_string(at1024->bestPredictedPes) + ". Measured at P = " +
+            std::to_string(r.what.pes) + ": " + formatBytes(bytes) + " sent in all, computation/communication " +
+            (r.summary.total.computeToComm >= 0 ? fmt(r.summary.total.computeToComm, "%.1f") : std::string("- (no messages)")) +
+            ", Karp&ndash;Flatt serial fraction " +
+            (std::isfinite(at1024->serialFraction) ? fmt(at1024->serialFraction, "%.3f") : std::string("-")) + ".</li>";
+    for (const auto& [method, s] : scaling)
+      if (!s.predicted.empty() && &s != at1024)
+        html += "<li>" + escape(method) + " at " + std::to_string(p.pes) + " PEs: " + fmt(s.predicted.back().seconds, "%.4f") +
+                " s, efficiency " + fmt(s.predicted.back().efficiency, "%.3f") + ", best P " +
+                std::to_string(s.bestPredictedPes) + ".</li>";
+  }
+  html += "</ul></div></section>\n";
+  return html;
+}
+
+}  // namespace pr::cli::report

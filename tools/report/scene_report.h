@@ -1,0 +1,38 @@
+// One scene's part of `parrender report`: the comparison run, the accuracy sweep, the
+// simulator's predictions, and every table, image and chart of the scene's section, written
+// into the scene's folder of the report (images, chart data, the comparison as CSV and JSON,
+// the chosen run's record and Chrome trace).
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "tools/lighting.h"
+#include "tools/render_methods.h"
+
+namespace pr::cli::report {
+
+struct ReportSpec {
+  std::vector<std::string> methods, schedules;
+  std::vector<int> threads;
+  int repeat = 3;
+  int width = 256, height = 256;
+  std::string camera;
+  RenderSettings settings;   // spp, depth, seed and the rest
+  std::string network = "1gbe";
+  int maxPredictedPes = 1024;
+  std::string timelineMethod = "object-space";  // whose largest-P run the per-PE bars and Gantt show
+  int referenceSpp = 256;
+  std::filesystem::path referenceDir;  // empty: the default cache
+  std::vector<double> photons = {5000, 20000, 80000};  // the photon map's accuracy curve
+  std::vector<int> pathSpp = {1, 4, 16, 64};           // the path tracer's
+  LightingOptions lighting;
+};
+
+// Writes the scene's files under dir (created) and returns its HTML section; `relDir` is dir
+// as index.html links it.
+std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
+                        const std::string& relDir);
+
+}  // namespace pr::cli::report
