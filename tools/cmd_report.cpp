@@ -170,15 +170,18 @@ void addReportCommand(CLI::App& app) {
       ->check(CLI::Range(1, rt::kMaxSpp))
       ->capture_default_str();
   cmd->add_option("--reference-dir", s.referenceDir, "where references are cached (default $XDG_CACHE_HOME/parrender/references)");
-  cmd->add_option("--photons", s.photons, "the photon map's accuracy curve: global photons, comma-separated")
+  cmd->add_option("--photon-spp", s.photonSpp, "the photon map's accuracy curve: samples per pixel, comma-separated")
       ->delimiter(',')
-      ->check(CLI::Range(1.0, 1e8))
+      ->check(CLI::Range(1, rt::kMaxSpp))
+      ->capture_default_str();
+  cmd->add_option("--photons", s.settings.ray.photonmap.globalPhotons, "photonmap: global photons")
+      ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))
       ->capture_default_str();
   cmd->add_option("--path-spp", s.pathSpp, "the path tracer's accuracy curve: samples per pixel, comma-separated")
       ->delimiter(',')
       ->check(CLI::Range(1, rt::kMaxSpp))
       ->capture_default_str();
-  cmd->add_option("--caustic-photons", s.settings.ray.photonmap.causticPhotons, "photonmap: caustic photons at the curve's default ratio")
+  cmd->add_option("--caustic-photons", s.settings.ray.photonmap.causticPhotons, "photonmap: caustic photons")
       ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))
       ->capture_default_str();
   cmd->add_option("--gather", s.settings.ray.photonmap.gatherRays, "photonmap: final-gather rays per record")

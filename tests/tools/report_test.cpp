@@ -91,7 +91,7 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   const std::string args =
       join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
             " --width 32 --height 24 --threads 1,2 --schedules demand --repeat 1 --spp 1 --max-depth 3",
-            " --reference-spp 8 --photons 500,1000 --caustic-photons 200 --gather 8 --path-spp 1,2 --max-pes 64",
+            " --reference-spp 8 --photons 1000 --caustic-photons 200 --photon-spp 1,2 --gather 8 --path-spp 1,2 --max-pes 64",
             " --reference-dir ", quoted(dir / "refs")});
   const auto r = runParrender(args);
   INFO(r.output);

@@ -370,8 +370,8 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   sweep.height = spec.height;
   sweep.camera = spec.camera;
   sweep.threads = maxP;
-  sweep.vary = "photons";
-  sweep.values = spec.photons;
+  sweep.vary = "spp";
+  sweep.values.assign(spec.photonSpp.begin(), spec.photonSpp.end());
   sweep.integrators = {"photonmap", "path"};
   sweep.pathSpp = spec.pathSpp;
   sweep.pathSppGiven = true;
@@ -391,8 +391,11 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   std::string toTarget;
   for (const auto& [integrator, t] : sw.cpuSecondsToTarget)
     toTarget += (toTarget.empty() ? "" : ", ") + integrator + " " + (t ? fmt(*t, "%.3g") + " CPU s" : std::string("not reached"));
-  html += "<h3>Accuracy against time</h3><p>The photon map (photons " + escape(formatValue(spec.photons.front())) +
-          " &hellip; " + escape(formatValue(spec.photons.back())) + ") against the path tracer (spp " +
+  html += "<h3>Accuracy against time</h3><p>The photon map (" +
+          std::to_string(spec.settings.ray.photonmap.globalPhotons) + " global and " +
+          std::to_string(spec.settings.ray.photonmap.causticPhotons) + " caustic photons, spp " +
+          std::to_string(spec.photonSpp.front()) + " &hellip; " + std::to_string(spec.photonSpp.back()) +
+          ") against the path tracer (spp " +
           std::to_string(spec.pathSpp.front()) + " &hellip; " + std::to_string(spec.pathSpp.back()) +
           "), RMSE against the reference. Time each needs for RMSE " + fmt(sw.targetRmse, "%.4f") + ": " + escape(toTarget) +
           ".</p>\n";

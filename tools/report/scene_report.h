@@ -25,8 +25,10 @@ struct ReportSpec {
   std::string timelineMethod = "object-space";  // whose largest-P run the per-PE bars and Gantt show
   int referenceSpp = 256;
   std::filesystem::path referenceDir;  // empty: the default cache
-  std::vector<double> photons = {5000, 20000, 80000};  // the photon map's accuracy curve
-  std::vector<int> pathSpp = {1, 4, 16, 64};           // the path tracer's
+  // The accuracy curves: samples per pixel of the photon map (its photon counts and gather
+  // settings from settings.ray.photonmap) and of the path tracer.
+  std::vector<int> photonSpp = {1, 4, 16};
+  std::vector<int> pathSpp = {1, 4, 16, 64};
   LightingOptions lighting;
 };
 
