@@ -140,6 +140,23 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   for (std::size_t at = dom.output.find("<svg"); at != std::string::npos; at = dom.output.find("<svg", at + 1)) ++svgs;
   CHECK(svgs >= std::size_t(charts));
 
+  // The page's own check can fail: with one chart's spec broken it counts the error and that
+  // chart is not drawn.
+  {
+    const std::filesystem::path broken = dir / "broken";
+    std::filesystem::copy(out, broken, std::filesystem::copy_options::recursive);
+    std::string page = readText(broken / "index.html");
+    const std::size_t at = page.find("\"mark\":\"bar\"");
+    REQUIRE(at != std::string::npos);
+    page.replace(at, 12, "\"mark\":\"no such mark\"");
+    std::ofstream(broken / "index.html") << page;
+    const auto bad = runCommand(join({chromium, "--dump-dom ",
+                                      pr::test::quoted("file://" + std::filesystem::absolute(broken / "index.html").string()),
+                                      " 2>/dev/null"}));
+    CHECK(bodyAttribute(bad.output, "data-errors") != "0");
+    CHECK(bodyAttribute(bad.output, "data-charts") == std::to_string(charts - 1));
+  }
+
   // The screenshot, kept as the test's artefact, is not blank.
   const std::filesystem::path artefacts = pr::test::binaryDir() / "test-artifacts";
   std::filesystem::create_directories(artefacts);

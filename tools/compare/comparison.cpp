@@ -149,6 +149,7 @@ Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input) {
     row.summary = par::summarize(row.record);
     row.cacheHitRatio = cacheHitRatio(row.summary);
     row.rays = mid.outcome.rays;
+    row.effects = mid.outcome.effects;
     if (!out.reference.image.empty()) row.rmse = imageError(mid.outcome.image, out.reference.image).rmse;
     row.image = std::move(mid.outcome.image);
 

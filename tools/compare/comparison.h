@@ -58,6 +58,7 @@ struct ComparisonRow {
   par::RunRecord record;       // the median run's record
   double cacheHitRatio = -1.0; // hits / uses of a data manager's cache; < 0 when none ran
   std::uint64_t rays = 0;
+  std::string effects;         // which of the plan's effects the method simulated (RenderOutcome::effects)
   double rmse = -1.0;          // against the path-traced reference; < 0 without one
   bool agrees = true;          // bit-identical to its family's first image
   std::string agreement;       // "reference", "identical", or what differs from which run

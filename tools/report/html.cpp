@@ -74,13 +74,17 @@ std::string page(const std::string& title, const std::string& body) {
 std::string pageScript() {
   return R"(// Embeds every chart of the page and marks on <body> what rendered: data-charts (charts
 // drawn), data-chart-total, data-images (images loaded with a size), data-image-total and
-// data-errors (script errors and rejected charts), for a person and for the report's test.
+// data-errors (script errors, unhandled rejections and console errors), for a person and for
+// the report's test.
 "use strict";
 (function () {
   let errors = 0;
   const body = document.body;
   const mark = () => { body.dataset.errors = String(errors); };
   window.addEventListener("error", () => { errors++; mark(); });
+  window.addEventListener("unhandledrejection", () => { errors++; mark(); });
+  const consoleError = console.error.bind(console);
+  console.error = (...args) => { errors++; mark(); consoleError(...args); };
   mark();
   const charts = Array.from(document.querySelectorAll("figure.chart"));
   body.dataset.chartTotal = String(charts.length);
@@ -89,7 +93,7 @@ std::string pageScript() {
     const spec = JSON.parse(figure.querySelector("script.spec").textContent);
     return vegaEmbed(figure.querySelector("div.vega"), spec, { actions: false, renderer: "svg" })
       .then(() => { drawn++; body.dataset.charts = String(drawn); })
-      .catch((e) => { errors++; mark(); console.error(e); });
+      .catch((e) => console.error(e));
   });
   const images = Array.from(document.images);
   body.dataset.imageTotal = String(images.length);

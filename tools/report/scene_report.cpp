@@ -131,11 +131,6 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   html += "}, " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: <a href=\"" + relDir +
           "/comparison.csv\">comparison.csv</a>, <a href=\"" + relDir + "/comparison.json\">comparison.json</a>.</p>\n";
 
-  // The render plan.
-  html += "<h3>Render plan</h3><ul>";
-  for (scene::Effect e : scene::allEffects()) html += "<li>" + escape(plan.line(e)) + "</li>";
-  html += "</ul>\n";
-
   // Each method's run at its largest P.
   std::map<std::string, MethodScaling> scaling;
   for (const ComparisonRow& r : c.rows) {
@@ -145,6 +140,14 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     if (r.speedup > 0.0) s.measured.emplace_back(r.what.pes, r.speedup);
     if (!s.largest || r.what.pes > s.largest->what.pes) s.largest = &r;
   }
+
+  // The render plan: what the scene calls for, and what each method simulated of it.
+  html += "<h3>Render plan</h3><p>The effects the scene calls for (effect analysis), and why:</p><ul>";
+  for (scene::Effect e : scene::allEffects()) html += "<li>" + escape(plan.line(e)) + "</li>";
+  html += "</ul><p>What each method simulated of them:</p><ul>";
+  for (const auto& [method, s] : scaling)
+    if (s.largest) html += "<li>" + escape(method) + ": " + escape(s.largest->effects) + "</li>";
+  html += "</ul>\n";
 
   // The classification.
   std::string models;
