@@ -127,21 +127,23 @@ void run(CompareArgs& a) {
   std::printf("compare %s, %dx%d, %d run%s per combination (median wall time, spread = (max - min) / 2 / median; messages and bytes of every kind)\n",
               a.scene.c_str(), a.width, a.height, a.repeat, a.repeat == 1 ? "" : "s");
   std::printf("%s\n", lighting.c_str());
+  std::printf("T1/Tn against the same combination at P=1, Ts/Tn against the family's sequential run (else its fastest "
+              "at P=1)");
   if (!c.reference.image.empty())
-    std::printf("rmse against a path-traced reference, %d spp, depth %d%s; T1/Tn against the same combination at P=1, "
-                "Ts/Tn against the family's sequential run (else its fastest at P=1)\n",
-                a.referenceSpp, a.referenceDepth, c.reference.cached ? " (cached)" : "");
+    std::printf("; rmse against a path-traced reference, %d spp, depth %d%s", a.referenceSpp, a.referenceDepth,
+                c.reference.cached ? " (cached)" : "");
+  std::printf("\n");
   std::printf("%s%s", comparisonTable(c).c_str(), comparisonNotes(c).c_str());
 
   if (!a.csv.empty()) writeFileAtomically(a.csv, comparisonCsv(c), "CSV file");
   if (!a.json.empty()) {
     nlohmann::json j = comparisonJson(c);
-    j["scene"] = a.scene;
+    j["scene"] = a.scene;  // written with invalid UTF-8 replaced (dump below)
     j["width"] = a.width;
     j["height"] = a.height;
     j["repeat"] = a.repeat;
     if (!c.reference.image.empty()) j["reference"]["spp"] = a.referenceSpp;
-    writeFileAtomically(a.json, j.dump(2) + "\n", "JSON file");
+    writeFileAtomically(a.json, j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", "JSON file");
   }
   if (!a.images.empty()) {
     const std::filesystem::path dir(a.images);

@@ -32,6 +32,9 @@ namespace pr::cli {
 
 namespace {
 
+// Written into every report: the mark that lets a later run replace the folder.
+constexpr const char* kReportMarker = ".parrender-report";
+
 struct ReportArgs {
   std::vector<std::string> scenes;
   std::string output = "report";
@@ -80,11 +83,13 @@ std::string methodsIntro(const report::ReportSpec& spec) {
 void build(const ReportArgs& a, const std::filesystem::path& dir) {
   copyScripts(dir);
   writeFileAtomically(dir / "page.js", report::pageScript(), "report script");
+  writeFileAtomically(dir / kReportMarker, "a report written by parrender report; the next report into this folder replaces it\n",
+                      "report marker");
   std::string body = "<h1>parrender: parallel rendering methods compared</h1>\n" + methodsIntro(a.spec);
   body += "<p>Scenes:";
   for (const std::string& s : a.scenes) {
     const std::string stem = std::filesystem::path(s).stem().string();
-    body += " <a href=\"#" + report::escape(stem) + "\">" + report::escape(stem) + "</a>";
+    body += " <a href=\"#" + report::escape(report::urlPath(stem)) + "\">" + report::escape(stem) + "</a>";
   }
   body += "</p>\n";
   for (const std::string& s : a.scenes) {
@@ -105,30 +110,50 @@ void run(ReportArgs& a) {
   }
   if (std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
     throw InputError("--threads must include 1: speed-up and efficiency are measured against P = 1");
+  for (const std::string& scene : a.scenes) {
+    const std::string stem = std::filesystem::path(scene).stem().string();
+    if (stem == "lib" || stem == "index.html" || stem == "page.js" || stem == kReportMarker || stem.empty() || stem[0] == '.')
+      throw InputError("scene " + scene + ": its name '" + stem + "' is reserved in the report's folder; copy or link it under another name");
+  }
   for (std::size_t i = 0; i < a.scenes.size(); ++i)
     for (std::size_t j = 0; j < i; ++j)
       if (std::filesystem::path(a.scenes[i]).stem() == std::filesystem::path(a.scenes[j]).stem())
         throw InputError("scenes " + a.scenes[j] + " and " + a.scenes[i] + " share the name of their report folder");
-  const std::filesystem::path out = std::filesystem::absolute(a.output).lexically_normal();
+  std::filesystem::path out = std::filesystem::absolute(a.output).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();  // "report/" or "."
+  if (!out.has_filename() || out == out.root_path())
+    throw InputError("report: " + a.output + " cannot be a report's folder (it must name a folder below another)");
   const std::filesystem::path parent = out.parent_path();
   if (!std::filesystem::is_directory(parent)) throw InputError("report: the folder " + parent.string() + " does not exist");
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
     throw InputError("report: " + out.string() + " exists and is not a folder");
+  // Only a report (or an empty folder) is replaced: never a folder of someone's files.
+  if (std::filesystem::is_directory(out) && !std::filesystem::is_empty(out) && !std::filesystem::exists(out / kReportMarker))
+    throw InputError("report: " + out.string() + " holds files that are not a parrender report (no " +
+                     std::string(kReportMarker) + " inside); choose another folder");
   const std::string pid = std::to_string(getpid());
   const std::filesystem::path fresh = parent / ("." + out.filename().string() + ".new-" + pid);
   const std::filesystem::path old = parent / ("." + out.filename().string() + ".old-" + pid);
   std::filesystem::remove_all(fresh);
+  std::filesystem::remove_all(old);
   std::filesystem::create_directories(fresh);
   try {
     build(a, fresh);
+    // The earlier report steps aside only once the new one is whole, and comes back if the
+    // new one cannot take its place.
+    const bool earlier = std::filesystem::exists(out);
+    if (earlier) std::filesystem::rename(out, old);
+    try {
+      std::filesystem::rename(fresh, out);
+    } catch (...) {
+      if (earlier) std::filesystem::rename(old, out);
+      throw;
+    }
   } catch (...) {
     std::error_code ignored;
     std::filesystem::remove_all(fresh, ignored);
     throw;
   }
-  // The earlier report steps aside only once the new one is whole.
-  if (std::filesystem::exists(out)) std::filesystem::rename(out, old);
-  std::filesystem::rename(fresh, out);
   std::error_code ignored;
   std::filesystem::remove_all(old, ignored);
   std::printf("report: %s\n", (out / "index.html").string().c_str());

@@ -35,7 +35,7 @@ struct SweepArgs : SweepSpec {
 
 void run(SweepArgs& a) {
   const SweepResult result = runSweep(a);
-  const std::vector<Row>& rows = result.rows;
+  const std::vector<SweepRow>& rows = result.rows;
   const double target = result.targetRmse;
   const bool cached = result.reference.cached;
   const double referenceCpu = result.reference.cpuSeconds;
@@ -43,7 +43,7 @@ void run(SweepArgs& a) {
               a.height, a.method.c_str(), a.threads, a.referenceSpp, cached ? " (cached)" : "");
   std::printf("%-10s %-8s %10s %9s %9s %10s %10s %9s %12s\n", "integrator", "setting", "value", "cpu_s", "wall_s", "rmse",
               "rel_mse", "max_err", "caustic_rmse");
-  for (const Row& r : rows)
+  for (const SweepRow& r : rows)
     std::printf("%-10s %-8s %10s %9.3f %9.3f %10.5f %10.5f %9.4f %12.5f\n", r.integrator.c_str(), r.setting.c_str(),
                 formatValue(r.value).c_str(), r.timed.cpuSeconds, r.timed.wallSeconds, r.error.rmse, r.error.relativeMse,
                 r.error.maxError, r.error.maskedRmse);
@@ -60,7 +60,7 @@ void run(SweepArgs& a) {
   if (!a.csv.empty()) {
     std::ostringstream out;
     out << "integrator,setting,value,cpu_seconds,wall_seconds,rmse,relative_mse,max_error,caustic_rmse\n";
-    for (const Row& r : rows)
+    for (const SweepRow& r : rows)
       out << r.integrator << "," << r.setting << "," << formatValue(r.value) << "," << formatValue(r.timed.cpuSeconds) << ","
           << formatValue(r.timed.wallSeconds) << "," << formatValue(r.error.rmse) << "," << formatValue(r.error.relativeMse) << ","
           << formatValue(r.error.maxError) << "," << formatValue(r.error.maskedRmse) << "\n";
@@ -73,7 +73,7 @@ void run(SweepArgs& a) {
                                        {"cached", bool(cached)}, {"cpuSeconds", referenceCpu}}},
                         {"causticPixels", rows.empty() ? std::size_t(0) : rows.front().error.maskedPixels}};
     nlohmann::json list = nlohmann::json::array();
-    for (const Row& r : rows)
+    for (const SweepRow& r : rows)
       list.push_back({{"integrator", r.integrator}, {"setting", r.setting}, {"value", r.value},
                       {"cpuSeconds", r.timed.cpuSeconds}, {"wallSeconds", r.timed.wallSeconds}, {"rmse", r.error.rmse},
                       {"relativeMse", r.error.relativeMse}, {"maxError", r.error.maxError},

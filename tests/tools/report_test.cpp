@@ -175,6 +175,7 @@ TEST_CASE("Report: a report that fails leaves the earlier one in place and no ha
   const std::filesystem::path out = dir / "report";
   std::filesystem::create_directories(out);
   { std::ofstream(out / "index.html") << "the earlier report"; }
+  { std::ofstream(out / ".parrender-report") << "a report"; }
   const std::string args = join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
                                  " --width 8 --height 8 --threads 1 --repeat 1"});
   const auto failed = runCommand(join({"PARRENDER_REPORT_SCRIPTS=", quoted(dir / "nowhere"), " \"", PARRENDER_EXE, "\" ", args}));
@@ -184,7 +185,29 @@ TEST_CASE("Report: a report that fails leaves the earlier one in place and no ha
   CHECK(readText(out / "index.html") == "the earlier report");
   int entries = 0;
   for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
-  CHECK(entries == 1);  // only the earlier report
+  CHECK(entries == 1);  // only the earlier report: no new or old folder left beside it
+
+  // A report made whole takes the earlier one's place.
+  const auto made = runParrender(join({args, " --spp 1 --reference-spp 2 --photon-spp 1 --path-spp 1 --max-pes 4 --reference-dir ",
+                                       quoted(dir / "refs")}));
+  INFO(made.output);
+  CHECK(made.exitStatus == 0);
+  CHECK(readText(out / "index.html").find("<!DOCTYPE html>") == 0);
+  CHECK(std::filesystem::exists(out / ".parrender-report"));
+  entries = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++entries;
+  CHECK(entries == 2);  // the report and the reference cache
+
+  // A folder that is not a report is never replaced.
+  const std::filesystem::path mine = dir / "mine";
+  std::filesystem::create_directories(mine);
+  { std::ofstream(mine / "notes.txt") << "someone's file"; }
+  const auto refused = runParrender(join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ",
+                                          quoted(mine), "/ --width 8 --height 8 --threads 1 --repeat 1"}));
+  CHECK(refused.exitStatus == 2);
+  CHECK(refused.output.find("not a parrender report") != std::string::npos);
+  CHECK(readText(mine / "notes.txt") == "someone's file");
+  std::filesystem::remove_all(mine);
 
   const auto bad = runParrender(join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
                                       " --threads 2"}));

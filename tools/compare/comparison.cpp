@@ -31,6 +31,15 @@ const std::vector<std::string>& comparisonKinds() {
 
 namespace {
 
+// The list without repeats, in its order.
+template <typename T>
+std::vector<T> distinct(const std::vector<T>& values) {
+  std::vector<T> out;
+  for (const T& v : values)
+    if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
+  return out;
+}
+
 bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 // Why the combination cannot run, or empty.
@@ -66,7 +75,12 @@ void checkNames(const std::vector<std::string>& names, const char* option, const
 
 }  // namespace
 
-Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input) {
+Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) {
+  ComparisonSpec spec = given;
+  spec.methods = distinct(spec.methods);
+  spec.schedules = distinct(spec.schedules);
+  spec.integrators = distinct(spec.integrators);
+  spec.compositors = distinct(spec.compositors);
   checkNames(spec.methods, "--methods", renderMethods());
   checkNames(spec.schedules, "--schedules", par::schedules());
   checkNames(spec.integrators, "--integrators", integrators());

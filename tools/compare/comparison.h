@@ -2,8 +2,9 @@
 // tracers) and compositors (sort-last) rendered afresh and timed N times on one scene, each
 // checked against the other images of its family (the project promises them bit-identical:
 // a ray tracer's image depends only on its integrator and settings, a rasterizer's on nothing
-// but the scene) and measured against the path-traced reference. Every figure of a row is read
-// from the run record of its median run through common/parallel/metrics.h. Used by
+// but the scene) and measured against the path-traced reference. Wall and CPU time are medians over
+// the repeats; every other figure of a row is read from the run record of its median run (the
+// lower middle one for an even count) through common/parallel/metrics.h. Used by
 // `parrender compare` (cmd_compare.cpp) and `parrender report` (cmd_report.cpp).
 #pragma once
 
@@ -49,7 +50,7 @@ struct ComparisonSpec {
 struct ComparisonRow {
   Combination what;
   std::vector<double> wallSeconds, cpuSeconds;  // one per repeat
-  double wall = 0.0, wallMin = 0.0, wallMax = 0.0, cpu = 0.0;  // median, spread
+  double wall = 0.0, wallMin = 0.0, wallMax = 0.0, cpu = 0.0;  // medians over the repeats, and the spread
   double speedup = 0.0;        // T1/Tn against the same combination at P = 1; 0 when not run
   double speedupSerial = 0.0;  // Ts/Tn against the family's serial reference; 0 when not run
   double efficiency = 0.0;     // speedup / P; 0 when T1 unknown

@@ -42,6 +42,13 @@ std::pair<std::uint64_t, std::uint64_t> allTraffic(const ComparisonRow& row) {
   return {messages, bytes};
 }
 
+// A CSV field in double quotes, its own quotes doubled.
+std::string csvText(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) out += c == '"' ? std::string("\"\"") : std::string(1, c);
+  return out + "\"";
+}
+
 std::string orDash(double v, bool known, const char* format = "%.2f") { return known ? number(v, format) : "-"; }
 
 // Left-aligned text columns then right-aligned figures, each as wide as its widest cell.
@@ -140,7 +147,7 @@ std::string comparisonCsv(const Comparison& c) {
       out << "," << (kt ? kt->messages : 0) << "," << (kt ? kt->bytes : 0);
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
-        << (r.agrees ? "true" : "false") << ",\"" << r.agreement << "\"\n";
+        << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "\n";
   }
   return out.str();
 }

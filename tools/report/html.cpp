@@ -1,6 +1,8 @@
 // The report's HTML (see html.h).
 #include "tools/report/html.h"
 
+#include <cctype>
+
 #include "common/util/atomic_file.h"
 
 namespace pr::cli::report {
@@ -20,6 +22,20 @@ std::string escape(const std::string& text) {
   return out;
 }
 
+std::string urlPath(const std::string& path) {
+  static const char* kHex = "0123456789ABCDEF";
+  std::string out;
+  for (unsigned char c : path) {
+    if (std::isalnum(c) || c == '-' || c == '.' || c == '_' || c == '~' || c == '/') out += char(c);
+    else out += std::string("%") + kHex[c >> 4] + kHex[c & 15];
+  }
+  return out;
+}
+
+std::string link(const std::string& path, const std::string& text) {
+  return "<a href=\"" + escape(urlPath(path)) + "\">" + escape(text) + "</a>";
+}
+
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,
                   const std::string& cssClass) {
   std::string out = "<table" + (cssClass.empty() ? std::string() : " class=\"" + cssClass + "\"") + "><thead><tr>";
@@ -34,7 +50,7 @@ std::string table(const std::vector<std::string>& header, const std::vector<std:
 }
 
 std::string image(const std::string& src, const std::string& caption) {
-  return "<figure class=\"image\"><img src=\"" + escape(src) + "\" alt=\"" + escape(caption) + "\"><figcaption>" +
+  return "<figure class=\"image\"><img src=\"" + escape(urlPath(src)) + "\" alt=\"" + escape(caption) + "\"><figcaption>" +
          escape(caption) + "</figcaption></figure>\n";
 }
 
@@ -45,13 +61,14 @@ std::string chart(const std::filesystem::path& dir, const std::string& relDir, c
   spec["data"] = {{"values", data}};
   if (!spec.contains("width")) spec["width"] = 520;
   if (!spec.contains("height")) spec["height"] = 260;
-  std::string text = spec.dump();
-  // A "</" inside the inlined JSON would end the script element.
-  for (std::size_t at = text.find("</"); at != std::string::npos; at = text.find("</", at + 3)) text.replace(at, 2, "<\\/");
+  // No '<' in the inlined JSON (it can only be inside a string there, where \u003c means the
+  // same): a "</script" or "<!--" would end or upset the script element.
+  std::string text;
+  for (char ch : spec.dump(-1, ' ', false, nlohmann::json::error_handler_t::replace)) text += ch == '<' ? std::string("\\u003c") : std::string(1, ch);
   const std::string id = relDir + "/" + name;
   return "<figure class=\"chart\"><div class=\"vega\" data-chart=\"" + escape(id) + "\"></div>" +
          "<script type=\"application/json\" class=\"spec\">" + text + "</script><figcaption>" + escape(caption) +
-         " <a href=\"" + escape(relDir + "/" + name + ".json") + "\">data</a></figcaption></figure>\n";
+         " " + link(relDir + "/" + name + ".json", "data") + "</figcaption></figure>\n";
 }
 
 std::string page(const std::string& title, const std::string& body) {
@@ -90,10 +107,15 @@ std::string pageScript() {
   body.dataset.chartTotal = String(charts.length);
   let drawn = 0;
   const jobs = charts.map((figure) => {
-    const spec = JSON.parse(figure.querySelector("script.spec").textContent);
-    return vegaEmbed(figure.querySelector("div.vega"), spec, { actions: false, renderer: "svg" })
-      .then(() => { drawn++; body.dataset.charts = String(drawn); })
-      .catch((e) => console.error(e));
+    try {
+      const spec = JSON.parse(figure.querySelector("script.spec").textContent);
+      return vegaEmbed(figure.querySelector("div.vega"), spec, { actions: false, renderer: "svg" })
+        .then(() => { drawn++; body.dataset.charts = String(drawn); })
+        .catch((e) => console.error(e));
+    } catch (e) {
+      console.error(e);  // one broken chart does not stop the others
+      return Promise.resolve();
+    }
   });
   const images = Array.from(document.images);
   body.dataset.imageTotal = String(images.length);

@@ -13,6 +13,11 @@
 namespace pr::cli::report {
 
 std::string escape(const std::string& text);
+// A relative path as a URL: every byte but letters, digits, '-', '.', '_', '~' and '/'
+// percent-encoded (a '#', '?' or '%' in a scene's name would otherwise break the link).
+std::string urlPath(const std::string& path);
+// A link to a file of the report: href escaped and encoded.
+std::string link(const std::string& path, const std::string& text);
 
 // A table: header cells then rows, every cell escaped.
 std::string table(const std::vector<std::string>& header, const std::vector<std::vector<std::string>>& rows,

@@ -62,7 +62,7 @@ std::string measuredFigure(const ComparisonRow& r, int width, int height) {
     return "broadcast " + formatBytes(kindBytes(r, "broadcasts") / std::uint64_t(p)) + " per PE, " +
            std::to_string(kindBytes(r, "rays", true)) + " ray messages (P=" + std::to_string(p) + ")";
   if (m == "image-space-cached")
-    return "hit ratio " + fmt(r.cacheHitRatio, "%.3f") + ", " + std::to_string(kindBytes(r, "requests", true)) +
+    return (r.cacheHitRatio >= 0.0 ? "hit ratio " + fmt(r.cacheHitRatio, "%.3f") : std::string("no cache used")) + ", " + std::to_string(kindBytes(r, "requests", true)) +
            " requests, " + formatBytes(kindBytes(r, "data")) + " of data fetched (P=" + std::to_string(p) + ")";
   if (m == "object-space" || m == "object")
     return std::to_string(kindBytes(r, "rays", true)) + " ray messages (" + formatBytes(kindBytes(r, "rays")) + ") for " +
@@ -120,7 +120,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   std::fprintf(stderr, "report: %s: comparison run\n", stem.c_str());
   const Comparison c = runComparison(cs, input);
   writeFileAtomically(dir / "comparison.csv", comparisonCsv(c), "CSV file");
-  writeFileAtomically(dir / "comparison.json", comparisonJson(c).dump(1) + "\n", "JSON file");
+  writeFileAtomically(dir / "comparison.json", comparisonJson(c).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", "JSON file");
 
   std::string html = "<section><h2>" + escape(stem) + "</h2>\n<p>" + escape(sceneFile) + ": " +
                      std::to_string(scene.triangles.size()) + " triangles, " + std::to_string(scene.lights.size()) +
@@ -128,8 +128,8 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                      escape(lighting) + ". " + std::to_string(spec.width) + "&times;" + std::to_string(spec.height) +
                      " pixels, P in {";
   for (std::size_t i = 0; i < spec.threads.size(); ++i) html += (i ? ", " : "") + std::to_string(spec.threads[i]);
-  html += "}, " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: <a href=\"" + relDir +
-          "/comparison.csv\">comparison.csv</a>, <a href=\"" + relDir + "/comparison.json\">comparison.json</a>.</p>\n";
+  html += "}, " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: " + link(relDir + "/comparison.csv", "comparison.csv") + ", " +
+          link(relDir + "/comparison.json", "comparison.json") + ".</p>\n";
 
   // Each method's run at its largest P.
   std::map<std::string, MethodScaling> scaling;
@@ -256,7 +256,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
            {"encoding", {{"x", x}, {"y", y}, {"color", color}, {"tooltip", {{{"field", "method"}}, {{"field", "P"}}}}}}}}}};
   };
   html += "<h3>Speed-up and efficiency against P</h3><p>Dots: measured (T1/Tn). Solid and dashed lines: the "
-          "simulator replaying each method's largest-P run at P = 1 &hellip; " + std::to_string(spec.maxPredictedPes) +
+          "simulator replaying each method's largest-P run at P = 1 &hellip; " + std::to_string(predictedPes.back()) +
           " on the " + escape(spec.network) + " network (" + escape(std::string(network.description)) +
           "), and Amdahl's law with the Karp&ndash;Flatt serial fraction fitted to the measured points. Diamonds: the "
           "best predicted P.</p>\n";
@@ -271,7 +271,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                        fmt(s.predicted.back().efficiency, "%.3f"), fmt(s.predicted.back().seconds, "%.4f")});
   }
   html += table({"method", "Karp-Flatt serial fraction", "Amdahl bound 1/f", "best predicted P",
-                 "predicted speed-up at " + std::to_string(spec.maxPredictedPes),
+                 "predicted speed-up at " + std::to_string(predictedPes.back()),
                  "predicted efficiency", "predicted seconds"},
                 fitRows);
 
@@ -294,8 +294,11 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
       perPe.push_back({{"pe", p}, {"state", "waiting at synchronisation"}, {"seconds", t.syncWaitSeconds}});
       perPe.push_back({{"pe", p}, {"state", "idle"}, {"seconds", other}});
     }
+    // The record keeps spans stage by stage and PE by PE; the chart shows the run's first ones in time.
+    std::vector<par::TaskSpan> timeline = chosen->record.timeline;
+    std::stable_sort(timeline.begin(), timeline.end(), [](const par::TaskSpan& x, const par::TaskSpan& y) { return x.start < y.start; });
     nlohmann::json spans = nlohmann::json::array();
-    for (const par::TaskSpan& s : chosen->record.timeline) {
+    for (const par::TaskSpan& s : timeline) {
       if (spans.size() >= kMaxTimelineSpans) break;
       const std::string what = s.task == par::kMessageSpan ? std::string("message handler")
                                                             : chosen->record.stages[std::size_t(s.stage)].name;
@@ -305,9 +308,10 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     const nlohmann::json peAxis = {{"field", "pe"}, {"type", "ordinal"}, {"title", "PE"}};
     html += "<h3>Per-PE time and timeline: " + escape(chosen->what.label()) + "</h3><p>Busy, communicating (inside "
             "channel calls or waiting on an empty mailbox), waiting at the end-of-stage synchronisation and otherwise idle, "
-            "per PE; then every task and message handler on its PE. The run's record: <a href=\"" + relDir +
-            "/timeline_metrics.json\">timeline_metrics.json</a>; its Chrome trace (Perfetto, chrome://tracing): <a href=\"" +
-            relDir + "/timeline.trace.json\">timeline.trace.json</a>.</p>\n";
+            "per PE; then every task and message handler on its PE. The run's record: " +
+            link(relDir + "/timeline_metrics.json", "timeline_metrics.json") +
+            "; its Chrome trace (Perfetto, chrome://tracing): " + link(relDir + "/timeline.trace.json", "timeline.trace.json") +
+            ".</p>\n";
     html += chart(dir, relDir, "per_pe",
                   {{"mark", "bar"},
                    {"height", 40 + 24 * int(totals.size())},
@@ -324,8 +328,8 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                                  {"color", {{"field", "what"}, {"type", "nominal"}}},
                                  {"tooltip", {{{"field", "what"}}, {{"field", "task"}}, {{"field", "start"}}, {{"field", "end"}}, {{"field", "messagesSent"}}}}}}},
                   spans,
-                  "Timeline, one row per PE" + std::string(chosen->record.timeline.size() > kMaxTimelineSpans
-                                                               ? " (the first " + std::to_string(kMaxTimelineSpans) + " spans)"
+                  "Timeline, one row per PE" + std::string(timeline.size() > kMaxTimelineSpans
+                                                               ? " (the first " + std::to_string(kMaxTimelineSpans) + " spans in time)"
                                                                : ""));
   }
 
@@ -388,7 +392,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   sweep.photonmap = spec.settings.ray.photonmap;
   const SweepResult sw = runSweep(sweep);
   nlohmann::json accuracy = nlohmann::json::array();
-  for (const Row& r : sw.rows)
+  for (const SweepRow& r : sw.rows)
     accuracy.push_back({{"integrator", r.integrator}, {"setting", r.setting + " " + formatValue(r.value)},
                         {"cpuSeconds", r.timed.cpuSeconds}, {"rmse", r.error.rmse}});
   std::string toTarget;

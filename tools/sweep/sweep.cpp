@@ -31,9 +31,9 @@ struct Context {
 };
 
 // One timed render of the series: a fresh runtime, CPU time of the whole process (every PE).
-Timed render(const Context& c, const RenderSettings& settings) {
+SweepTimed render(const Context& c, const RenderSettings& settings) {
   TimedRender t = timedRender(findRenderMethod(c.args.method), c.input, settings, c.args.threads, c.args.schedule);
-  return Timed{std::move(t.outcome.image), t.cpuSeconds, t.wallSeconds};
+  return SweepTimed{std::move(t.outcome.image), t.cpuSeconds, t.wallSeconds};
 }
 
 RenderSettings baseSettings(const SweepSpec& a, const std::string& integrator, int spp, std::uint64_t seed, int depth) {
@@ -77,8 +77,8 @@ std::vector<double> defaultValues(const std::string& vary, const scene::Scene& s
 
 // The CPU seconds at which an integrator's curve (rows by increasing cost) first reaches the
 // target RMSE, by log-log interpolation between the two renders around it; nullopt if never.
-std::optional<double> timeToTarget(std::vector<const Row*> rows, double target) {
-  std::sort(rows.begin(), rows.end(), [](const Row* a, const Row* b) { return a->timed.cpuSeconds < b->timed.cpuSeconds; });
+std::optional<double> timeToTarget(std::vector<const SweepRow*> rows, double target) {
+  std::sort(rows.begin(), rows.end(), [](const SweepRow* a, const SweepRow* b) { return a->timed.cpuSeconds < b->timed.cpuSeconds; });
   for (std::size_t i = 0; i < rows.size(); ++i) {
     if (rows[i]->error.rmse > target) continue;
     if (i == 0) return rows[0]->timed.cpuSeconds;
@@ -138,7 +138,7 @@ SweepResult runSweep(SweepSpec& a) {
   }
 
   // The series.
-  std::vector<Row> rows;
+  std::vector<SweepRow> rows;
   std::size_t total = 0;
   // The path tracer's series: --path-spp when given, else --values when spp is varied.
   const std::vector<double> pathValues = (a.vary == "spp" && !a.pathSppGiven)
@@ -153,7 +153,7 @@ SweepResult runSweep(SweepSpec& a) {
       RenderSettings s = baseSettings(a, integrator, a.spp, a.seed, a.maxDepth);
       if (integrator == "photonmap") applyVaried(a.vary, v, s);
       else s.ray.spp = int(v);
-      Row row{integrator, setting, v, render(ctx, s), {}};
+      SweepRow row{integrator, setting, v, render(ctx, s), {}};
       row.error = imageError(row.timed.image, reference, causticMask);
       std::fprintf(stderr, "[%zu/%zu] %s %s %s: %.2f CPU s, RMSE %.5f\n", rows.size() + 1, total, integrator.c_str(),
                    setting.c_str(), formatValue(v).c_str(), row.timed.cpuSeconds, row.error.rmse);
@@ -173,7 +173,7 @@ SweepResult runSweep(SweepSpec& a) {
   if (!(target > 0.0))
     for (const std::string& integrator : a.integrators) {
       double best = 1e300;
-      for (const Row& r : rows)
+      for (const SweepRow& r : rows)
         if (r.integrator == integrator) best = std::min(best, r.error.rmse);
       target = std::max(target, best);
     }
@@ -182,8 +182,8 @@ SweepResult runSweep(SweepSpec& a) {
   result.lighting = lighting;
   result.causticPixels = rows.empty() ? std::size_t(0) : rows.front().error.maskedPixels;
   for (const std::string& integrator : a.integrators) {
-    std::vector<const Row*> mine;
-    for (const Row& r : rows)
+    std::vector<const SweepRow*> mine;
+    for (const SweepRow& r : rows)
       if (r.integrator == integrator) mine.push_back(&r);
     result.cpuSecondsToTarget.emplace_back(integrator, timeToTarget(mine, target));
   }

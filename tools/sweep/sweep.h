@@ -48,20 +48,20 @@ struct SweepSpec {
   LightingOptions lighting;
 };
 
-struct Timed {
+struct SweepTimed {
   image::Image image;
   double cpuSeconds = 0.0, wallSeconds = 0.0;
 };
 
-struct Row {
+struct SweepRow {
   std::string integrator, setting;
   double value = 0.0;
-  Timed timed;
+  SweepTimed timed;
   ImageError error;
 };
 
 struct SweepResult {
-  std::vector<Row> rows;  // the figures of each render (images not kept)
+  std::vector<SweepRow> rows;  // the figures of each render (images not kept)
   Reference reference;
   double targetRmse = 0.0;  // given, or the lowest RMSE every integrator reaches
   std::vector<std::pair<std::string, std::optional<double>>> cpuSecondsToTarget;  // per integrator; nullopt: not reached
