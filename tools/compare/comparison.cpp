@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <numeric>
+#include <set>
 #include <tuple>
 
 #include "common/parallel/schedulers/scheduler.h"
@@ -38,6 +39,14 @@ std::vector<T> distinct(const std::vector<T>& values) {
   for (const T& v : values)
     if (std::find(out.begin(), out.end(), v) == out.end()) out.push_back(v);
   return out;
+}
+
+// The render settings of one combination.
+RenderSettings settingsFor(const Combination& c, const ComparisonSpec& spec) {
+  RenderSettings settings = spec.settings;
+  if (c.integrator != kNotApplicable) settings.ray.integrator = c.integrator;
+  if (c.compositor != kNotApplicable) settings.raster.compositor = c.compositor;
+  return settings;
 }
 
 bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
@@ -121,14 +130,23 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
 
   if (spec.reference) out.reference = pathReference(spec.referenceSettings, input);
 
+  // One untimed render per family first: the first render of a process pays one-time costs
+  // (lazily built tables such as the environment's, first-touch page faults, the allocator's
+  // growth) that would otherwise land on whichever combination happens to run first.
+  std::set<MethodFamily> warmed;
+  for (const Combination& c : combinations) {
+    if (!warmed.insert(c.family).second) continue;
+    if (spec.progress) std::fprintf(stderr, "warm-up (untimed): %s\n", c.label().c_str());
+    const RenderSettings settings = settingsFor(c, spec);
+    timedRender(findRenderMethod(c.method), input, settings, c.pes, par::ScheduleOptions{c.schedule, spec.scheduleParams});
+  }
+
   const int total = int(combinations.size()) * spec.repeat;
   int done = 0;
   // The first image of each family and integrator: every other must equal it bit for bit.
   std::map<std::pair<MethodFamily, std::string>, std::size_t> familyFirst;
   for (const Combination& c : combinations) {
-    RenderSettings settings = spec.settings;
-    if (c.integrator != kNotApplicable) settings.ray.integrator = c.integrator;
-    if (c.compositor != kNotApplicable) settings.raster.compositor = c.compositor;
+    const RenderSettings settings = settingsFor(c, spec);
     const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
     const RenderMethod& method = findRenderMethod(c.method);
     ComparisonRow row;
