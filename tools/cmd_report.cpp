@@ -124,7 +124,10 @@ void run(ReportArgs& a) {
   if (!out.has_filename() || out == out.root_path())
     throw InputError("report: " + a.output + " cannot be a report's folder (it must name a folder below another)");
   const std::filesystem::path parent = out.parent_path();
-  if (!std::filesystem::is_directory(parent)) throw InputError("report: the folder " + parent.string() + " does not exist");
+  std::error_code made;
+  std::filesystem::create_directories(parent, made);
+  if (!std::filesystem::is_directory(parent))
+    throw InputError("report: cannot make the folder " + parent.string() + (made ? " (" + made.message() + ")" : std::string()));
   if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
     throw InputError("report: " + out.string() + " exists and is not a folder");
   // Only a report (or an empty folder) is replaced: never a folder of someone's files.
