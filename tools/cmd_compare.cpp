@@ -9,7 +9,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include <CLI/CLI.hpp>
@@ -51,21 +50,6 @@ struct CompareArgs {
   LightingOptions lighting;
 };
 
-// 1, 2, 4, ... up to this machine's cores, and the core count itself.
-std::vector<int> defaultThreads() {
-  const int cores = std::max(1, int(std::thread::hardware_concurrency()));
-  std::vector<int> out;
-  for (int p = 1; p < cores; p *= 2) out.push_back(p);
-  out.push_back(cores);
-  return out;
-}
-
-std::vector<std::string> allMethods() {
-  std::vector<std::string> out;
-  for (const RenderMethod& m : renderMethods()) out.push_back(m.name);
-  return out;
-}
-
 // A file name for a row's image: its label with spaces and '=' made safe.
 std::string fileStem(const Combination& c) {
   std::string s = c.label();
@@ -75,8 +59,9 @@ std::string fileStem(const Combination& c) {
 }
 
 void run(CompareArgs& a) {
-  if (a.methods.empty()) a.methods = allMethods();
-  if (a.threads.empty()) a.threads = defaultThreads();
+  if (a.methods.empty())
+    for (std::string_view m : renderMethods().names()) a.methods.emplace_back(m);
+  if (a.threads.empty()) a.threads = defaultThreadCounts();
   ComparisonSpec spec;
   spec.methods = a.methods;
   spec.schedules = a.schedules;

@@ -20,6 +20,7 @@
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
+#include "tools/compare/comparison.h"
 #include "tools/report/classification.h"
 #include "tools/report/html.h"
 #include "tools/report/scene_report.h"
@@ -103,11 +104,7 @@ void run(ReportArgs& a) {
   for (const std::string& m : a.spec.methods) report::classifyMethod(m);
   for (const std::string& s : a.spec.schedules) report::classifySchedule(s);
   par::networkByName(a.spec.network);
-  if (a.spec.threads.empty()) {
-    const int cores = std::max(1, int(std::thread::hardware_concurrency()));
-    for (int p = 1; p < cores; p *= 2) a.spec.threads.push_back(p);
-    a.spec.threads.push_back(cores);
-  }
+  if (a.spec.threads.empty()) a.spec.threads = defaultThreadCounts();
   if (std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
     throw InputError("--threads must include 1: speed-up and efficiency are measured against P = 1");
   for (const std::string& scene : a.scenes) {
@@ -167,7 +164,7 @@ void run(ReportArgs& a) {
 void addReportCommand(CLI::App& app) {
   auto a = std::make_shared<ReportArgs>();
   report::ReportSpec& s = a->spec;
-  for (const RenderMethod& m : renderMethods()) s.methods.push_back(m.name);
+  for (std::string_view m : renderMethods().names()) s.methods.emplace_back(m);
   s.schedules = {"demand", "balanced"};
   CLI::App* cmd = app.add_subcommand("report", "a self-contained HTML report classifying the methods, with the figures measured on each scene");
   cmd->add_option("scenes", a->scenes, "glTF 2.0 scenes (.gltf or .glb)")->required()->check(CLI::ExistingFile);

@@ -7,6 +7,7 @@
 #include <map>
 #include <numeric>
 #include <set>
+#include <thread>
 #include <tuple>
 
 #include "common/parallel/schedulers/scheduler.h"
@@ -28,6 +29,26 @@ const std::vector<std::string>& comparisonKinds() {
   static const std::vector<std::string> kKinds = {"tasks", "primitives", "rays", "pixels", "broadcasts", "results",
                                                   "requests", "data"};
   return kKinds;
+}
+
+const par::KindTraffic* kindTraffic(const ComparisonRow& row, const std::string& kind) {
+  for (const par::KindTraffic& k : row.summary.total.byKind)
+    if (k.kind == kind) return &k;
+  return nullptr;
+}
+
+par::KindTraffic allTraffic(const ComparisonRow& row) {
+  par::KindTraffic all{"all"};
+  for (const par::KindTraffic& k : row.summary.total.byKind) all.messages += k.messages, all.bytes += k.bytes;
+  return all;
+}
+
+std::vector<int> defaultThreadCounts() {
+  const int cores = std::max(1, int(std::thread::hardware_concurrency()));
+  std::vector<int> out;
+  for (int p = 1; p < cores; p *= 2) out.push_back(p);
+  out.push_back(cores);
+  return out;
 }
 
 namespace {

@@ -85,4 +85,11 @@ Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input);
 // The message kinds in the order the table and files list them.
 const std::vector<std::string>& comparisonKinds();
 
+// A row's traffic of one kind (nullptr when none), and of every kind together.
+const par::KindTraffic* kindTraffic(const ComparisonRow& row, const std::string& kind);
+par::KindTraffic allTraffic(const ComparisonRow& row);
+
+// The default values of P: 1, 2, 4, ... up to this machine's cores, and the core count itself.
+std::vector<int> defaultThreadCounts();
+
 }  // namespace pr::cli

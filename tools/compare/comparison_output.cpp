@@ -4,18 +4,19 @@
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
-#include <utility>
 #include <vector>
 
 namespace pr::cli {
 
-namespace {
-
-std::string number(double v, const char* format = "%.3f") {
+std::string formatNumber(double v, const char* format) {
   char text[48];
   std::snprintf(text, sizeof text, format, v);
   return text;
 }
+
+namespace {
+
+std::string number(double v, const char* format = "%.3f") { return formatNumber(v, format); }
 
 std::string exact(double v) { return number(v, "%.6g"); }
 
@@ -27,19 +28,6 @@ std::string compact(std::uint64_t v) {
   int unit = -1;
   while (x >= 1000.0 && unit < 3) x /= 1000.0, ++unit;
   return number(x, x < 10.0 ? "%.1f" : "%.0f") + units[unit];
-}
-
-const par::KindTraffic* kind(const ComparisonRow& row, const std::string& name) {
-  for (const par::KindTraffic& k : row.summary.total.byKind)
-    if (k.kind == name) return &k;
-  return nullptr;
-}
-
-// Messages and bytes of every kind, data and scheduling and broadcasts.
-std::pair<std::uint64_t, std::uint64_t> allTraffic(const ComparisonRow& row) {
-  std::uint64_t messages = 0, bytes = 0;
-  for (const par::KindTraffic& k : row.summary.total.byKind) messages += k.messages, bytes += k.bytes;
-  return {messages, bytes};
 }
 
 // A CSV field in double quotes, its own quotes doubled.
@@ -78,7 +66,7 @@ std::string comparisonTable(const Comparison& c) {
   std::vector<std::string> kinds;
   for (const std::string& k : comparisonKinds())
     for (const ComparisonRow& row : c.rows)
-      if (const par::KindTraffic* t = kind(row, k); t && t->messages > 0) {
+      if (const par::KindTraffic* t = kindTraffic(row, k); t && t->messages > 0) {
         kinds.push_back(k);
         break;
       }
@@ -90,7 +78,7 @@ std::string comparisonTable(const Comparison& c) {
   cells.push_back(header);
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
-    const auto [messages, bytes] = allTraffic(r);
+    const par::KindTraffic all = allTraffic(r);
     std::vector<std::string> line = {r.what.method,
                                      std::string(toString(r.what.family)),
                                      r.what.schedule,
@@ -104,10 +92,10 @@ std::string comparisonTable(const Comparison& c) {
                                      orDash(r.speedupSerial, r.speedupSerial > 0.0),
                                      orDash(r.efficiency, r.efficiency > 0.0),
                                      number(t.imbalance),
-                                     compact(messages),
-                                     compact(bytes)};
+                                     compact(all.messages),
+                                     compact(all.bytes)};
     for (const std::string& k : kinds) {
-      const par::KindTraffic* kt = kind(r, k);
+      const par::KindTraffic* kt = kindTraffic(r, k);
       line.push_back(kt ? compact(kt->messages) + "/" + compact(kt->bytes) : "-");
     }
     line.push_back(orDash(t.computeToComm, t.computeToComm >= 0.0, "%.1f"));
@@ -140,10 +128,10 @@ std::string comparisonCsv(const Comparison& c) {
     out << r.what.method << "," << toString(r.what.family) << "," << r.what.schedule << "," << r.what.integrator << ","
         << r.what.compositor << "," << r.what.pes << "," << r.wallSeconds.size() << "," << exact(r.wall) << ","
         << exact(r.wallMin) << "," << exact(r.wallMax) << "," << exact(r.cpu) << "," << exact(r.speedup) << ","
-        << exact(r.speedupSerial) << "," << exact(r.efficiency) << "," << exact(t.imbalance) << "," << allTraffic(r).first
-        << "," << allTraffic(r).second;
+        << exact(r.speedupSerial) << "," << exact(r.efficiency) << "," << exact(t.imbalance) << "," << allTraffic(r).messages
+        << "," << allTraffic(r).bytes;
     for (const std::string& k : comparisonKinds()) {
-      const par::KindTraffic* kt = kind(r, k);
+      const par::KindTraffic* kt = kindTraffic(r, k);
       out << "," << (kt ? kt->messages : 0) << "," << (kt ? kt->bytes : 0);
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
@@ -175,8 +163,8 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"efficiency", optional(r.efficiency, r.efficiency > 0.0)},
                     {"recordEfficiency", t.efficiency},
                     {"loadImbalance", t.imbalance},
-                    {"messages", allTraffic(r).first},
-                    {"bytes", allTraffic(r).second},
+                    {"messages", allTraffic(r).messages},
+                    {"bytes", allTraffic(r).bytes},
                     {"byKind", byKind},
                     {"computeToComm", optional(t.computeToComm, t.computeToComm >= 0.0)},
                     {"cacheHitRatio", optional(r.cacheHitRatio, r.cacheHitRatio >= 0.0)},

@@ -16,6 +16,8 @@ std::string comparisonTable(const Comparison& comparison);
 // Skipped combinations and image agreement, a line each.
 std::string comparisonNotes(const Comparison& comparison);
 std::string comparisonCsv(const Comparison& comparison);
+// A number through a printf format ("%.3f"): the figures of the table and of the report.
+std::string formatNumber(double v, const char* format);
 nlohmann::json comparisonJson(const Comparison& comparison);
 
 }  // namespace pr::cli

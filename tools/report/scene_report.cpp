@@ -31,16 +31,12 @@ namespace {
 // Gantt charts beyond this many spans draw the first ones only (and say so).
 constexpr std::size_t kMaxTimelineSpans = 20000;
 
-std::string fmt(double v, const char* format = "%.3g") {
-  char text[48];
-  std::snprintf(text, sizeof text, format, v);
-  return text;
-}
+std::string fmt(double v, const char* format = "%.3g") { return formatNumber(v, format); }
 
+// Bytes (or messages) of one kind in a row, 0 when none.
 std::uint64_t kindBytes(const ComparisonRow& r, const std::string& kind, bool messages = false) {
-  for (const par::KindTraffic& k : r.summary.total.byKind)
-    if (k.kind == kind) return messages ? k.messages : k.bytes;
-  return 0;
+  const par::KindTraffic* k = kindTraffic(r, kind);
+  return !k ? 0 : messages ? k->messages : k->bytes;
 }
 
 double counter(const ComparisonRow& r, const std::string& name) {
@@ -192,15 +188,14 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   std::vector<std::vector<std::string>> rows;
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
-    std::uint64_t messages = 0, bytes = 0;
-    for (const par::KindTraffic& k : t.byKind) messages += k.messages, bytes += k.bytes;
+    const par::KindTraffic all = allTraffic(r);
     std::string kinds;
     for (const par::KindTraffic& k : t.byKind)
       if (k.messages) kinds += (kinds.empty() ? "" : ", ") + k.kind + " " + std::to_string(k.messages);
     rows.push_back({r.what.method, r.what.schedule, r.what.integrator, std::to_string(r.what.pes), fmt(r.wall, "%.4f"),
                     fmt(r.cpu, "%.4f"), r.speedup > 0 ? fmt(r.speedup, "%.2f") : "-",
                     r.speedupSerial > 0 ? fmt(r.speedupSerial, "%.2f") : "-", r.efficiency > 0 ? fmt(r.efficiency, "%.2f") : "-",
-                    fmt(t.imbalance, "%.3f"), std::to_string(messages), formatBytes(bytes), kinds,
+                    fmt(t.imbalance, "%.3f"), std::to_string(all.messages), formatBytes(all.bytes), kinds,
                     t.computeToComm >= 0 ? fmt(t.computeToComm, "%.1f") : "-",
                     r.cacheHitRatio >= 0 ? fmt(r.cacheHitRatio, "%.3f") : "-", fmt(r.rmse, "%.4f"),
                     r.agrees ? r.agreement : "DIFFERS: " + r.agreement});
@@ -465,9 +460,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
         if (q.pes == s.bestPredictedPes) bestPoint = &q;
       const std::uint64_t perPeBytes = kindBytes(r, "broadcasts") / std::uint64_t(r.what.pes);
       const std::uint64_t perPeMessages = kindBytes(r, "broadcasts", true) / std::uint64_t(r.what.pes);
-      std::uint64_t dataBytes = 0;
-      for (const par::KindTraffic& k : r.summary.total.byKind)
-        if (k.kind != "broadcasts" && k.kind != "tasks") dataBytes += k.bytes;
+      const std::uint64_t dataBytes = allTraffic(r).bytes - kindBytes(r, "broadcasts") - kindBytes(r, "tasks");
       html += "<li>" + escape(method) + ": " + fmt(last.seconds, "%.4f") + " s at " + std::to_string(topP) +
               " PEs (speed-up " + fmt(last.speedup, "%.3g") + ", efficiency " + fmt(last.efficiency, "%.3f") + ", imbalance " +
               fmt(last.imbalance, "%.2f") + "); best at P = " + std::to_string(bestPoint->pes) + ", " +
