@@ -25,6 +25,11 @@ namespace pr::rt {
 // of 73 bytes per triangle.
 inline constexpr int kBvhWidth = 4;
 
+// Leaf triangles tested at once (triangle4.h): one SSE lane each. The SAH counts a leaf's cost
+// in such blocks, so a leaf of four costs what a leaf of one does.
+inline constexpr int kLeafLanes = 4;
+inline constexpr uint32_t leafBlocks(uint32_t triangles) { return (triangles + kLeafLanes - 1) / kLeafLanes; }
+
 // One node of the 4-wide BVH, 128 bytes (two cache lines): the bounds of its children, one
 // SIMD lane each (bounds[0..2] = min x, y, z; bounds[3..5] = max x, y, z), and the children's
 // references (see BvhRef). The binned-SAH build makes a binary tree first and collapses it,

@@ -77,7 +77,7 @@ class Builder {
     if (count == 1) return makeLeaf(nodeIndex, begin, end);
 
     Split split = depth < kSahDepthLimit ? findSahSplit(begin, end, bounds, centroids) : Split{};
-    const float leafCost = options_.intersectionCost * float(count);
+    const float leafCost = options_.intersectionCost * float(leafBlocks(count));
     if (count <= uint32_t(options_.maxLeafSize) && !(split.valid && split.cost < leafCost))
       return makeLeaf(nodeIndex, begin, end);
 
@@ -165,7 +165,7 @@ class Builder {
         n += bins[a][b - 1].count;
         if (n == 0 || rightCount[b] == 0) continue;
         const float cost = options_.traversalCost +
-            options_.intersectionCost * (acc.halfArea() * float(n) + rightArea[b] * float(rightCount[b])) / nodeArea;
+            options_.intersectionCost * (acc.halfArea() * float(leafBlocks(n)) + rightArea[b] * float(leafBlocks(rightCount[b]))) / nodeArea;
         if (cost < best.cost) best = Split{true, a, b, cost};
       }
     }

@@ -1,16 +1,19 @@
 // BVH queries: closest hit and any hit (shadow). Called by every tracer for every ray, on the
 // PE that holds the BVH (the world-model BVH in image-space, a PE's own BVH in the partitioned
 // tracers); read-only, so any number of PEs may query one Bvh at once.
-// Each wide node is two 4-lane SSE slab tests whose near and far planes are picked once per ray
-// by the sign of the direction; hit children are visited nearest first, and subtrees that start
+// Each wide node is one 4-lane SSE slab test per four children, whose near and far planes are
+// picked once per ray by the sign of the direction; leaves test four triangles at once
+// (triangle4.h); hit children are visited nearest first, and subtrees that start
 // beyond the best hit so far are pruned.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <emmintrin.h>  // SSE2: part of every x86-64 target
+#include <xmmintrin.h>  // _mm_prefetch
 
 #include "raytrace/core/bvh.h"
-#include "raytrace/core/triangle.h"
+#include "raytrace/core/triangle4.h"
 
 namespace pr::rt {
 namespace {
@@ -26,10 +29,14 @@ constexpr int kGroups = kBvhWidth / 4;
 constexpr float kUlp = 0x1p-24f;
 constexpr float kSlabScale = 1.0f + 2.0f * (3.0f * kUlp) / (1.0f - 3.0f * kUlp);
 
-// Smallest |direction| component used for the reciprocal: a zero component would give
-// 0 * inf = NaN for a box face through the origin; 1e-30 keeps every product finite for
-// scenes up to 1e8 in size and is far below any direction a renderer produces.
-constexpr float kMinDirection = 1e-30f;
+// A direction component of 0 gives an infinite reciprocal, and a box face through the origin
+// along that axis then gives 0 * inf = NaN: the ray lies in the face's plane. Closed boxes
+// count such a ray as inside the slab, so a NaN distance must constrain nothing. SSE's max and
+// min return their second operand when either is NaN, so every distance is combined as the
+// first operand with a finite running bound as the second (see slab()). Clamping the component
+// to a tiny value instead gave a distance of exactly 0 and lost boxes whose far face held the
+// ray, and with them ties between triangles that meet in that plane.
+constexpr float kInfinity = std::numeric_limits<float>::infinity();
 
 // The triangle test and the slab test round differently: a hit's t can come out a little
 // smaller than the computed entry distance of its own box. The error of both is a few ulps of
@@ -43,20 +50,22 @@ struct BoxRay {
   __m128 invDir[3];
   __m128 lo;     // tMin - slack
   __m128 slack;
-  int nearRow[3];  // BvhNode::bounds row of the entry plane per axis: min for d >= 0, else max
-  int farRow[3];
+  // Byte offset in a BvhNode of the bounds row of the entry plane per axis (min for d >= 0,
+  // else max) and of the exit plane, so a node's planes are loaded with no index arithmetic.
+  size_t nearRow[3];
+  size_t farRow[3];
 };
 
 BoxRay makeBoxRay(const Ray& ray, float magnitude) {
   BoxRay r;
   for (int a = 0; a < 3; ++a) {
     const float d = ray.direction[a];
-    const float dClamped = std::fabs(d) < kMinDirection ? std::copysign(kMinDirection, d) : d;
     r.origin[a] = _mm_set1_ps(ray.origin[a]);
-    r.invDir[a] = _mm_set1_ps(1.0f / dClamped);
-    const bool negative = std::signbit(dClamped);
-    r.nearRow[a] = negative ? 3 + a : a;
-    r.farRow[a] = negative ? a : 3 + a;
+    r.invDir[a] = _mm_set1_ps(1.0f / d);
+    const bool negative = std::signbit(d);
+    const size_t rowBytes = sizeof(BvhNode::bounds[0]);
+    r.nearRow[a] = (negative ? 3 + a : a) * rowBytes;
+    r.farRow[a] = (negative ? a : 3 + a) * rowBytes;
   }
   const glm::vec3 ad = glm::abs(ray.direction), ao = glm::abs(ray.origin);
   const float scale = std::max({magnitude, ao.x, ao.y, ao.z});
@@ -72,17 +81,21 @@ BoxRay makeBoxRay(const Ray& ray, float magnitude) {
 inline int slab(const BvhNode& node, const BoxRay& r, float hi, __m128 (&tEntry)[kGroups]) {
   const __m128 hiVec = _mm_set1_ps(hi);
   const __m128 scale = _mm_set1_ps(kSlabScale);
+  const __m128 infinity = _mm_set1_ps(kInfinity);
+  const char* base = reinterpret_cast<const char*>(node.bounds);
+  const auto row = [&](size_t offset, int o) { return _mm_load_ps(reinterpret_cast<const float*>(base + offset) + o); };
   int mask = 0;
   for (int g = 0; g < kGroups; ++g) {
     const int o = 4 * g;
-    const __m128 nx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[0]] + o), r.origin[0]), r.invDir[0]);
-    const __m128 ny = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[1]] + o), r.origin[1]), r.invDir[1]);
-    const __m128 nz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[2]] + o), r.origin[2]), r.invDir[2]);
-    const __m128 fx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[0]] + o), r.origin[0]), r.invDir[0]);
-    const __m128 fy = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[1]] + o), r.origin[1]), r.invDir[1]);
-    const __m128 fz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[2]] + o), r.origin[2]), r.invDir[2]);
-    const __m128 enter = _mm_max_ps(_mm_max_ps(nx, ny), _mm_max_ps(nz, r.lo));
-    const __m128 leave = _mm_mul_ps(_mm_min_ps(_mm_min_ps(fx, fy), fz), scale);
+    const __m128 nx = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[0], o), r.origin[0]), r.invDir[0]);
+    const __m128 ny = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[1], o), r.origin[1]), r.invDir[1]);
+    const __m128 nz = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[2], o), r.origin[2]), r.invDir[2]);
+    const __m128 fx = _mm_mul_ps(_mm_sub_ps(row(r.farRow[0], o), r.origin[0]), r.invDir[0]);
+    const __m128 fy = _mm_mul_ps(_mm_sub_ps(row(r.farRow[1], o), r.origin[1]), r.invDir[1]);
+    const __m128 fz = _mm_mul_ps(_mm_sub_ps(row(r.farRow[2], o), r.origin[2]), r.invDir[2]);
+    // Each distance first, the running bound second: a NaN distance (see kInfinity) drops out.
+    const __m128 enter = _mm_max_ps(nz, _mm_max_ps(ny, _mm_max_ps(nx, r.lo)));
+    const __m128 leave = _mm_mul_ps(_mm_min_ps(fz, _mm_min_ps(fy, _mm_min_ps(fx, infinity))), scale);
     const __m128 limit = _mm_add_ps(_mm_min_ps(leave, hiVec), r.slack);
     tEntry[g] = enter;
     mask |= _mm_movemask_ps(_mm_cmple_ps(enter, limit)) << o;
@@ -95,6 +108,21 @@ bool usable(const Ray& ray) {
   const bool finiteRay = std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) &&
                          std::isfinite(o.x) && std::isfinite(o.y) && std::isfinite(o.z);
   return finiteRay && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && ray.tMin <= ray.tMax;
+}
+
+// Starts the loads of the hit children's nodes or leaf triangles when more than one is hit: the
+// nearest is visited next and the others wait on the stack, and a ray's walk is a chain of
+// dependent cache misses on a BVH larger than the cache; the waiting ones' misses then overlap
+// with the walk of the nearest.
+inline void prefetchChildren(const BvhNode& node, int mask, const BvhNode* nodes, const BvhTriangle* triangles) {
+  if ((mask & (mask - 1)) == 0) return;
+  for (; mask != 0; mask &= mask - 1) {
+    const uint32_t ref = node.child[__builtin_ctz(unsigned(mask))];
+    const char* p = BvhRef::isLeaf(ref) ? reinterpret_cast<const char*>(triangles + BvhRef::leafFirst(ref))
+                                        : reinterpret_cast<const char*>(nodes + ref);
+    _mm_prefetch(p, _MM_HINT_T0);
+    _mm_prefetch(p + 64, _MM_HINT_T0);
+  }
 }
 
 struct StackEntry {
@@ -162,21 +190,27 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
       __m128 tEntry[kGroups];
       const int mask = slab(nodes[ref], boxRay, bestT, tEntry);
       if (mask != 0) {
+        prefetchChildren(nodes[ref], mask, nodes, triangles);
         ref = orderChildren(nodes[ref], mask, tEntry, stack, sp);
         continue;
       }
     } else {
       const BvhTriangle* tri = triangles + BvhRef::leafFirst(ref);
       const uint32_t count = BvhRef::leafCount(ref);
-      for (uint32_t i = 0; i < count; ++i, ++tri) {
-        TriangleHit th;
-        if (!intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, bestT, th)) continue;
-        // th.t <= bestT here; equal t keeps the lower triangle index (Hit::closerThan).
-        if ((th.t < bestT || tri->triangle < bestTriangle) && (!alpha || alpha->passes(tri->triangle, th.u, th.v, ray))) {
-          bestT = th.t;
-          bestTriangle = tri->triangle;
-          bestU = th.u;
-          bestV = th.v;
+      for (uint32_t first = 0; first < count; first += kLeafLanes, tri += kLeafLanes) {
+        alignas(16) float t[kLeafLanes], u[kLeafLanes], v[kLeafLanes];
+        // In lane order, as one triangle after another: a lane counts only if it is no farther
+        // than the best hit so far; equal t keeps the lower triangle index (Hit::closerThan).
+        for (int mask = intersectLeaf<Kz>(shear, tri, std::min<uint32_t>(count - first, kLeafLanes), ray.tMin, bestT, t, u, v);
+             mask != 0; mask &= mask - 1) {
+          const int lane = __builtin_ctz(unsigned(mask));
+          const uint32_t id = tri[lane].triangle;
+          if (t[lane] <= bestT && (t[lane] < bestT || id < bestTriangle) && (!alpha || alpha->passes(id, u[lane], v[lane], ray))) {
+            bestT = t[lane];
+            bestTriangle = id;
+            bestU = u[lane];
+            bestV = v[lane];
+          }
         }
       }
     }
@@ -215,6 +249,7 @@ bool Bvh::occludedK(const Ray& ray) const {
         // Any hit ends the query, so the order of the children only matters for how soon one
         // is found: no sort, the first hit lane goes on, the others wait on the stack.
         const BvhNode& node = nodes[ref];
+        prefetchChildren(node, mask, nodes, triangles);
         ref = node.child[__builtin_ctz(unsigned(mask))];
         for (mask &= mask - 1; mask != 0; mask &= mask - 1) stack[sp++] = {node.child[__builtin_ctz(unsigned(mask))], 0.0f};
         continue;
@@ -222,11 +257,14 @@ bool Bvh::occludedK(const Ray& ray) const {
     } else {
       const BvhTriangle* tri = triangles + BvhRef::leafFirst(ref);
       const uint32_t count = BvhRef::leafCount(ref);
-      for (uint32_t i = 0; i < count; ++i, ++tri) {
-        TriangleHit th;
-        if (intersectTriangle<Kz>(shear, tri->p0, tri->p1, tri->p2, ray.tMin, tMax, th) &&
-            (!alpha || alpha->passes(tri->triangle, th.u, th.v, ray)))
-          return true;
+      for (uint32_t first = 0; first < count; first += kLeafLanes, tri += kLeafLanes) {
+        alignas(16) float t[kLeafLanes], u[kLeafLanes], v[kLeafLanes];
+        const int mask = intersectLeaf<Kz>(shear, tri, std::min<uint32_t>(count - first, kLeafLanes), ray.tMin, tMax, t, u, v);
+        if (mask != 0 && !alpha) return true;
+        for (int rest = mask; rest != 0; rest &= rest - 1) {
+          const int lane = __builtin_ctz(unsigned(rest));
+          if (alpha->passes(tri[lane].triangle, u[lane], v[lane], ray)) return true;
+        }
       }
     }
     if (sp == 0) return false;

@@ -3,6 +3,7 @@
 // degenerate triangles are never hit.
 #include <doctest/doctest.h>
 
+#include <bit>
 #include <cmath>
 #include <random>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/core/triangle.h"
+#include "raytrace/core/triangle4.h"
 
 using pr::rt::Bvh;
 using pr::rt::Hit;
@@ -152,4 +154,62 @@ TEST_CASE("Triangle: degenerate triangles are never hit and cause no NaN") {
       }
     }
   CHECK(hits == 0);
+}
+
+// The leaf test (triangle4.h) must be the scalar test, lane by lane, to the bit: images stay
+// the same whichever test a leaf uses. The cases mix ordinary triangles with the hard ones:
+// rays through a vertex or along an edge (edge functions exactly 0, the double fallback),
+// degenerate triangles stored as three equal points, huge and tiny ones, and rays parallel to
+// the plane.
+TEST_CASE("Triangle: the four-lane leaf test gives the scalar test's hit, t, u and v bit for bit") {
+  std::mt19937 rng(20261203);
+  std::uniform_real_distribution<float> unit(-1.0f, 1.0f);
+  const auto randomPoint = [&](float scale) { return glm::vec3(unit(rng), unit(rng), unit(rng)) * scale; };
+  const auto bits = [](float f) { return std::bit_cast<uint32_t>(f); };
+  int hits = 0, fallbacks = 0, compared = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const float scale = trial % 5 == 0 ? 1e4f : trial % 5 == 1 ? 1e-3f : 1.0f;
+    const Ray ray{randomPoint(2.0f * scale), 0.0f, glm::normalize(randomPoint(1.0f) + glm::vec3(0.0f, 0.0f, 1e-3f)),
+                  pr::rt::kInfinity};
+    pr::rt::BvhTriangle tris[4];
+    const uint32_t count = 1 + uint32_t(trial % 4);
+    for (uint32_t i = 0; i < count; ++i) {
+      glm::vec3 p0 = randomPoint(scale), p1 = randomPoint(scale), p2 = randomPoint(scale);
+      switch ((trial / 4 + i) % 6) {
+        case 0: p0 = ray.origin + ray.direction * (3.0f * scale); break;  // the ray through a vertex
+        case 1: p1 = p0 + (p2 - p0) * 2.0f; break;                         // collinear: degenerate
+        case 2: p1 = p2 = p0; break;                                       // as the build stores degenerates
+        case 3: p1 = p0 + ray.direction * scale; break;                    // an edge along the ray
+        default: break;
+      }
+      tris[i] = pr::rt::BvhTriangle{p0, p1, p2, i};
+    }
+    const pr::rt::RayShear shear = pr::rt::makeRayShear(ray);
+    const float tMax = trial % 3 == 0 ? 2.5f * scale : pr::rt::kInfinity;
+    alignas(16) float t[4], u[4], v[4];
+    int mask = 0;
+    switch (shear.kz) {
+      case 0: mask = pr::rt::intersectLeaf<0>(shear, tris, count, 0.0f, tMax, t, u, v); break;
+      case 1: mask = pr::rt::intersectLeaf<1>(shear, tris, count, 0.0f, tMax, t, u, v); break;
+      default: mask = pr::rt::intersectLeaf<2>(shear, tris, count, 0.0f, tMax, t, u, v); break;
+    }
+    CHECK((mask >> count) == 0);
+    for (uint32_t i = 0; i < count; ++i) {
+      pr::rt::TriangleHit h;
+      const bool scalarHit = pr::rt::intersectTriangle(shear, tris[i].p0, tris[i].p1, tris[i].p2, 0.0f, tMax, h);
+      const bool leafHit = ((mask >> i) & 1) != 0;
+      REQUIRE(leafHit == scalarHit);
+      ++compared;
+      if (!scalarHit) continue;
+      ++hits;
+      CHECK(bits(t[i]) == bits(h.t));
+      CHECK(bits(u[i]) == bits(h.u));
+      CHECK(bits(v[i]) == bits(h.v));
+      fallbacks += (trial / 4 + i) % 6 == 0 ? 1 : 0;
+    }
+  }
+  // The cases reach both outcomes and the through-a-vertex hits of the double fallback.
+  CHECK(hits > 1000);
+  CHECK(hits < compared);
+  CHECK(fallbacks > 100);
 }
