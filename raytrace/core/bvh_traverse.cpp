@@ -10,7 +10,6 @@
 #include <limits>
 
 #include <emmintrin.h>  // SSE2: part of every x86-64 target
-#include <xmmintrin.h>  // _mm_prefetch
 
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/triangle4.h"
@@ -50,10 +49,8 @@ struct BoxRay {
   __m128 invDir[3];
   __m128 lo;     // tMin - slack
   __m128 slack;
-  // Byte offset in a BvhNode of the bounds row of the entry plane per axis (min for d >= 0,
-  // else max) and of the exit plane, so a node's planes are loaded with no index arithmetic.
-  size_t nearRow[3];
-  size_t farRow[3];
+  int nearRow[3];  // BvhNode::bounds row of the entry plane per axis: min for d >= 0, else max
+  int farRow[3];
 };
 
 BoxRay makeBoxRay(const Ray& ray, float magnitude) {
@@ -63,9 +60,8 @@ BoxRay makeBoxRay(const Ray& ray, float magnitude) {
     r.origin[a] = _mm_set1_ps(ray.origin[a]);
     r.invDir[a] = _mm_set1_ps(1.0f / d);
     const bool negative = std::signbit(d);
-    const size_t rowBytes = sizeof(BvhNode::bounds[0]);
-    r.nearRow[a] = (negative ? 3 + a : a) * rowBytes;
-    r.farRow[a] = (negative ? a : 3 + a) * rowBytes;
+    r.nearRow[a] = negative ? 3 + a : a;
+    r.farRow[a] = negative ? a : 3 + a;
   }
   const glm::vec3 ad = glm::abs(ray.direction), ao = glm::abs(ray.origin);
   const float scale = std::max({magnitude, ao.x, ao.y, ao.z});
@@ -82,17 +78,15 @@ inline int slab(const BvhNode& node, const BoxRay& r, float hi, __m128 (&tEntry)
   const __m128 hiVec = _mm_set1_ps(hi);
   const __m128 scale = _mm_set1_ps(kSlabScale);
   const __m128 infinity = _mm_set1_ps(kInfinity);
-  const char* base = reinterpret_cast<const char*>(node.bounds);
-  const auto row = [&](size_t offset, int o) { return _mm_load_ps(reinterpret_cast<const float*>(base + offset) + o); };
   int mask = 0;
   for (int g = 0; g < kGroups; ++g) {
     const int o = 4 * g;
-    const __m128 nx = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[0], o), r.origin[0]), r.invDir[0]);
-    const __m128 ny = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[1], o), r.origin[1]), r.invDir[1]);
-    const __m128 nz = _mm_mul_ps(_mm_sub_ps(row(r.nearRow[2], o), r.origin[2]), r.invDir[2]);
-    const __m128 fx = _mm_mul_ps(_mm_sub_ps(row(r.farRow[0], o), r.origin[0]), r.invDir[0]);
-    const __m128 fy = _mm_mul_ps(_mm_sub_ps(row(r.farRow[1], o), r.origin[1]), r.invDir[1]);
-    const __m128 fz = _mm_mul_ps(_mm_sub_ps(row(r.farRow[2], o), r.origin[2]), r.invDir[2]);
+    const __m128 nx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[0]] + o), r.origin[0]), r.invDir[0]);
+    const __m128 ny = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[1]] + o), r.origin[1]), r.invDir[1]);
+    const __m128 nz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.nearRow[2]] + o), r.origin[2]), r.invDir[2]);
+    const __m128 fx = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[0]] + o), r.origin[0]), r.invDir[0]);
+    const __m128 fy = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[1]] + o), r.origin[1]), r.invDir[1]);
+    const __m128 fz = _mm_mul_ps(_mm_sub_ps(_mm_load_ps(node.bounds[r.farRow[2]] + o), r.origin[2]), r.invDir[2]);
     // Each distance first, the running bound second: a NaN distance (see kInfinity) drops out.
     const __m128 enter = _mm_max_ps(nz, _mm_max_ps(ny, _mm_max_ps(nx, r.lo)));
     const __m128 leave = _mm_mul_ps(_mm_min_ps(fz, _mm_min_ps(fy, _mm_min_ps(fx, infinity))), scale);
@@ -108,21 +102,6 @@ bool usable(const Ray& ray) {
   const bool finiteRay = std::isfinite(d.x) && std::isfinite(d.y) && std::isfinite(d.z) &&
                          std::isfinite(o.x) && std::isfinite(o.y) && std::isfinite(o.z);
   return finiteRay && (d.x != 0.0f || d.y != 0.0f || d.z != 0.0f) && ray.tMin <= ray.tMax;
-}
-
-// Starts the loads of the hit children's nodes or leaf triangles when more than one is hit: the
-// nearest is visited next and the others wait on the stack, and a ray's walk is a chain of
-// dependent cache misses on a BVH larger than the cache; the waiting ones' misses then overlap
-// with the walk of the nearest.
-inline void prefetchChildren(const BvhNode& node, int mask, const BvhNode* nodes, const BvhTriangle* triangles) {
-  if ((mask & (mask - 1)) == 0) return;
-  for (; mask != 0; mask &= mask - 1) {
-    const uint32_t ref = node.child[__builtin_ctz(unsigned(mask))];
-    const char* p = BvhRef::isLeaf(ref) ? reinterpret_cast<const char*>(triangles + BvhRef::leafFirst(ref))
-                                        : reinterpret_cast<const char*>(nodes + ref);
-    _mm_prefetch(p, _MM_HINT_T0);
-    _mm_prefetch(p + 64, _MM_HINT_T0);
-  }
 }
 
 struct StackEntry {
@@ -190,7 +169,6 @@ bool Bvh::intersectK(const Ray& ray, Hit& hit) const {
       __m128 tEntry[kGroups];
       const int mask = slab(nodes[ref], boxRay, bestT, tEntry);
       if (mask != 0) {
-        prefetchChildren(nodes[ref], mask, nodes, triangles);
         ref = orderChildren(nodes[ref], mask, tEntry, stack, sp);
         continue;
       }
@@ -249,7 +227,6 @@ bool Bvh::occludedK(const Ray& ray) const {
         // Any hit ends the query, so the order of the children only matters for how soon one
         // is found: no sort, the first hit lane goes on, the others wait on the stack.
         const BvhNode& node = nodes[ref];
-        prefetchChildren(node, mask, nodes, triangles);
         ref = node.child[__builtin_ctz(unsigned(mask))];
         for (mask &= mask - 1; mask != 0; mask &= mask - 1) stack[sp++] = {node.child[__builtin_ctz(unsigned(mask))], 0.0f};
         continue;
