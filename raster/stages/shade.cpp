@@ -14,6 +14,7 @@
 #include <numbers>
 
 #include "common/scene/material_layers.h"
+#include "common/util/cpu_features.h"
 #include "common/util/error.h"
 #include "common/scene/surface_material.h"
 #include "common/scene/texture.h"
@@ -377,11 +378,6 @@ namespace avx2 {
 #else
 #pragma GCC pop_options
 #endif
-
-bool hasAvx2() {
-  static const bool has = __builtin_cpu_supports("avx2");
-  return has;
-}
 
 }  // namespace
 

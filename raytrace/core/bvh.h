@@ -1,7 +1,7 @@
 // The bounding volume hierarchy every ray tracer queries: built with the binned surface area
 // heuristic over any subset of the scene's triangles (image-space: all of them; object-space
-// and object partitioning: one PE's own triangles only), stored as 4-wide nodes (one SSE slab
-// test checks four boxes) in depth-first order with the leaf triangles copied next to them.
+// and object partitioning: one PE's own triangles only), stored as 8-wide nodes (one AVX2 slab
+// test checks eight boxes) in depth-first order with the leaf triangles copied next to them.
 // Queries: closest hit and any hit (shadow).
 #pragma once
 
@@ -19,22 +19,22 @@
 
 namespace pr::rt {
 
-// Children per node: one SSE group of four lanes. The traversal loops over groups of four,
-// so 8 works too (two SSE tests per node); measured on the 1M-triangle terrain (bench_rays)
-// it was no faster, since the greedy collapse leaves many lanes empty, and it took 90 instead
-// of 73 bytes per triangle.
-inline constexpr int kBvhWidth = 4;
+// Children per node: one AVX2 slab test of eight lanes, or two SSE tests of four where the
+// processor has no AVX2 (bvh_traverse_lanes.inc). Measured on the 1M-triangle terrain
+// (bench_rays, leaves in blocks of four): against 4-wide nodes, 25-45% more rays per second
+// with either test, for 59 instead of 56 bytes per triangle.
+inline constexpr int kBvhWidth = 8;
 
 // Leaf triangles tested at once (triangle4.h): one SSE lane each. The SAH counts a leaf's cost
 // in such blocks, so a leaf of four costs what a leaf of one does.
 inline constexpr int kLeafLanes = 4;
 inline constexpr uint32_t leafBlocks(uint32_t triangles) { return (triangles + kLeafLanes - 1) / kLeafLanes; }
 
-// One node of the 4-wide BVH, 128 bytes (two cache lines): the bounds of its children, one
+// One node of the 8-wide BVH, 256 bytes (four cache lines): the bounds of its children, one
 // SIMD lane each (bounds[0..2] = min x, y, z; bounds[3..5] = max x, y, z), and the children's
 // references (see BvhRef). The binned-SAH build makes a binary tree first and collapses it,
 // pulling up the descendants with the largest surface area (Wald et al. 2008, "Getting rid of
-// packets"); one wide slab test then replaces up to two binary levels, and a ray's chain of
+// packets"); one wide slab test then replaces up to three binary levels, and a ray's chain of
 // dependent node loads gets that much shorter.
 struct alignas(64) BvhNode {
   float bounds[6][kBvhWidth];
@@ -42,6 +42,12 @@ struct alignas(64) BvhNode {
   uint32_t pad[kBvhWidth];
 };
 static_assert(sizeof(BvhNode) == 32 * kBvhWidth, "BvhNode must stay 32 bytes per lane");
+
+// Lanes of the slab test the queries run: 8 (AVX2) where the processor has it, else 4 (SSE2).
+// Both give bit-identical hits; tests and benchmarks set 4 to run the other kernel (setting 8
+// on a processor without AVX2 throws pr::InputError). Process-wide; set it while no query runs.
+int bvhSlabLanes();
+void setBvhSlabLanes(int lanes);
 
 // A reference to a child: an interior node index, a leaf (bit 31; bits 27-30 = count - 1;
 // bits 0-26 = first triangle in Bvh::triangles()), or empty (all bits set, empty bounds).
@@ -118,8 +124,6 @@ class Bvh {
  private:
   void build(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,
              std::span<const uint32_t> subset, const BvhBuildOptions& options);
-  template <int Kz> bool intersectK(const Ray& ray, Hit& hit) const;
-  template <int Kz> bool occludedK(const Ray& ray) const;
 
   uint32_t root_ = BvhRef::kEmpty;
   scene::Bounds bounds_;

@@ -7,6 +7,8 @@
 #include <random>
 #include <vector>
 
+#include "common/util/cpu_features.h"
+#include "common/util/error.h"
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/core/triangle.h"
@@ -179,4 +181,64 @@ TEST_CASE("BvhTraverse: unusable rays (zero or NaN direction, empty interval) hi
   CHECK_FALSE(bvh.intersect(Ray{{0, 0, -5}, 2.0f, {0, 0, 1}, 1.0f}, hit));
   CHECK_FALSE(bvh.occluded(Ray{{0, 0, 0}, 0.0f, {0, 0, 0}, pr::rt::kInfinity}));
   CHECK_FALSE(hit.valid());
+}
+
+namespace {
+// Sets the slab test's lanes for one scope, and puts back what was there.
+struct ScopedSlabLanes {
+  explicit ScopedSlabLanes(int lanes) : saved(pr::rt::bvhSlabLanes()) { pr::rt::setBvhSlabLanes(lanes); }
+  ~ScopedSlabLanes() { pr::rt::setBvhSlabLanes(saved); }
+  int saved;
+};
+}  // namespace
+
+TEST_CASE("BvhTraverse: the 4-lane and 8-lane slab tests give brute force's hits, and each other's, bit for bit") {
+  // A closed box of grid triangles: rays along the axes and in the grid planes make the 0 * inf
+  // slab distances, and the random rays the general case.
+  const auto soup = pr::test::randomSoup(1500, 1.0f, glm::vec3(0.0f), 23);
+  const auto box = pr::test::closedBox(glm::vec3(-1.0f), glm::vec3(1.0f), 6);
+  std::vector<Ray> axisRays;
+  for (int k = -6; k <= 6; ++k)
+    for (int axis = 0; axis < 3; ++axis) {
+      const float c = float(k) / 6.0f;  // on the grid lines and between them
+      Ray r;
+      r.origin = glm::vec3(0.0f);
+      r.origin[(axis + 1) % 3] = c;
+      r.origin[(axis + 2) % 3] = 0.5f * c;
+      r.direction = glm::vec3(0.0f);
+      r.direction[axis] = k % 2 ? 1.0f : -1.0f;
+      axisRays.push_back(r);
+    }
+  std::vector<int> widths = {4};
+  if (pr::hasAvx2()) widths.push_back(8);
+  else MESSAGE("this processor has no AVX2: only the 4-lane slab test runs");
+  for (const pr::scene::Scene* scene : {&soup, &box}) {
+    const Bvh bvh(*scene);
+    std::vector<Ray> rays = randomRays(1500, 1.0f, glm::vec3(0.0f), 29);
+    rays.insert(rays.end(), axisRays.begin(), axisRays.end());
+    std::vector<std::vector<Hit>> hits(widths.size());
+    for (size_t w = 0; w < widths.size(); ++w) {
+      const ScopedSlabLanes lanes(widths[w]);
+      CHECK(pr::rt::bvhSlabLanes() == widths[w]);
+      int found = 0;
+      for (const Ray& ray : rays) {
+        const Hit want = bruteForce(*scene, ray);
+        hits[w].push_back(query(bvh, ray));
+        checkSame(hits[w].back(), want);
+        CHECK(bvh.occluded(ray) == want.valid());
+        found += want.valid();
+      }
+      CHECK(found > 500);
+    }
+    for (size_t i = 0; i < rays.size() && widths.size() == 2; ++i) {
+      CHECK(hits[0][i].triangle == hits[1][i].triangle);
+      CHECK(hits[0][i].t == hits[1][i].t);
+    }
+  }
+}
+
+TEST_CASE("BvhTraverse: a slab test of other than 4 or 8 lanes is an input error") {
+  CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(3), pr::InputError);
+  CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(16), pr::InputError);
+  if (!pr::hasAvx2()) CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(8), pr::InputError);
 }
