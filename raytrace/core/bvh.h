@@ -49,8 +49,8 @@ static_assert(sizeof(BvhNode) == 32 * kBvhWidth, "BvhNode must stay 32 bytes per
 int bvhSlabLanes();
 void setBvhSlabLanes(int lanes);
 
-// A reference to a child: an interior node index, a leaf (bit 31; bits 27-30 = count - 1;
-// bits 0-26 = first triangle in Bvh::triangles()), or empty (all bits set, empty bounds).
+// A reference to a child: an interior node index, a leaf (bit 31; bits 27-30 = triangle count
+// - 1; bits 0-26 = its first block in Bvh::leafBlocks()), or empty (all bits set, empty bounds).
 namespace BvhRef {
 inline constexpr uint32_t kEmpty = 0xffffffffu;
 inline constexpr uint32_t kLeafBit = 0x80000000u;
@@ -69,12 +69,26 @@ inline uint32_t leaf(uint32_t first, uint32_t count) { return kLeafBit | ((count
 // holds a subset of it).
 void checkBvhLimit(std::string_view where, size_t triangles);
 
-// A leaf triangle: its world-space vertices (copied so a leaf is one contiguous read) and its
-// scene triangle index, which hit records report. 40 bytes.
+// A leaf triangle as the build prepares it: its world-space vertices and its scene triangle
+// index, which hit records report.
 struct BvhTriangle {
   glm::vec3 p0, p1, p2;
   uint32_t triangle;
 };
+
+// Four of a leaf's triangles, vertex coordinates by lane (p[vertex][axis][lane]), so the leaf
+// test (triangle4.h) loads each coordinate of four triangles with one aligned read and needs
+// no transposes. A leaf of n triangles is ceil(n / 4) consecutive blocks; lanes past the last
+// triangle repeat it (the test masks them off). 160 bytes, as four BvhTriangles.
+struct alignas(16) BvhLeafBlock {
+  float p[3][3][kLeafLanes];
+  uint32_t triangle[kLeafLanes];
+  glm::vec3 vertex(int k, int lane) const { return {p[k][0][lane], p[k][1][lane], p[k][2][lane]}; }
+};
+static_assert(sizeof(BvhLeafBlock) == 40 * kLeafLanes, "a leaf block must stay as small as its triangles");
+
+// Packs tri[0, count) (1 <= count <= kLeafLanes) into one block.
+BvhLeafBlock packLeafBlock(const BvhTriangle* tri, uint32_t count);
 
 struct BvhBuildOptions {
   int bins = 32;          // SAH bins per axis (Wald 2007, "On fast construction of SAH-based BVHs")
@@ -94,7 +108,7 @@ struct BvhStats {
   size_t triangles = 0;
   size_t degenerateTriangles = 0;  // stored, but made unhittable (see bvh_build.cpp)
   int maxDepth = 0;                // of the binary tree
-  size_t memoryBytes = 0;          // nodes + leaf triangles
+  size_t memoryBytes = 0;          // nodes + leaf blocks
 };
 
 class Bvh {
@@ -117,7 +131,7 @@ class Bvh {
   // The root reference: a node index, or a leaf when everything fits in one.
   uint32_t root() const { return root_; }
   std::span<const BvhNode> nodes() const { return nodes_; }
-  std::span<const BvhTriangle> triangles() const { return triangles_; }
+  std::span<const BvhLeafBlock> leafBlocks() const { return leafBlocks_; }
   const BvhStats& stats() const { return stats_; }
   scene::Bounds bounds() const;
 
@@ -128,7 +142,7 @@ class Bvh {
   uint32_t root_ = BvhRef::kEmpty;
   scene::Bounds bounds_;
   std::vector<BvhNode> nodes_;
-  std::vector<BvhTriangle> triangles_;
+  std::vector<BvhLeafBlock> leafBlocks_;
   BvhStats stats_;
   float magnitude_ = 0.0f;  // largest |coordinate| of any vertex, for the traversal slack
   std::shared_ptr<const AlphaTest> alpha_;

@@ -45,7 +45,7 @@ struct Bin {
   uint32_t count = 0;
 };
 
-// A node of the binary SAH tree, before collapsing to 4 wide. Interior: count == 0, the first
+// A node of the binary SAH tree, before collapsing to kBvhWidth wide. Interior: count == 0, the first
 // child follows it, `second` is the other. Leaf: triangles [first, first + count).
 struct BinaryNode {
   Box box;
@@ -190,12 +190,19 @@ class Builder {
   int bins_;
 };
 
-// Collapses the binary subtree at `index` into wide nodes appended to `wide` and returns its
-// reference. A node takes its two children, then keeps opening the interior child with the
-// largest surface area (the one a ray is likeliest to enter) until it has kBvhWidth.
-uint32_t collapse(const std::vector<BinaryNode>& binary, uint32_t index, std::vector<BvhNode>& wide) {
+// Collapses the binary subtree at `index` into wide nodes appended to `wide`, its leaves'
+// triangles (in leafTris) packed into blocks appended to `blocks`, and returns its reference.
+// A node takes its two children, then keeps opening the interior child with the largest
+// surface area (the one a ray is likeliest to enter) until it has kBvhWidth.
+uint32_t collapse(const std::vector<BinaryNode>& binary, uint32_t index, const std::vector<BvhTriangle>& leafTris,
+                  std::vector<BvhNode>& wide, std::vector<BvhLeafBlock>& blocks) {
   const BinaryNode& node = binary[index];
-  if (node.count > 0) return BvhRef::leaf(node.first, node.count);
+  if (node.count > 0) {
+    const auto first = static_cast<uint32_t>(blocks.size());
+    for (uint32_t i = 0; i < node.count; i += kLeafLanes)
+      blocks.push_back(packLeafBlock(leafTris.data() + node.first + i, std::min<uint32_t>(node.count - i, kLeafLanes)));
+    return BvhRef::leaf(first, node.count);
+  }
   std::array<uint32_t, kBvhWidth> kids{};
   kids[0] = index + 1;
   kids[1] = node.second;
@@ -227,7 +234,7 @@ uint32_t collapse(const std::vector<BinaryNode>& binary, uint32_t index, std::ve
     wide[wideIndex].child[lane] = BvhRef::kEmpty;
   }
   for (int lane = 0; lane < n; ++lane) {
-    const uint32_t ref = collapse(binary, kids[lane], wide);  // may reallocate `wide`
+    const uint32_t ref = collapse(binary, kids[lane], leafTris, wide, blocks);  // may reallocate `wide`
     wide[wideIndex].child[lane] = ref;
   }
   return wideIndex;
@@ -250,6 +257,19 @@ BvhTriangle prepareTriangle(std::span<const glm::vec3> positions, const scene::T
 }
 
 }  // namespace
+
+BvhLeafBlock packLeafBlock(const BvhTriangle* tri, uint32_t count) {
+  PR_CHECK(count >= 1 && count <= uint32_t(kLeafLanes), "packLeafBlock: " + std::to_string(count) + " triangles");
+  BvhLeafBlock block;
+  for (int lane = 0; lane < kLeafLanes; ++lane) {
+    const BvhTriangle& one = tri[std::min<uint32_t>(uint32_t(lane), count - 1)];
+    const glm::vec3* vertices[3] = {&one.p0, &one.p1, &one.p2};
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < 3; ++a) block.p[k][a][lane] = (*vertices[k])[a];
+    block.triangle[lane] = one.triangle;
+  }
+  return block;
+}
 
 Bvh::Bvh(const scene::Scene& scene, const BvhBuildOptions& options) {
   std::vector<uint32_t> all(scene.triangles.size());
@@ -276,7 +296,7 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   stats_ = BvhStats{};
   alpha_ = options.alpha;
   nodes_.clear();
-  triangles_.clear();
+  leafBlocks_.clear();
   root_ = BvhRef::kEmpty;
   bounds_ = scene::Bounds{};
   magnitude_ = 0.0f;
@@ -305,8 +325,9 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
 
   std::vector<BinaryNode> binary;
   binary.reserve(2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
-  triangles_.reserve(subset.size());
-  Builder builder(options, refs, prepared, binary, triangles_, stats_);
+  std::vector<BvhTriangle> leafTris;
+  leafTris.reserve(subset.size());
+  Builder builder(options, refs, prepared, binary, leafTris, stats_);
   builder.build(0, static_cast<uint32_t>(refs.size()), 0);
   // The traversal stack holds at most kBvhWidth - 1 entries per level (bvh_traverse.cpp).
   PR_CHECK(stats_.maxDepth <= 60, "BVH deeper than the traversal stack: " + std::to_string(stats_.maxDepth));
@@ -314,15 +335,17 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   prepared = {};
 
   nodes_.reserve(binary.size() / 2 + 1);
-  root_ = collapse(binary, 0, nodes_);
+  leafBlocks_.reserve(stats_.leaves + leafTris.size() / kLeafLanes);
+  root_ = collapse(binary, 0, leafTris, nodes_, leafBlocks_);
   nodes_.shrink_to_fit();
+  leafBlocks_.shrink_to_fit();
   bounds_.extend(binary[0].box.lo);
   bounds_.extend(binary[0].box.hi);
 
   stats_.binaryNodes = binary.size();
   stats_.nodes = nodes_.size();
-  stats_.triangles = triangles_.size();
-  stats_.memoryBytes = nodes_.size() * sizeof(BvhNode) + triangles_.size() * sizeof(BvhTriangle);
+  stats_.triangles = leafTris.size();
+  stats_.memoryBytes = nodes_.size() * sizeof(BvhNode) + leafBlocks_.size() * sizeof(BvhLeafBlock);
 }
 
 scene::Bounds Bvh::bounds() const { return bounds_; }

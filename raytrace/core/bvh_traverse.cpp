@@ -89,7 +89,7 @@ struct StackEntry {
 // What a query reads of a Bvh.
 struct BvhQuery {
   const BvhNode* nodes;
-  const BvhTriangle* triangles;
+  const BvhLeafBlock* blocks;
   uint32_t root;
   float magnitude;
   const AlphaTest* alpha;
@@ -137,13 +137,13 @@ void setBvhSlabLanes(int lanes) {
 
 bool Bvh::intersect(const Ray& ray, Hit& hit) const {
   if (empty() || !usable(ray)) return false;
-  const BvhQuery q{nodes_.data(), triangles_.data(), root_, magnitude_, alpha_.get()};
+  const BvhQuery q{nodes_.data(), leafBlocks_.data(), root_, magnitude_, alpha_.get()};
   return g_slabLanes == avx2::kLanes ? avx2::intersect(q, ray, hit) : sse::intersect(q, ray, hit);
 }
 
 bool Bvh::occluded(const Ray& ray) const {
   if (empty() || !usable(ray)) return false;
-  const BvhQuery q{nodes_.data(), triangles_.data(), root_, magnitude_, alpha_.get()};
+  const BvhQuery q{nodes_.data(), leafBlocks_.data(), root_, magnitude_, alpha_.get()};
   return g_slabLanes == avx2::kLanes ? avx2::occluded(q, ray) : sse::occluded(q, ray);
 }
 

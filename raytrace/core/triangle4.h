@@ -14,27 +14,17 @@
 
 namespace pr::rt {
 
-// Hits of up to four of a leaf's triangles, tri[0..count) (1 <= count <= 4), for t in [tMin, tMax]: bit i of
-// the result is set when tri[i] is hit, and then t[i], u[i], v[i] hold what intersectTriangle
-// gives for it.
+// Hits of the first `count` triangles of a leaf block (1 <= count <= 4) for t in [tMin, tMax]:
+// bit i of the result is set when triangle i is hit, and then t[i], u[i], v[i] hold what
+// intersectTriangle gives for it.
 template <int Kz>
-inline int intersectLeaf(const RayShear& s, const BvhTriangle* tri, uint32_t count, float tMin, float tMax,
+inline int intersectLeaf(const RayShear& s, const BvhLeafBlock& block, uint32_t count, float tMin, float tMax,
                          float (&t)[kLeafLanes], float (&u)[kLeafLanes], float (&v)[kLeafLanes]) {
   constexpr int Kx = (Kz + 1) % 3, Ky = (Kx + 1) % 3;
-  // Rows x, y, z of p0, p1 and p2 over the lanes. A BvhTriangle is p0 p1 p2 id, 40 bytes, so
-  // 16 bytes from each vertex stay inside it; lanes past count repeat the last triangle.
-  __m128 p[3][4];
-  for (int k = 0; k < 3; ++k) {
-    __m128 r[4];
-    for (int lane = 0; lane < kLeafLanes; ++lane) {
-      const BvhTriangle& one = tri[lane < int(count) ? lane : int(count) - 1];
-      r[lane] = _mm_loadu_ps(&(k == 0 ? one.p0 : k == 1 ? one.p1 : one.p2).x);
-    }
-    _MM_TRANSPOSE4_PS(r[0], r[1], r[2], r[3]);
-    p[k][0] = r[0];
-    p[k][1] = r[1];
-    p[k][2] = r[2];
-  }
+  // Rows x, y, z of p0, p1 and p2 over the lanes.
+  __m128 p[3][3];
+  for (int k = 0; k < 3; ++k)
+    for (int a = 0; a < 3; ++a) p[k][a] = _mm_load_ps(block.p[k][a]);
   const __m128 o[3] = {_mm_set1_ps(s.origin.x), _mm_set1_ps(s.origin.y), _mm_set1_ps(s.origin.z)};
   const __m128 sx = _mm_set1_ps(s.sx), sy = _mm_set1_ps(s.sy);
   // Vertices relative to the origin (a, b, c) and sheared (triangle.h, eq. 1-3).
@@ -83,7 +73,7 @@ inline int intersectLeaf(const RayShear& s, const BvhTriangle* tri, uint32_t cou
   for (int rest = exactZero; rest != 0; rest &= rest - 1) {
     const int lane = __builtin_ctz(unsigned(rest));
     TriangleHit th;
-    if (intersectTriangle<Kz>(s, tri[lane].p0, tri[lane].p1, tri[lane].p2, tMin, tMax, th)) {
+    if (intersectTriangle<Kz>(s, block.vertex(0, lane), block.vertex(1, lane), block.vertex(2, lane), tMin, tMax, th)) {
       mask |= 1 << lane;
       t[lane] = th.t;
       u[lane] = th.u;

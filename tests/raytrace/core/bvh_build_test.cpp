@@ -32,26 +32,35 @@ bool contains(const LaneBox& outer, glm::vec3 p) {
 
 // Walks the wide tree from the root and checks: every node is reached exactly once, each
 // child's boxes lie inside the parent's box for it, leaf triangles lie inside their leaf's
-// box, leaves are within the size limit and together cover Bvh::triangles() exactly once, and
+// box, leaves are within the size limit and together cover Bvh::leafBlocks() exactly once, and
 // empty lanes come last with empty bounds. Returns how often each scene triangle appears.
 std::vector<int> checkStructure(const Bvh& bvh, size_t sceneTriangles, int maxLeafSize) {
   namespace Ref = pr::rt::BvhRef;
   const auto nodes = bvh.nodes();
-  const auto tris = bvh.triangles();
-  std::vector<int> nodeSeen(nodes.size(), 0), slotSeen(tris.size(), 0), triangleSeen(sceneTriangles, 0);
+  const auto blocks = bvh.leafBlocks();
+  std::vector<int> nodeSeen(nodes.size(), 0), slotSeen(blocks.size(), 0), triangleSeen(sceneTriangles, 0);
   const pr::scene::Bounds all = bvh.bounds();
   std::function<void(uint32_t, const LaneBox&)> visit = [&](uint32_t ref, const LaneBox& box) {
     REQUIRE(ref != Ref::kEmpty);
     if (Ref::isLeaf(ref)) {
       CHECK(Ref::leafCount(ref) <= uint32_t(maxLeafSize));
-      REQUIRE(Ref::leafFirst(ref) + Ref::leafCount(ref) <= tris.size());
-      for (uint32_t i = Ref::leafFirst(ref); i < Ref::leafFirst(ref) + Ref::leafCount(ref); ++i) {
-        slotSeen[i]++;
-        REQUIRE(tris[i].triangle < sceneTriangles);
-        triangleSeen[tris[i].triangle]++;
-        CHECK(contains(box, tris[i].p0));
-        CHECK(contains(box, tris[i].p1));
-        CHECK(contains(box, tris[i].p2));
+      const uint32_t count = Ref::leafCount(ref), blockCount = pr::rt::leafBlocks(count);
+      REQUIRE(Ref::leafFirst(ref) + blockCount <= blocks.size());
+      for (uint32_t i = 0; i < count; ++i) {
+        const uint32_t b = Ref::leafFirst(ref) + i / pr::rt::kLeafLanes;
+        const int lane = int(i % pr::rt::kLeafLanes);
+        if (lane == 0) slotSeen[b]++;
+        const pr::rt::BvhLeafBlock& block = blocks[b];
+        REQUIRE(block.triangle[lane] < sceneTriangles);
+        triangleSeen[block.triangle[lane]]++;
+        for (int k = 0; k < 3; ++k) CHECK(contains(box, block.vertex(k, lane)));
+      }
+      // Lanes past the leaf's last triangle repeat it.
+      const int last = int((count - 1) % pr::rt::kLeafLanes);
+      const pr::rt::BvhLeafBlock& tail = blocks[Ref::leafFirst(ref) + blockCount - 1];
+      for (int lane = last + 1; lane < pr::rt::kLeafLanes; ++lane) {
+        CHECK(tail.triangle[lane] == tail.triangle[last]);
+        for (int k = 0; k < 3; ++k) CHECK(tail.vertex(k, lane) == tail.vertex(k, last));
       }
       return;
     }
@@ -91,7 +100,7 @@ TEST_CASE("BvhBuild: every triangle in exactly one leaf and node bounds contain 
     CHECK(bvh.stats().nodes == bvh.nodes().size());
     CHECK(bvh.stats().binaryNodes == 2 * bvh.stats().leaves - 1);  // a full binary tree
     CHECK(bvh.stats().nodes < bvh.stats().binaryNodes / 2);        // collapsing merges levels
-    CHECK(bvh.stats().memoryBytes == bvh.nodes().size() * sizeof(BvhNode) + bvh.triangles().size() * sizeof(pr::rt::BvhTriangle));
+    CHECK(bvh.stats().memoryBytes == bvh.nodes().size() * sizeof(BvhNode) + bvh.leafBlocks().size() * sizeof(pr::rt::BvhLeafBlock));
     const auto seen = checkStructure(bvh, scene.triangles.size(), maxLeaf);
     for (int count : seen) CHECK(count == 1);
     // The root bounds are the scene bounds.

@@ -184,14 +184,15 @@ TEST_CASE("Triangle: the four-lane leaf test gives the scalar test's hit, t, u a
       }
       tris[i] = pr::rt::BvhTriangle{p0, p1, p2, i};
     }
+    const pr::rt::BvhLeafBlock block = pr::rt::packLeafBlock(tris, count);
     const pr::rt::RayShear shear = pr::rt::makeRayShear(ray);
     const float tMax = trial % 3 == 0 ? 2.5f * scale : pr::rt::kInfinity;
     alignas(16) float t[4], u[4], v[4];
     int mask = 0;
     switch (shear.kz) {
-      case 0: mask = pr::rt::intersectLeaf<0>(shear, tris, count, 0.0f, tMax, t, u, v); break;
-      case 1: mask = pr::rt::intersectLeaf<1>(shear, tris, count, 0.0f, tMax, t, u, v); break;
-      default: mask = pr::rt::intersectLeaf<2>(shear, tris, count, 0.0f, tMax, t, u, v); break;
+      case 0: mask = pr::rt::intersectLeaf<0>(shear, block, count, 0.0f, tMax, t, u, v); break;
+      case 1: mask = pr::rt::intersectLeaf<1>(shear, block, count, 0.0f, tMax, t, u, v); break;
+      default: mask = pr::rt::intersectLeaf<2>(shear, block, count, 0.0f, tMax, t, u, v); break;
     }
     CHECK((mask >> count) == 0);
     for (uint32_t i = 0; i < count; ++i) {
