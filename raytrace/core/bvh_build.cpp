@@ -8,6 +8,8 @@
 #include <cmath>
 #include <string>
 
+#include <emmintrin.h>  // SSE2: part of every x86-64 target
+
 #include "common/util/error.h"
 #include "common/util/limits.h"
 #include "raytrace/core/bvh.h"
@@ -20,24 +22,48 @@ namespace {
 constexpr int kSahDepthLimit = 32;
 constexpr int kMaxBins = 32;
 
+// An axis-aligned box as two SSE vectors (x, y, z, unused), so growing one is two instructions.
+// Each lane computes what glm::min(lo, p) and glm::max(hi, p) do, NaN included: the new value
+// goes first, where SSE's min and max return the second operand on NaN.
 struct Box {
-  glm::vec3 lo{kInfinity};
-  glm::vec3 hi{-kInfinity};
-  void extend(const glm::vec3& p) { lo = glm::min(lo, p); hi = glm::max(hi, p); }
-  void extend(const Box& b) { lo = glm::min(lo, b.lo); hi = glm::max(hi, b.hi); }
+  __m128 lo = _mm_set1_ps(kInfinity);
+  __m128 hi = _mm_set1_ps(-kInfinity);
+  void extend(const glm::vec3& p) {
+    const __m128 v = _mm_setr_ps(p.x, p.y, p.z, 0.0f);
+    lo = _mm_min_ps(v, lo);
+    hi = _mm_max_ps(v, hi);
+  }
+  void extend(__m128 p) {
+    lo = _mm_min_ps(p, lo);
+    hi = _mm_max_ps(p, hi);
+  }
+  void extend(const Box& b) {
+    lo = _mm_min_ps(b.lo, lo);
+    hi = _mm_max_ps(b.hi, hi);
+  }
+  glm::vec3 lower() const { return toVec3(lo); }
+  glm::vec3 upper() const { return toVec3(hi); }
   // Half the surface area: the SAH only needs area ratios.
   float halfArea() const {
-    if (lo.x > hi.x) return 0.0f;
-    const glm::vec3 d = hi - lo;
+    const glm::vec3 l = lower(), h = upper();
+    if (l.x > h.x) return 0.0f;
+    const glm::vec3 d = h - l;
     return d.x * d.y + d.y * d.z + d.z * d.x;
+  }
+  static glm::vec3 toVec3(__m128 v) {
+    alignas(16) float f[4];
+    _mm_store_ps(f, v);
+    return {f[0], f[1], f[2]};
   }
 };
 
-// One triangle during the build: its bounds, their centre (binned), its slot in `leafTris`.
+// One triangle during the build: its bounds, their centre (binned; lane 3 unused), its slot in
+// `leafTris`.
 struct PrimRef {
   Box box;
-  glm::vec3 centroid;
+  __m128 centroid;
   uint32_t slot;
+  float centre(int axis) const { return Box::toVec3(centroid)[axis]; }
 };
 
 struct Bin {
@@ -71,34 +97,35 @@ class Builder {
       bounds.extend(refs_[i].box);
       centroids.extend(refs_[i].centroid);
     }
+    const glm::vec3 centreLo = centroids.lower(), centreHi = centroids.upper();
     const uint32_t nodeIndex = static_cast<uint32_t>(nodes_.size());
     nodes_.push_back(BinaryNode{bounds, 0, 0, 0});
     const uint32_t count = end - begin;
     if (count == 1) return makeLeaf(nodeIndex, begin, end);
 
-    Split split = depth < kSahDepthLimit ? findSahSplit(begin, end, bounds, centroids) : Split{};
+    Split split = depth < kSahDepthLimit ? findSahSplit(begin, end, bounds, centreLo, centreHi) : Split{};
     const float leafCost = options_.intersectionCost * float(leafBlocks(count));
     if (count <= uint32_t(options_.maxLeafSize) && !(split.valid && split.cost < leafCost))
       return makeLeaf(nodeIndex, begin, end);
 
     uint32_t mid = begin;
     if (split.valid) {
-      const float lo = centroids.lo[split.axis];
-      const float scale = float(bins_) / (centroids.hi[split.axis] - centroids.lo[split.axis]);
+      const float lo = centreLo[split.axis];
+      const float scale = float(split.bins) / (centreHi[split.axis] - centreLo[split.axis]);
       auto* first = refs_.data() + begin;
       mid = begin + uint32_t(std::partition(first, refs_.data() + end, [&](const PrimRef& r) {
-                               return binIndex(r.centroid[split.axis], lo, scale) < split.bin;
+                               return binIndex(r.centre(split.axis), lo, scale, split.bins) < split.bin;
                              }) - first);
     }
     if (mid == begin || mid == end) {
       // No usable SAH split (all centres equal, or below the depth limit): object median along
       // the widest centroid axis, which always makes progress.
-      const glm::vec3 e = centroids.hi - centroids.lo;
+      const glm::vec3 e = centreHi - centreLo;
       split.axis = e.x >= e.y ? (e.x >= e.z ? 0 : 2) : (e.y >= e.z ? 1 : 2);
       mid = begin + count / 2;
       std::nth_element(refs_.begin() + begin, refs_.begin() + mid, refs_.begin() + end,
                        [&](const PrimRef& a, const PrimRef& b) {
-                         const float ca = a.centroid[split.axis], cb = b.centroid[split.axis];
+                         const float ca = a.centre(split.axis), cb = b.centre(split.axis);
                          return ca < cb || (ca == cb && a.slot < b.slot);
                        });
     }
@@ -113,35 +140,49 @@ class Builder {
     bool valid = false;
     int axis = 0;
     int bin = 0;  // left side: bins [0, bin)
+    int bins = 0;  // of this node's binning
     float cost = kInfinity;
   };
 
   // Clamped before the cast: a NaN or out-of-range float converted to int is undefined.
-  int binIndex(float c, float lo, float scale) const {
+  static int binIndex(float c, float lo, float scale, int bins) {
     const float t = (c - lo) * scale;
-    return t >= 0.0f ? (t < float(bins_ - 1) ? static_cast<int>(t) : bins_ - 1) : 0;
+    return t >= 0.0f ? (t < float(bins - 1) ? static_cast<int>(t) : bins - 1) : 0;
   }
 
   // SAH cost of a split into L and R (Goldsmith & Salmon 1987; MacDonald & Booth 1990):
   //   C = Ct + Ci (A(L) N(L) + A(R) N(R)) / A(node)
-  // evaluated at the bins_-1 planes between bins, on all three axes, in one pass over refs.
-  Split findSahSplit(uint32_t begin, uint32_t end, const Box& bounds, const Box& centroids) const {
+  // evaluated at the planes between bins, on all three axes, in one pass over refs. A node of
+  // n < bins_ triangles gets n bins: the sweep over the bins then costs what binning its
+  // triangles does, where 32 bins for a handful of triangles made the sweeps most of the build.
+  Split findSahSplit(uint32_t begin, uint32_t end, const Box& bounds, const glm::vec3& centreLo,
+                     const glm::vec3& centreHi) const {
     Split best;
     const float nodeArea = bounds.halfArea();
     if (!(nodeArea > 0.0f)) return best;  // flat or point node: the median split handles it
-    std::array<std::array<Bin, kMaxBins>, 3> bins{};
+    const int nodeBins = std::min(bins_, int(end - begin));
+    std::array<std::array<Bin, kMaxBins>, 3> bins;
+    for (auto& axisBins : bins) std::fill_n(axisBins.begin(), nodeBins, Bin{});
     glm::vec3 scale(0.0f);
     for (int a = 0; a < 3; ++a) {
-      const float extent = centroids.hi[a] - centroids.lo[a];
-      scale[a] = extent > 0.0f ? float(bins_) / extent : 0.0f;
+      const float extent = centreHi[a] - centreLo[a];
+      scale[a] = extent > 0.0f ? float(nodeBins) / extent : 0.0f;
       // A denormal extent overflows the scale; (c - lo) * inf would be NaN, and casting NaN
       // to int is undefined. Such an axis cannot be split by binning anyway.
       if (!std::isfinite(scale[a])) scale[a] = 0.0f;
     }
+    // binIndex() on all three axes at once: the same (c - lo) * scale, clamped to
+    // [0, bins - 1] with NaN going to bin 0 (max returns its second operand, 0, on NaN).
+    const __m128 lo4 = _mm_setr_ps(centreLo.x, centreLo.y, centreLo.z, 0.0f);
+    const __m128 scale4 = _mm_setr_ps(scale.x, scale.y, scale.z, 0.0f);
+    const __m128 last = _mm_set1_ps(float(nodeBins - 1));
     for (uint32_t i = begin; i < end; ++i) {
       const PrimRef& r = refs_[i];
+      const __m128 t = _mm_min_ps(_mm_max_ps(_mm_mul_ps(_mm_sub_ps(r.centroid, lo4), scale4), _mm_setzero_ps()), last);
+      alignas(16) int32_t index[4];
+      _mm_store_si128(reinterpret_cast<__m128i*>(index), _mm_cvttps_epi32(t));
       for (int a = 0; a < 3; ++a) {
-        Bin& bin = bins[a][binIndex(r.centroid[a], centroids.lo[a], scale[a])];
+        Bin& bin = bins[a][index[a]];
         bin.count++;
         bin.box.extend(r.box);
       }
@@ -152,7 +193,7 @@ class Builder {
       if (scale[a] == 0.0f) continue;
       Box acc;
       uint32_t n = 0;
-      for (int b = bins_ - 1; b > 0; --b) {
+      for (int b = nodeBins - 1; b > 0; --b) {
         acc.extend(bins[a][b].box);
         n += bins[a][b].count;
         rightArea[b] = acc.halfArea();
@@ -160,13 +201,13 @@ class Builder {
       }
       acc = Box{};
       n = 0;
-      for (int b = 1; b < bins_; ++b) {
+      for (int b = 1; b < nodeBins; ++b) {
         acc.extend(bins[a][b - 1].box);
         n += bins[a][b - 1].count;
         if (n == 0 || rightCount[b] == 0) continue;
         const float cost = options_.traversalCost +
             options_.intersectionCost * (acc.halfArea() * float(leafBlocks(n)) + rightArea[b] * float(leafBlocks(rightCount[b]))) / nodeArea;
-        if (cost < best.cost) best = Split{true, a, b, cost};
+        if (cost < best.cost) best = Split{true, a, b, nodeBins, cost};
       }
     }
     return best;
@@ -228,8 +269,8 @@ uint32_t collapse(const std::vector<BinaryNode>& binary, uint32_t index, const s
     // Empty lanes get inverted bounds: the slab test's entry is +inf there, so they never hit.
     const Box box = lane < n ? binary[kids[lane]].box : Box{};
     for (int a = 0; a < 3; ++a) {
-      wide[wideIndex].bounds[a][lane] = box.lo[a];
-      wide[wideIndex].bounds[3 + a][lane] = box.hi[a];
+      wide[wideIndex].bounds[a][lane] = box.lower()[a];
+      wide[wideIndex].bounds[3 + a][lane] = box.upper()[a];
     }
     wide[wideIndex].child[lane] = BvhRef::kEmpty;
   }
@@ -317,9 +358,10 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
     ref.box.extend(prepared[i].p0);
     ref.box.extend(prepared[i].p1);
     ref.box.extend(prepared[i].p2);
-    ref.centroid = 0.5f * ref.box.lo + 0.5f * ref.box.hi;  // halved first: no overflow near FLT_MAX
+    const __m128 half = _mm_set1_ps(0.5f);  // halved first: no overflow near FLT_MAX
+    ref.centroid = _mm_add_ps(_mm_mul_ps(half, ref.box.lo), _mm_mul_ps(half, ref.box.hi));
     ref.slot = static_cast<uint32_t>(i);
-    const glm::vec3 m = glm::max(glm::abs(ref.box.lo), glm::abs(ref.box.hi));
+    const glm::vec3 m = glm::max(glm::abs(ref.box.lower()), glm::abs(ref.box.upper()));
     magnitude_ = std::max({magnitude_, m.x, m.y, m.z});
   }
 
@@ -339,8 +381,8 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   root_ = collapse(binary, 0, leafTris, nodes_, leafBlocks_);
   nodes_.shrink_to_fit();
   leafBlocks_.shrink_to_fit();
-  bounds_.extend(binary[0].box.lo);
-  bounds_.extend(binary[0].box.hi);
+  bounds_.extend(binary[0].box.lower());
+  bounds_.extend(binary[0].box.upper());
 
   stats_.binaryNodes = binary.size();
   stats_.nodes = nodes_.size();
