@@ -40,4 +40,24 @@ std::vector<Rect> stripRegions(int width, int height, int count) {
   return strips;
 }
 
+std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost) {
+  double total = 0.0;
+  for (double c : rowCost) total += c;
+  if (rowCost.size() != size_t(height) || !(total > 0.0)) return stripRegions(width, height, count);
+  count = std::max(1, std::min(count, height));
+  std::vector<Rect> strips;
+  double sum = 0.0;
+  int y = 0;
+  for (int i = 0; i < count; ++i) {
+    const int y0 = y;
+    // Leave at least one row for each strip still to come.
+    const int last = height - (count - 1 - i);
+    const double share = total * double(i + 1) / double(count);
+    do sum += rowCost[size_t(y++)];
+    while (y < last && (sum < share || i == count - 1));
+    strips.push_back(Rect{0, y0, width, y});
+  }
+  return strips;
+}
+
 }  // namespace pr::raster

@@ -3,6 +3,7 @@
 // to the owners of the regions they overlap, sort-last composites by region.
 #pragma once
 
+#include <span>
 #include <vector>
 
 namespace pr::raster {
@@ -34,5 +35,11 @@ std::vector<Rect> tileRegions(int width, int height, int tileSizePx);
 
 // count horizontal strips of (nearly) equal height, top to bottom; count is clamped to height.
 std::vector<Rect> stripRegions(int width, int height, int count);
+
+// count horizontal strips, top to bottom, of (nearly) equal total rowCost (one entry per row,
+// >= 0): each strip ends at the first row where the running sum reaches its share, and has at
+// least one row. Equal heights (stripRegions) when rowCost does not have `height` entries or
+// sums to 0.
+std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost);
 
 }  // namespace pr::raster

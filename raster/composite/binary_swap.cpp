@@ -30,7 +30,7 @@ class BinarySwap : public Compositor {
   std::string_view name() const override { return "binary-swap"; }
 
   std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,
-                              bool sparse) override {
+                              bool sparse, std::span<const double> /*rowCost*/) override {
     const int pes = rt.pes();
     if (!std::has_single_bit(static_cast<unsigned>(pes)))
       throw InputError("binary-swap compositing needs a power-of-two PE count, got " + std::to_string(pes) +

@@ -8,6 +8,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -65,10 +66,12 @@ class Compositor {
   // (full screen each; every pixel outside drawn[pe] is clear); runs its own stages, merging
   // received pixels into the receiver's own buffer and widening its drawn[pe] by them. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
   // (disjoint rectangles that cover the screen; empty for a PE left without one).
-  // Each PE's traffic goes to the run record (recordCompositeTallies). Throws pr::InputError
-  // when the method cannot run with this PE count.
+  // Each PE's traffic goes to the run record (recordCompositeTallies). rowCost: the expected
+  // cost of shading each screen row (the last frame's), or empty when unknown; direct-send cuts
+  // its strips at equal cost, binary-swap's halves are fixed by its exchange pattern. Throws
+  // pr::InputError when the method cannot run with this PE count.
   virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers,
-                                      std::vector<Rect>& drawn, bool sparse) = 0;
+                                      std::vector<Rect>& drawn, bool sparse, std::span<const double> rowCost) = 0;
 };
 
 // Factories, one per compositor file.

@@ -1,6 +1,7 @@
-// Direct-send compositing (sort-last): the screen is cut into P strips, PE i owns strip i; each
+// Direct-send compositing (sort-last): the screen is cut into P strips of equal expected
+// shading cost (the last frame's covered pixels per row), PE i owns strip i; each
 // PE sends every other owner the part of its framebuffer inside that owner's strip (P - 1
-// messages of A / P pixels in the full-frame variant: b * A * (1 - 1/P) bytes per PE), then
+// messages in the full-frame variant, b * A * (1 - 1/P) bytes per PE on average), then
 // each owner depth-composites what it received into its own strip. Also the pixel packing
 // shared with binary swap.
 #include <algorithm>
@@ -60,11 +61,12 @@ class DirectSend : public Compositor {
   std::string_view name() const override { return "direct-send"; }
 
   std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,
-                              bool sparse) override {
+                              bool sparse, std::span<const double> rowCost) override {
     const int pes = rt.pes();
     const Rect screen = buffers[0].rect();
-    // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows).
-    std::vector<Rect> strips = stripRegions(screen.width(), screen.height(), pes);
+    // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows),
+    // cut so that each owner expects the same shading work.
+    std::vector<Rect> strips = weightedStripRegions(screen.width(), screen.height(), pes, rowCost);
     const int owners = static_cast<int>(strips.size());
 
     std::vector<CompositeTally> counters(pes);

@@ -11,7 +11,10 @@
 // geometry batch).
 // Each PE keeps the bounding rectangle of the pixels its buffer holds (drawn or merged): only
 // that is cleared next frame, and sparse compositing sends only its part of each region, so a
-// PE whose primitives cover a corner of the screen pays for the corner.
+// PE whose primitives cover a corner of the screen pays for the corner. The shading stage
+// counts the covered pixels of each row, and the next frame's direct-send strips are cut at
+// equal counts, so the owners' shading work stays even when the picture is not (sky above,
+// terrain below).
 #include <algorithm>
 
 #include "common/util/error.h"
@@ -81,17 +84,26 @@ class SortLast : public SortPoint {
       drawn_[pe.id()] = enclose(drawn_[pe.id()], intersect(pixelBounds(batchTriangles), screen));
     });
 
-    // Stage 2, the sort: depth compositing by screen region (its counters go to the record).
-    const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse);
+    // Stage 2, the sort: depth compositing by screen region (its counters go to the record),
+    // the regions cut by the last frame's shading work per row.
+    if (rowCost_.size() != size_t(f.view.height)) rowCost_.assign(size_t(f.view.height), 0.0);
+    else std::fill(rowCost_.begin(), rowCost_.end(), 0.0);
+    for (size_t p = 0; p < rowCostByPe_.size(); ++p)
+      if (rowCostByPe_[p].size() == rowCost_.size())
+        for (size_t y = 0; y < rowCost_.size(); ++y) rowCost_[y] += rowCostByPe_[p][y];
+    const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse, rowCost_);
 
     // Stage 3, shading of the visible fragments of each PE's region, in its own buffer.
     shade_.assign(size_t(pes), ShadeCounters{});
+    rowCostByPe_.resize(size_t(pes));
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
+      std::vector<double>& cost = rowCostByPe_[size_t(pe.id())];
+      cost.assign(size_t(f.view.height), 0.0);
       const Rect visible = intersect(regions[pe.id()], drawn_[pe.id()]);
       if (visible.empty()) return;
       shaded_[pe.id()] = visible;
       PixelWindow pixels = buffers[pe.id()].window(visible);
-      adoptForeignFragments(f, pixels, tris[pe.id()], adopted_[pe.id()]);
+      adoptForeignFragments(f, pixels, tris[pe.id()], adopted_[pe.id()], cost);
       shadeRegion(ctx, tris[pe.id()], pixels, &shade_[size_t(pe.id())]);
     });
 
@@ -120,16 +132,20 @@ class SortLast : public SortPoint {
 
   // Gives every visible fragment that came from another PE (triangle index kNoTriangle) an
   // index into `tris`, appending the screen triangles of its primitive, recomputed by the
-  // geometry stage, once per primitive.
+  // geometry stage, once per primitive. Counts the covered pixels of each row in rowCost
+  // (indexed by screen row): the shading work the next frame's regions are cut by.
   static void adoptForeignFragments(const FrameInputs& f, const PixelWindow& pixels, std::vector<ScreenTriangle>& tris,
-                                    AdoptedTriangles& adopted) {
+                                    AdoptedTriangles& adopted, std::vector<double>& rowCost) {
     adopted.nextFrame(f.scene.triangles.size());
     ScreenTriangle pieces[kMaxSubTriangles];
-    for (int y = pixels.rect.y0; y < pixels.rect.y1; ++y)
+    for (int y = pixels.rect.y0; y < pixels.rect.y1; ++y) {
+      uint32_t covered = 0;
       for (int x = pixels.rect.x0; x < pixels.rect.x1; ++x) {
         const size_t i = pixels.index(x, y);
         const uint64_t key = pixels.keys[i];
-        if (!keyCovered(key) || pixels.triangles[i] != kNoTriangle) continue;
+        if (!keyCovered(key)) continue;
+        ++covered;
+        if (pixels.triangles[i] != kNoTriangle) continue;
         const uint32_t primitive = keyPrimitive(key);
         if (adopted.stamp[primitive] != adopted.frame) {
           const int n = processTriangle(f.scene, f.view, primitive, pieces);
@@ -146,6 +162,8 @@ class SortLast : public SortPoint {
         }
         pixels.triangles[i] = at;
       }
+      rowCost[size_t(y)] = double(covered);
+    }
   }
 
   std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
@@ -154,6 +172,8 @@ class SortLast : public SortPoint {
   std::vector<AdoptedTriangles> adopted_;   // per PE
   std::vector<std::vector<ScreenTriangle>> tris_;  // per PE: this frame's screen triangles
   std::vector<ShadeCounters> shade_;        // per PE, the last frame's
+  std::vector<std::vector<double>> rowCostByPe_;  // per PE, the last frame: covered pixels per row it shaded
+  std::vector<double> rowCost_;                   // their sum, per screen row
   RegionBufferPool pool_;                   // region message storage, kept between frames
   SceneDistribution distribution_;
 };

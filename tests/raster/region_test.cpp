@@ -48,6 +48,36 @@ TEST_CASE("Region: tiles and strips partition the screen") {
   }
 }
 
+TEST_CASE("Region: weighted strips hold equal shares of the row cost, each at least one row") {
+  // All the cost in rows 10..19 of 100: two strips split it at row 15, four at 12, 15 and 17
+  // (the first row where the running sum reaches each share).
+  std::vector<double> cost(100, 0.0);
+  for (int y = 10; y < 20; ++y) cost[size_t(y)] = 1.0;
+  const auto two = weightedStripRegions(64, 100, 2, cost);
+  CHECK(partitions(two, 64, 100));
+  REQUIRE(two.size() == 2);
+  CHECK(two[0] == Rect{0, 0, 64, 15});
+  const auto four = weightedStripRegions(64, 100, 4, cost);
+  CHECK(partitions(four, 64, 100));
+  REQUIRE(four.size() == 4);
+  CHECK(four[0].y1 == 13);  // rows 10, 11, 12: 3 >= 2.5
+  CHECK(four[1].y1 == 15);
+  CHECK(four[2].y1 == 18);  // 8 >= 7.5
+  // One costly row and more strips than rows with cost: every strip still gets a row.
+  std::vector<double> spike(37, 0.0);
+  spike[36] = 5.0;
+  for (int strips : {2, 7, 37, 50}) {
+    CAPTURE(strips);
+    const auto s = weightedStripRegions(100, 37, strips, spike);
+    CHECK(partitions(s, 100, 37));
+    CHECK(s.size() == static_cast<size_t>(strips < 37 ? strips : 37));
+  }
+  // Unknown cost (no entries, wrong count, all zero): the equal strips.
+  CHECK(weightedStripRegions(64, 100, 3, {}) == stripRegions(64, 100, 3));
+  CHECK(weightedStripRegions(64, 100, 3, std::vector<double>(99, 1.0)) == stripRegions(64, 100, 3));
+  CHECK(weightedStripRegions(64, 100, 3, std::vector<double>(100, 0.0)) == stripRegions(64, 100, 3));
+}
+
 TEST_CASE("Region: intersection and overlap") {
   Rect a{0, 0, 10, 10}, b{5, 8, 20, 30}, c{10, 0, 20, 10};
   CHECK(intersect(a, b) == Rect{5, 8, 10, 10});
