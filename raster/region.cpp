@@ -41,6 +41,7 @@ std::vector<Rect> stripRegions(int width, int height, int count) {
 }
 
 std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost) {
+  PR_CHECK(width >= 0 && height >= 0 && count > 0, "weightedStripRegions: bad size");
   double total = 0.0;
   for (double c : rowCost) total += c;
   if (rowCost.size() != size_t(height) || !(total > 0.0)) return stripRegions(width, height, count);

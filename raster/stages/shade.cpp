@@ -362,22 +362,13 @@ namespace sse {
 
 // The same kernel eight lanes wide, compiled for AVX2 (and only run where the processor has
 // it). Everything it defines has internal linkage, so no AVX code reaches other callers.
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+PR_BEGIN_AVX2
 namespace avx2 {
 #define PR_SHADE_LANES 8
 #include "raster/stages/shade_lanes.inc"
 #undef PR_SHADE_LANES
 }  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+PR_END_AVX2
 
 }  // namespace
 

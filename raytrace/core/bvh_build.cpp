@@ -161,8 +161,7 @@ class Builder {
     const float nodeArea = bounds.halfArea();
     if (!(nodeArea > 0.0f)) return best;  // flat or point node: the median split handles it
     const int nodeBins = std::min(bins_, int(end - begin));
-    std::array<std::array<Bin, kMaxBins>, 3> bins;
-    for (auto& axisBins : bins) std::fill_n(axisBins.begin(), nodeBins, Bin{});
+    std::array<std::array<Bin, kMaxBins>, 3> bins{};  // only [0, nodeBins) of each axis is used
     glm::vec3 scale(0.0f);
     for (int a = 0; a < 3; ++a) {
       const float extent = centreHi[a] - centreLo[a];

@@ -103,22 +103,13 @@ namespace sse {
 
 // The same queries with one AVX2 slab test per node (run only where the processor has it).
 // Everything defined here has internal linkage, so no AVX code reaches other callers.
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2")
-#endif
+PR_BEGIN_AVX2
 namespace avx2 {
 #define PR_BVH_LANES 8
 #include "raytrace/core/bvh_traverse_lanes.inc"
 #undef PR_BVH_LANES
 }  // namespace avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+PR_END_AVX2
 
 }  // namespace
 
