@@ -55,7 +55,13 @@ void RegionDrawer::drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<con
                            const Rect& rect, FrameAssembly& frame) {
   if (!frame.assembles(pe)) {
     RegionFramebuffer region = frame.buffer(rect);
-    drawRegion(ctx, tris, region.window(), nullptr, &shade_);
+    if (rect.area() > kScratchTilePixels) {
+      drawRegion(ctx, tris, region.window(), nullptr, &shade_);
+    } else {
+      scratch_.reshape(rect);
+      drawRegion(ctx, tris, scratch_.window(), nullptr, &shade_);
+      copyInto(scratch_, region);
+    }
     frame.deliver(pe, std::move(region));
     return;
   }

@@ -21,6 +21,7 @@
 #include <span>
 
 #include "common/parallel/channel.h"
+#include "common/parallel/per_pe.h"
 #include "common/scene/poisoned_view.h"
 #include "common/util/error.h"
 #include "raster/frame_assembly.h"
@@ -78,7 +79,7 @@ struct Tally {
   uint64_t routed = 0, sent = 0, duplicated = 0, migrated = 0, preTransforms = 0, geometryRepeated = 0;
 };
 
-void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
+void recordTallies(par::Runtime& rt, const par::PerPe<Tally>& tallies) {
   for (int p = 0; p < rt.pes(); ++p) {
     const Tally& t = tallies[p];
     rt.addCounter("Sort/primitives_routed", p, double(t.routed));
@@ -113,7 +114,7 @@ class SortFirst : public SortPoint {
   std::string_view name() const override { return "sort-first"; }
   std::vector<ShadeCounters> takeShadeCounters() override {
     std::vector<ShadeCounters> out;
-    for (RegionDrawer& d : drawers_) out.push_back(d.takeShadeCounters());
+    for (int p = 0; p < drawers_.size(); ++p) out.push_back(drawers_[p].takeShadeCounters());
     return out;
   }
 
@@ -147,7 +148,7 @@ class SortFirst : public SortPoint {
       previous_.reset();
     }
 
-    std::vector<Tally> counters(pes);
+    par::PerPe<Tally> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
     par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
@@ -230,7 +231,7 @@ class SortFirst : public SortPoint {
     const int pes = rt.pes();
     const int tiles = grid.regionCount();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
-    std::vector<Tally> counters(pes);
+    par::PerPe<Tally> counters(pes);
     std::vector<std::vector<std::vector<uint32_t>>> bins(pes, std::vector<std::vector<uint32_t>>(tiles));
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
@@ -274,7 +275,7 @@ class SortFirst : public SortPoint {
     FrameView view;
     RegionGrid grid;
   };
-  std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
+  par::PerPe<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
   RegionBufferPool pool_;              // region message storage, kept between frames
   SceneDistribution distribution_;
   // Between frames: the primitives each PE holds, and the view and regions they were sorted by.

@@ -17,6 +17,7 @@
 // terrain below).
 #include <algorithm>
 
+#include "common/parallel/per_pe.h"
 #include "common/util/error.h"
 
 #include "raster/composite/compositor.h"
@@ -34,7 +35,11 @@ namespace {
 class SortLast : public SortPoint {
  public:
   std::string_view name() const override { return "sort-last"; }
-  std::vector<ShadeCounters> takeShadeCounters() override { return std::exchange(shade_, {}); }
+  std::vector<ShadeCounters> takeShadeCounters() override {
+    std::vector<ShadeCounters> out;
+    for (int p = 0; p < pe_.size(); ++p) out.push_back(std::exchange(pe_[p].shade, {}));
+    return out;
+  }
 
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
@@ -50,30 +55,28 @@ class SortLast : public SortPoint {
     // one is read only where this frame wrote a key, and whatever wrote it set the index.
     buffers_.resize(pes);
     drawn_.resize(pes);
-    shaded_.resize(pes);
-    adopted_.resize(pes);
+    pe_.resize(pes);
     rt.runOnEachPe("sort-last clear", [&](par::Pe& pe) {
       RegionFramebuffer& mine = buffers_[pe.id()];
+      PeFrame& state = pe_[pe.id()];
       if (mine.rect() == screen) {
         mine.window(intersect(drawn_[pe.id()], screen)).clearKeys();
-        mine.window(intersect(shaded_[pe.id()], screen)).clearColours();
+        mine.window(intersect(state.shaded, screen)).clearColours();
       } else {
         mine = RegionFramebuffer(screen);
       }
-      drawn_[pe.id()] = shaded_[pe.id()] = Rect{};
+      drawn_[pe.id()] = state.shaded = Rect{};
     });
     std::vector<RegionFramebuffer>& buffers = buffers_;
 
     // Stage 1, geometry and rasterization of a PE's batches into its own full-screen buffer;
     // the triangle list stays with the PE for deferred shading (triangle index = list position).
-    tris_.resize(pes);
-    for (std::vector<ScreenTriangle>& list : tris_) list.clear();  // storage kept: no page faults per frame
-    std::vector<std::vector<ScreenTriangle>>& tris = tris_;
+    for (int p = 0; p < pes; ++p) pe_[p].tris.clear();  // storage kept: no page faults per frame
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     const uint32_t batch = f.options.batchSize;
     const size_t batches = (total + batch - 1) / batch;
     rt.runStage("sort-last render", par::TaskSet::uniform(batches), [&](par::Pe& pe, par::TaskId t) {
-      std::vector<ScreenTriangle>& mine = tris[pe.id()];
+      std::vector<ScreenTriangle>& mine = pe_[pe.id()].tris;
       const size_t before = mine.size();
       const uint32_t first = static_cast<uint32_t>(t) * batch;
       processTriangles(f.scene, f.view, first, std::min(batch, total - first), mine);
@@ -88,23 +91,22 @@ class SortLast : public SortPoint {
     // the regions cut by the last frame's shading work per row.
     if (rowCost_.size() != size_t(f.view.height)) rowCost_.assign(size_t(f.view.height), 0.0);
     else std::fill(rowCost_.begin(), rowCost_.end(), 0.0);
-    for (size_t p = 0; p < rowCostByPe_.size(); ++p)
-      if (rowCostByPe_[p].size() == rowCost_.size())
-        for (size_t y = 0; y < rowCost_.size(); ++y) rowCost_[y] += rowCostByPe_[p][y];
+    for (int p = 0; p < pes; ++p)
+      if (pe_[p].rowCost.size() == rowCost_.size())
+        for (size_t y = 0; y < rowCost_.size(); ++y) rowCost_[y] += pe_[p].rowCost[y];
     const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse, rowCost_);
 
     // Stage 3, shading of the visible fragments of each PE's region, in its own buffer.
-    shade_.assign(size_t(pes), ShadeCounters{});
-    rowCostByPe_.resize(size_t(pes));
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
-      std::vector<double>& cost = rowCostByPe_[size_t(pe.id())];
-      cost.assign(size_t(f.view.height), 0.0);
+      PeFrame& state = pe_[pe.id()];
+      state.shade = ShadeCounters{};
+      state.rowCost.assign(size_t(f.view.height), 0.0);
       const Rect visible = intersect(regions[pe.id()], drawn_[pe.id()]);
       if (visible.empty()) return;
-      shaded_[pe.id()] = visible;
+      state.shaded = visible;
       PixelWindow pixels = buffers[pe.id()].window(visible);
-      adoptForeignFragments(f, pixels, tris[pe.id()], adopted_[pe.id()], cost);
-      shadeRegion(ctx, tris[pe.id()], pixels, &shade_[size_t(pe.id())]);
+      adoptForeignFragments(f, pixels, state.tris, state.adopted, state.rowCost);
+      shadeRegion(ctx, state.tris, pixels, &state.shade);
     });
 
     // Each PE delivers the rectangle it composited to the assembler (in place on PE 0).
@@ -166,14 +168,18 @@ class SortLast : public SortPoint {
     }
   }
 
+  // What a PE writes while it renders and shades, kept between frames.
+  struct PeFrame {
+    Rect shaded;                     // its colours are 0 outside this rectangle
+    AdoptedTriangles adopted;
+    std::vector<ScreenTriangle> tris;  // this frame's screen triangles
+    ShadeCounters shade;               // the last frame's
+    std::vector<double> rowCost;       // the last frame: covered pixels per row it shaded
+  };
   std::vector<RegionFramebuffer> buffers_;  // per PE, full screen, kept between frames
   std::vector<Rect> drawn_;                 // per PE: its keys are clear outside this rectangle
-  std::vector<Rect> shaded_;                // per PE: its colours are 0 outside this rectangle
-  std::vector<AdoptedTriangles> adopted_;   // per PE
-  std::vector<std::vector<ScreenTriangle>> tris_;  // per PE: this frame's screen triangles
-  std::vector<ShadeCounters> shade_;        // per PE, the last frame's
-  std::vector<std::vector<double>> rowCostByPe_;  // per PE, the last frame: covered pixels per row it shaded
-  std::vector<double> rowCost_;                   // their sum, per screen row
+  par::PerPe<PeFrame> pe_;
+  std::vector<double> rowCost_;             // the PEs' row costs summed, per screen row
   RegionBufferPool pool_;                   // region message storage, kept between frames
   SceneDistribution distribution_;
 };

@@ -6,6 +6,7 @@
 #include <algorithm>
 
 #include "common/parallel/channel.h"
+#include "common/parallel/per_pe.h"
 #include "raster/frame_assembly.h"
 #include "raster/scene_distribution.h"
 #include "raster/sort/bins.h"
@@ -24,7 +25,7 @@ struct Tally {
   uint64_t routed = 0, sent = 0, duplicated = 0;
 };
 
-void recordTallies(par::Runtime& rt, const std::vector<Tally>& tallies) {
+void recordTallies(par::Runtime& rt, const par::PerPe<Tally>& tallies) {
   for (int p = 0; p < rt.pes(); ++p) {
     rt.addCounter("Sort/triangles_routed", p, double(tallies[p].routed));
     rt.addCounter("Sort/triangles_sent", p, double(tallies[p].sent));
@@ -37,7 +38,7 @@ class SortMiddle : public SortPoint {
   std::string_view name() const override { return "sort-middle"; }
   std::vector<ShadeCounters> takeShadeCounters() override {
     std::vector<ShadeCounters> out;
-    for (RegionDrawer& d : drawers_) out.push_back(d.takeShadeCounters());
+    for (int p = 0; p < drawers_.size(); ++p) out.push_back(drawers_[p].takeShadeCounters());
     return out;
   }
 
@@ -49,7 +50,7 @@ class SortMiddle : public SortPoint {
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
     FrameAssembly frame(rt, image, pool_);
     if (grid.dynamic()) return renderDynamic(f, rt, grid, ctx, frame);
-    std::vector<Tally> counters(pes);
+    par::PerPe<Tally> counters(pes);
     par::Channel<std::vector<ScreenTriangle>> triangles(rt, "screen triangles", par::MessageKind::Primitives);
 
     // Stage 1, geometry and the sort: one task per batch of scene triangles, on any PE.
@@ -124,7 +125,7 @@ class SortMiddle : public SortPoint {
                      FrameAssembly& frame) {
     const int pes = rt.pes();
     const int tiles = grid.regionCount();
-    std::vector<Tally> counters(pes);
+    par::PerPe<Tally> counters(pes);
     std::vector<std::vector<std::vector<ScreenTriangle>>> bins(pes, std::vector<std::vector<ScreenTriangle>>(tiles));
 
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
@@ -159,7 +160,7 @@ class SortMiddle : public SortPoint {
     recordTallies(rt, counters);
   }
 
-  std::vector<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
+  par::PerPe<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
   RegionBufferPool pool_;              // region message storage, kept between frames
   SceneDistribution distribution_;
 };

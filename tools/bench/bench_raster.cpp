@@ -157,21 +157,35 @@ struct SortRow {
   std::string stages;  // wall ms per frame of each stage, from the run record
 };
 
-// "name ms, name ms, ..." per frame, each stage's wall time summed over the timed frames (the
-// record's stages from index `first` on).
+// "name ms [busy ms of PE 0 / PE 1 ...], ..." per frame: each stage's wall time and each PE's
+// busy time, summed over the timed frames (the record's stages from index `first` on).
 std::string stageSummary(const pr::par::RunRecord& record, size_t first, int frames) {
-  std::vector<std::pair<std::string, double>> sums;
+  struct Sum {
+    std::string name;
+    double seconds = 0.0;
+    std::vector<double> busy;
+  };
+  std::vector<Sum> sums;
   for (size_t i = first; i < record.stages.size(); ++i) {
     const pr::par::StageRecord& st = record.stages[i];
-    auto at = std::find_if(sums.begin(), sums.end(), [&](const auto& e) { return e.first == st.name; });
-    if (at == sums.end()) sums.emplace_back(st.name, st.wallSeconds);
-    else at->second += st.wallSeconds;
+    auto at = std::find_if(sums.begin(), sums.end(), [&](const Sum& e) { return e.name == st.name; });
+    if (at == sums.end()) at = sums.insert(sums.end(), Sum{st.name, 0.0, std::vector<double>(st.pes.size(), 0.0)});
+    at->seconds += st.wallSeconds;
+    for (size_t p = 0; p < st.pes.size() && p < at->busy.size(); ++p) at->busy[p] += st.pes[p].busySeconds;
   }
   std::string out;
   char buf[128];
-  for (const auto& [name, seconds] : sums) {
-    std::snprintf(buf, sizeof buf, "%s%s %.1f", out.empty() ? "" : ", ", name.c_str(), 1e3 * seconds / frames);
+  for (const Sum& sum : sums) {
+    std::snprintf(buf, sizeof buf, "%s%s %.1f", out.empty() ? "" : ", ", sum.name.c_str(), 1e3 * sum.seconds / frames);
     out += buf;
+    if (sum.busy.size() > 1) {
+      out += " [";
+      for (size_t p = 0; p < sum.busy.size(); ++p) {
+        std::snprintf(buf, sizeof buf, "%s%.1f", p ? "/" : "", 1e3 * sum.busy[p] / frames);
+        out += buf;
+      }
+      out += "]";
+    }
   }
   return out;
 }
@@ -294,10 +308,8 @@ void benchScene(const std::string& label, const std::string& path, const Options
                 "%.2f%s\n",
                 v.label.c_str(), p2.ms, p2.cpuMs, triangles / p2.ms / 1e3, pixels / p2.ms / 1e3,
                 p1.ms / p2.ms, p1.ms / (2.0 * p2.ms), p2Ratios.c_str());
-    if (info.name == "sort-last") {
-      std::printf("  %s stages, ms per frame, P=1: %s\n", v.label.c_str(), p1.stages.c_str());
-      std::printf("  %s stages, ms per frame, P=2: %s\n", v.label.c_str(), p2.stages.c_str());
-    }
+    std::printf("  %s stages, ms per frame, P=1: %s\n", v.label.c_str(), p1.stages.c_str());
+    std::printf("  %s stages, ms per frame, P=2: %s\n", v.label.c_str(), p2.stages.c_str());
     if (info.name == "sort-last" && v.options.sparse)
       std::printf("%s P=2 efficiency %.2f (target >= 0.8 on the landscape)\n", v.label.c_str(), p1.ms / (2.0 * p2.ms));
     if (info.name == "sort-middle" && (anchors[1].ok || anchors[2].ok)) {
