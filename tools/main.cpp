@@ -5,12 +5,14 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/util/allocator.h"
 #include "common/util/error.h"
 #include "common/util/interrupt.h"
 #include "common/util/memory_limit.h"
 #include "tools/commands.h"
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   pr::installInterruptHandler();
   CLI::App app{"parrender: a parallel software renderer (sort-first/middle/last rasterizers, "
                "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};

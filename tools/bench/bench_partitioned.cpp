@@ -20,6 +20,7 @@
 
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
+#include "common/util/allocator.h"
 #include "raytrace/partition/partition.h"
 
 namespace {
@@ -205,6 +206,7 @@ int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int
 }  // namespace
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   CLI::App app{"bench_partitioned: object-space and object partitioning at P = 1 and 2, ray batches and messages per ray"};
   std::vector<std::string> scenes = {std::string(PARRENDER_SOURCE_DIR) + "/scenes/hotspot.gltf"};
   int width = 384, height = 384, spp = 2, repeats = 3;

@@ -23,11 +23,12 @@
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
+#include "common/scene/gltf_loader.h"
+#include "common/util/allocator.h"
 #include "photonmap/density_estimate.h"
 #include "photonmap/kd_tree.h"
 #include "photonmap/photon.h"
 #include "photonmap/photon_tracer.h"
-#include "common/scene/gltf_loader.h"
 #include "raytrace/core/bvh.h"
 
 #ifdef PARRENDER_HAVE_NANOFLANN
@@ -153,6 +154,7 @@ void tracingSection(int repeat) {
 }
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   std::size_t photonCount = 1000000, queryCount = 200000;
   int k = 50, repeat = 3;
   float radius = 0.05f;

@@ -22,14 +22,15 @@
 #include "common/parallel/runtime.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
+#include "common/util/allocator.h"
 #include "common/util/error.h"
 #include "raster/framebuffer.h"
 #include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
+#include "raster/sort/sort_point.h"
 #include "raster/stages/geometry.h"
 #include "raster/stages/rasterize.h"
 #include "raster/stages/shade.h"
-#include "raster/sort/sort_point.h"
 
 namespace {
 
@@ -322,6 +323,7 @@ void benchScene(const std::string& label, const std::string& path, const Options
 }  // namespace
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   CLI::App app{"bench_raster: raster pipeline frame times against Mesa llvmpipe in the same run"};
   Options o;
   std::string landscape = PARRENDER_BINARY_DIR "/scenes/landscape.glb";

@@ -16,6 +16,7 @@
 #include <glm/glm.hpp>
 
 #include "common/scene/scene.h"
+#include "common/util/allocator.h"
 #include "raytrace/core/bvh.h"
 #include "raytrace/core/interaction.h"
 
@@ -255,6 +256,7 @@ int intArg(int argc, char** argv, const char* name, int fallback, int lo, int hi
 }  // namespace
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   const int res = intArg(argc, argv, "--res", 1024, 16, 8192);
   const int grid = intArg(argc, argv, "--grid", 708, 2, 4096);  // 708^2 * 2 = 1.0M triangles
   const int repeat = intArg(argc, argv, "--repeat", 2, 1, 100);

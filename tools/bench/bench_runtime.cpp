@@ -20,6 +20,7 @@
 #include "common/parallel/runtime.h"
 #include "common/parallel/simulator.h"
 #include "common/parallel/spin_work.h"
+#include "common/util/allocator.h"
 
 using namespace pr::par;
 
@@ -196,6 +197,7 @@ void stageOverhead() {
 }  // namespace
 
 int main() {
+  pr::retainFreedMemory();
   std::printf("bench_runtime: %u hardware threads\n", std::thread::hardware_concurrency());
   workedExample(3, 5e-3);
   workedExample(2, 5e-3);

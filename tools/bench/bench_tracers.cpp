@@ -17,6 +17,7 @@
 #include "common/parallel/metrics.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
+#include "common/util/allocator.h"
 #include "raytrace/core/interaction.h"
 #include "raytrace/integrators/sampling.h"
 #include "raytrace/partition/partition.h"
@@ -127,6 +128,7 @@ void embreeComparison(const std::string& file, int w, int h, int repeats) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  pr::retainFreedMemory();
   CLI::App app{"bench_tracers: image-space parallel efficiency and ray throughput against Embree"};
   std::string hotspot = std::string(PARRENDER_SOURCE_DIR) + "/scenes/hotspot.gltf";
   std::vector<std::string> embreeScenes = {std::string(PARRENDER_SOURCE_DIR) + "/scenes/hotspot.gltf",
