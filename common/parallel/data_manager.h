@@ -20,6 +20,7 @@
 
 #include "common/parallel/await_reply.h"
 #include "common/parallel/channel.h"
+#include "common/parallel/per_pe.h"
 #include "common/parallel/pe.h"
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
@@ -67,6 +68,7 @@ template <class T>
 class DataCache {
  public:
   using ByteSize = std::function<std::size_t(const T&)>;
+  DataCache() : DataCache(0) {}  // holds nothing
   explicit DataCache(std::size_t capacity, std::size_t capacityBytes = SIZE_MAX, ByteSize bytes = {})
       : capacity_(capacity), capacityBytes_(capacityBytes), bytes_(std::move(bytes)) {}
 
@@ -142,11 +144,8 @@ class DataManager {
         items_(runtime, name + " items", MessageKind::Data),
         requests_(runtime, name + " requests", MessageKind::Requests,
                   [this](Pe& owner, Request&& r) { serve(owner, r); }) {
-    for (int p = 0; p < runtime.pes(); ++p) caches_.emplace_back(cacheCapacity, cacheBytes, bytes_);
-    local_.resize(static_cast<std::size_t>(runtime.pes()));
-    async_.resize(static_cast<std::size_t>(runtime.pes()));
-    hits_.assign(static_cast<std::size_t>(runtime.pes()), 0);
-    misses_.assign(static_cast<std::size_t>(runtime.pes()), 0);
+    pe_.resize(runtime.pes());
+    for (int p = 0; p < runtime.pes(); ++p) pe_[p].cache = DataCache<T>(cacheCapacity, cacheBytes, bytes_);
   }
 
   int owner(ItemId item) const { return owners_.owner(item); }
@@ -161,20 +160,20 @@ class DataManager {
   // acquire or prefetch. Items of pe's own partition are neither hits nor misses.
   const T& acquire(Pe& pe, ItemId item) {
     const int owner = owners_.owner(item);
-    if (owner == pe.id()) return local_[pe.id()] = load_(pe, item);
-    DataCache<T>& cache = caches_[pe.id()];
+    if (owner == pe.id()) return pe_[pe.id()].local = load_(pe, item);
+    DataCache<T>& cache = pe_[pe.id()].cache;
     if (const T* cached = cache.find(item)) {
-      ++hits_[pe.id()];
+      ++pe_[pe.id()].hits;
       pe.counters().cacheHits.fetch_add(1, std::memory_order_relaxed);
       return *cached;
     }
-    ++misses_[pe.id()];
+    ++pe_[pe.id()].misses;
     pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
     requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
     Reply reply = awaitReply(pe);
     PR_CHECK(reply.item == item, "DataManager: a reply for another item");
     waitUntilReady(pe, reply);
-    if (!cache.fits(reply.value)) return local_[pe.id()] = std::move(reply.value);
+    if (!cache.fits(reply.value)) return pe_[pe.id()].local = std::move(reply.value);
     return cache.insert(item, std::move(reply.value));
   }
 
@@ -185,7 +184,7 @@ class DataManager {
     std::size_t asked = 0;
     for (ItemId item : items) {
       const int owner = owners_.owner(item);
-      if (owner == pe.id() || caches_[pe.id()].contains(item)) continue;
+      if (owner == pe.id() || pe_[pe.id()].cache.contains(item)) continue;
       pe.counters().prefetches.fetch_add(1, std::memory_order_relaxed);
       requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
       ++asked;
@@ -193,7 +192,7 @@ class DataManager {
     for (; asked > 0; --asked) {
       Reply reply = awaitReply(pe);
       waitUntilReady(pe, reply);
-      if (caches_[pe.id()].fits(reply.value)) caches_[pe.id()].insert(reply.item, std::move(reply.value));
+      if (pe_[pe.id()].cache.fits(reply.value)) pe_[pe.id()].cache.insert(reply.item, std::move(reply.value));
     }
   }
 
@@ -204,17 +203,17 @@ class DataManager {
   // joined(pe)). The pointer stays
   // valid until pe's next awaitArrival. Items of pe's own partition go through acquire.
   const T* tryAcquire(Pe& pe, ItemId item, bool countHit = true) {
-    Async& a = async_[pe.id()];
+    Async& a = pe_[pe.id()].async;
     if (a.heldValid && a.heldItem == item) return &a.held;
-    if (const T* cached = caches_[pe.id()].find(item)) {
+    if (const T* cached = pe_[pe.id()].cache.find(item)) {
       if (countHit) {
-        ++hits_[pe.id()];
+        ++pe_[pe.id()].hits;
         pe.counters().cacheHits.fetch_add(1, std::memory_order_relaxed);
       }
       return cached;
     }
     if (a.outstanding.insert(item).second) {
-      ++misses_[pe.id()];
+      ++pe_[pe.id()].misses;
       pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
       requests_.send(pe, owners_.owner(item), Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
     } else {
@@ -227,7 +226,7 @@ class DataManager {
   // outstanding items has arrived and is usable; puts it in the cache, or holds it until the
   // next awaitArrival when it does not fit, and returns its id.
   ItemId awaitArrival(Pe& pe) {
-    Async& a = async_[pe.id()];
+    Async& a = pe_[pe.id()].async;
     PR_CHECK(!a.outstanding.empty(), "DataManager: awaiting an arrival with no request out");
     a.heldValid = false;
     a.held = T{};
@@ -242,8 +241,8 @@ class DataManager {
       Reply r = std::move(*ready);
       a.travelling.erase(ready);
       a.outstanding.erase(r.item);
-      if (caches_[pe.id()].fits(r.value)) {
-        caches_[pe.id()].insert(r.item, std::move(r.value));
+      if (pe_[pe.id()].cache.fits(r.value)) {
+        pe_[pe.id()].cache.insert(r.item, std::move(r.value));
       } else {
         a.held = std::move(r.value);
         a.heldItem = r.item;
@@ -255,11 +254,11 @@ class DataManager {
     return arrived;
   }
 
-  std::uint64_t hits(int pe) const { return hits_[pe]; }
+  std::uint64_t hits(int pe) const { return pe_[pe].hits; }
   // tryAcquire calls that missed an item already requested (no message of their own).
-  std::uint64_t joined(int pe) const { return async_[pe].joined; }
-  std::uint64_t misses(int pe) const { return misses_[pe]; }
-  const DataCache<T>& cache(int pe) const { return caches_[pe]; }
+  std::uint64_t joined(int pe) const { return pe_[pe].async.joined; }
+  std::uint64_t misses(int pe) const { return pe_[pe].misses; }
+  const DataCache<T>& cache(int pe) const { return pe_[pe].cache; }
 
  private:
   struct Request {
@@ -306,11 +305,16 @@ class DataManager {
   ByteSize bytes_;
   Channel<Reply> items_;
   Channel<Request> requests_;
-  std::vector<DataCache<T>> caches_;  // one per PE, touched only by that PE
-  std::vector<T> local_;
-  std::vector<Async> async_;  // one per PE, touched only by that PE
+  // What each PE touches on every acquire, its own only (on cache lines of its own: a cache
+  // hit reorders the LRU list, whose head lives in the DataCache object).
+  struct PeData {
+    DataCache<T> cache;
+    T local{};
+    Async async;
+    std::uint64_t hits = 0, misses = 0;
+  };
+  PerPe<PeData> pe_;
   double latency_ = 0.0;
-  std::vector<std::uint64_t> hits_, misses_;
 };
 
 }  // namespace pr::par

@@ -11,12 +11,15 @@ namespace pr::raster {
 
 void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scratch, std::vector<int>& owners) {
   owners.clear();
-  grid.forEachOverlapped(bounds, [&](int r) {
+  // A large triangle overlaps hundreds of tiles but only P owners: stop once all are found.
+  const size_t pes = scratch.size();
+  grid.forEachOverlappedWhile(bounds, [&](int r) {
     const int o = grid.owner(r);
     if (!scratch[o]) {
       scratch[o] = 1;
       owners.push_back(o);
     }
+    return owners.size() < pes;
   });
   for (int o : owners) scratch[o] = 0;
   std::sort(owners.begin(), owners.end());

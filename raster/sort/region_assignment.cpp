@@ -25,9 +25,11 @@ std::string_view regionStrategyName(RegionStrategy strategy) {
   return "?";
 }
 
-RegionGrid::RegionGrid(int width, int height, RegionStrategy strategy, int tileSizePx, int pes)
+RegionGrid::RegionGrid(int width, int height, RegionStrategy strategy, int tileSizePx, int pes,
+                       std::span<const double> shares)
     : screen_{0, 0, width, height}, dynamic_(strategy == RegionStrategy::Dynamic) {
   PR_CHECK(width > 0 && height > 0 && pes >= 1, "RegionGrid: bad screen or PE count");
+  PR_CHECK(shares.empty() || shares.size() == size_t(pes), "RegionGrid: one share per PE");
   if (tileSizePx < 1 || tileSizePx > 4096)
     throw InputError("tile size " + std::to_string(tileSizePx) + " px is outside [1, 4096]");
   if (strategy == RegionStrategy::StaticStrips) {
@@ -38,14 +40,22 @@ RegionGrid::RegionGrid(int width, int height, RegionStrategy strategy, int tileS
     for (const Rect& s : regions_) ys_.push_back(s.y1);
     for (int i = 0; i < static_cast<int>(regions_.size()); ++i) owner_.push_back(i);
   } else {
-    // Tiles dealt round-robin in row-major order: neighbouring tiles go to different PEs,
+    // Tiles dealt in row-major order, interleaved: neighbouring tiles go to different PEs,
     // which spreads a screen-space hot spot over all of them (static interleaving).
     regions_ = tileRegions(width, height, tileSizePx);
     for (int x = 0; x < width; x += tileSizePx) xs_.push_back(x);
     xs_.push_back(width);
     for (int y = 0; y < height; y += tileSizePx) ys_.push_back(y);
     ys_.push_back(height);
-    for (int i = 0; i < static_cast<int>(regions_.size()); ++i) owner_.push_back(i % pes);
+    std::vector<double> dealt(size_t(pes), 0.0);
+    for (size_t i = 0; i < regions_.size(); ++i) {
+      const auto grown = [&](int p) { return (dealt[size_t(p)] + 1.0) / (shares.empty() ? 1.0 : shares[size_t(p)]); };
+      int to = 0;
+      for (int p = 1; p < pes; ++p)
+        if (grown(p) < grown(to)) to = p;
+      dealt[size_t(to)] += 1.0;
+      owner_.push_back(to);
+    }
   }
 }
 
@@ -68,6 +78,34 @@ std::vector<int> RegionGrid::regionsOf(int pe) const {
 int RegionGrid::cellOf(const std::vector<int>& edges, int v) {
   // edges is increasing with edges.front() <= v < edges.back(): the cell whose start is <= v.
   return static_cast<int>(std::upper_bound(edges.begin(), edges.end(), v) - edges.begin()) - 1;
+}
+
+
+std::span<const double> TileShares::forFrame(int pes) const {
+  if (shares_.size() != size_t(pes)) return {};
+  return shares_;
+}
+
+void TileShares::learn(const RegionGrid& grid, const par::StageRecord& drawStage) {
+  const int pes = static_cast<int>(drawStage.pes.size());
+  if (grid.dynamic() || pes < 2) return;
+  std::vector<double> tiles(size_t(pes), 0.0);
+  for (int owner : grid.owners()) tiles[size_t(owner)] += 1.0;
+  // Tiles per busy second; a PE without tiles or without measured time keeps an equal rate.
+  std::vector<double> rate(size_t(pes), 0.0);
+  double sum = 0.0;
+  for (int p = 0; p < pes; ++p) {
+    const double busy = drawStage.pes[size_t(p)].busySeconds;
+    rate[size_t(p)] = tiles[size_t(p)] > 0.0 && busy > 0.0 ? tiles[size_t(p)] / busy : 0.0;
+    sum += rate[size_t(p)];
+  }
+  if (sum <= 0.0) return;
+  const double mean = sum / pes;
+  if (shares_.size() != size_t(pes)) shares_.assign(size_t(pes), 1.0);
+  for (int p = 0; p < pes; ++p) {
+    const double measured = rate[size_t(p)] > 0.0 ? rate[size_t(p)] / mean : 1.0;
+    shares_[size_t(p)] = 0.5 * (shares_[size_t(p)] + measured);
+  }
 }
 
 }  // namespace pr::raster

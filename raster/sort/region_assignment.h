@@ -1,14 +1,17 @@
 // Region assignment: which PE owns which screen region in the parallel raster pipelines.
-// Static strips (one per PE) or static tiles (dealt round-robin) are fixed before the frame;
+// Static strips (one per PE) or static tiles (dealt round-robin, or in proportion to shares
+// learnt from the previous frame: TileShares) are fixed before the frame;
 // every PE holds the same small RegionGrid (replicated, like the camera), so the owners of a
 // triangle's bounds are found by two binary searches, never by scanning all regions.
 #pragma once
 
 #include <memory>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
 
+#include "common/parallel/run_record.h"
 #include "common/parallel/schedulers/scheduler.h"
 #include "common/parallel/task.h"
 #include "raster/region.h"
@@ -28,8 +31,12 @@ std::string_view regionStrategyName(RegionStrategy strategy);
 // The screen cut into a cols x rows grid of regions (strips: 1 column), each with an owner.
 class RegionGrid {
  public:
-  // Throws pr::InputError for a tile size outside [1, 4096]. pes >= 1.
-  RegionGrid(int width, int height, RegionStrategy strategy, int tileSizePx, int pes);
+  // Throws pr::InputError for a tile size outside [1, 4096]. pes >= 1. Static tiles are dealt
+  // in proportion to shares (one positive value per PE; equal when empty): in row-major order,
+  // each tile to the PE whose tiles per share grow least by it (ties to the lower PE), so equal
+  // shares deal round-robin and neighbouring tiles still go to different PEs.
+  RegionGrid(int width, int height, RegionStrategy strategy, int tileSizePx, int pes,
+             std::span<const double> shares = {});
 
   int regionCount() const { return static_cast<int>(regions_.size()); }
   const Rect& region(int r) const { return regions_[r]; }
@@ -44,13 +51,22 @@ class RegionGrid {
   // Calls fn(regionIndex) for every region the pixel rectangle overlaps (clipped to the screen).
   template <class Fn>
   void forEachOverlapped(const Rect& bounds, Fn&& fn) const {
+    forEachOverlappedWhile(bounds, [&](int region) {
+      fn(region);
+      return true;
+    });
+  }
+  // The same, in row-major order, until fn returns false.
+  template <class Fn>
+  void forEachOverlappedWhile(const Rect& bounds, Fn&& fn) const {
     Rect b = intersect(bounds, screen_);
     if (b.empty()) return;
     const int c0 = cellOf(xs_, b.x0), c1 = cellOf(xs_, b.x1 - 1);
     const int r0 = cellOf(ys_, b.y0), r1 = cellOf(ys_, b.y1 - 1);
     const int cols = static_cast<int>(xs_.size()) - 1;
     for (int r = r0; r <= r1; ++r)
-      for (int c = c0; c <= c1; ++c) fn(r * cols + c);
+      for (int c = c0; c <= c1; ++c)
+        if (!fn(r * cols + c)) return;
   }
 
  private:
@@ -61,6 +77,24 @@ class RegionGrid {
   std::vector<int> xs_, ys_;  // cell boundaries, first 0, last width/height
   std::vector<Rect> regions_;
   std::vector<int> owner_;
+};
+
+// The shares of static tiles, learnt from frame to frame by the sort points that deliver regions
+// to the assembler (sort-first, sort-middle). PE 0 also stores every region the other PEs
+// deliver (frame_assembly.h), so with equal shares it finishes last. After each frame a PE's
+// share becomes proportional to the tiles it drew per second of its busy time in that frame's
+// draw stage (the runtime's measurement), averaged with its previous share. The first frame,
+// and any frame after P changed, deals equally. Images do not depend on the shares (regions
+// are disjoint); only which PE draws which tile, and so the traffic, does.
+class TileShares {
+ public:
+  // The shares for a frame on `pes` PEs (empty: deal equally).
+  std::span<const double> forFrame(int pes) const;
+  // After the frame drawn with `grid`: learns from its draw stage's record.
+  void learn(const RegionGrid& grid, const par::StageRecord& drawStage);
+
+ private:
+  std::vector<double> shares_;
 };
 
 }  // namespace pr::raster

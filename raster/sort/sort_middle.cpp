@@ -44,7 +44,8 @@ class SortMiddle : public SortPoint {
 
   void renderFrame(const FrameInputs& f, par::Runtime& rt, RegionFramebuffer& image) override {
     const int pes = rt.pes();
-    const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes);
+    const RegionGrid grid(f.view.width, f.view.height, f.options.regions, f.options.tileSizePx, pes,
+                          shares_.forFrame(pes));
     const ShadingContext ctx = makeShadingContext(f.scene, f.view, f.options.effects, f.options.headlight);
     declareSortCounters(name(), rt);
     if (distribution_.firstFrame(f.scene, rt)) distributeReplicated(rt, f.scene);
@@ -115,6 +116,7 @@ class SortMiddle : public SortPoint {
       const int p = pe.id();
       drawers_[p].draw(pe, ctx, inbox[p], grid, grid.regionsOf(p), frame);
     });
+    shares_.learn(grid, rt.record().stages.back());
     recordTallies(rt, counters);
   }
 
@@ -161,6 +163,7 @@ class SortMiddle : public SortPoint {
   }
 
   par::PerPe<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
+  TileShares shares_;                 // static tiles per PE, from the last frame's draw times
   RegionBufferPool pool_;              // region message storage, kept between frames
   SceneDistribution distribution_;
 };

@@ -55,6 +55,47 @@ TEST_CASE("RegionAssignment: overlap queries match a brute-force scan") {
   CHECK(owners == std::vector<int>{1});
 }
 
+TEST_CASE("RegionAssignment: static tiles are dealt in proportion to shares, interleaved") {
+  // 4 x 2 tiles; PE 1 has three times PE 0's share: tiles 0..7 go 1 1 0 1 1 1 0 1 (each to the
+  // PE whose tiles per share grow least, ties to the lower PE), a quarter of them to PE 0.
+  const std::vector<double> shares{1.0, 3.0};
+  RegionGrid tiles(64, 32, RegionStrategy::StaticTiles, 16, 2, shares);
+  checkCover(tiles, 64, 32);
+  CHECK(tiles.owners() == std::vector<int>{1, 1, 0, 1, 1, 1, 0, 1});
+  // Equal shares deal round-robin, as without shares.
+  const std::vector<double> equal{2.0, 2.0, 2.0};
+  RegionGrid same(50, 30, RegionStrategy::StaticTiles, 16, 3, equal);
+  for (int r = 0; r < same.regionCount(); ++r) CHECK(same.owner(r) == r % 3);
+}
+
+TEST_CASE("TileShares: a PE slower per tile gets a smaller share, and balanced times keep the shares") {
+  TileShares shares;
+  CHECK(shares.forFrame(2).empty());  // the first frame deals equally
+  RegionGrid grid(64, 64, RegionStrategy::StaticTiles, 16, 2);  // 8 tiles each
+  par::StageRecord draw;
+  draw.pes.resize(2);
+  draw.pes[0].busySeconds = 0.012;  // the assembler: its own tiles and the other PE's stores
+  draw.pes[1].busySeconds = 0.008;
+  shares.learn(grid, draw);
+  REQUIRE(shares.forFrame(2).size() == 2);
+  const double first0 = shares.forFrame(2)[0], first1 = shares.forFrame(2)[1];
+  CHECK(first0 < 1.0);
+  CHECK(first1 > 1.0);
+  CHECK(first0 + first1 == doctest::Approx(2.0));
+  CHECK(shares.forFrame(3).empty());  // learnt for another P
+  // A frame dealt by these shares in which each PE drew tiles at the rate its share says (so
+  // both were equally busy): the shares stay.
+  RegionGrid next(64, 64, RegionStrategy::StaticTiles, 16, 2, shares.forFrame(2));
+  std::vector<int> tiles(2, 0);
+  for (int owner : next.owners()) ++tiles[size_t(owner)];
+  CHECK(tiles[0] < tiles[1]);
+  draw.pes[0].busySeconds = 0.001 * tiles[0] / first0;
+  draw.pes[1].busySeconds = 0.001 * tiles[1] / first1;
+  shares.learn(next, draw);
+  CHECK(shares.forFrame(2)[0] == doctest::Approx(first0).epsilon(0.05));
+  CHECK(shares.forFrame(2)[1] == doctest::Approx(first1).epsilon(0.05));
+}
+
 TEST_CASE("RegionAssignment: unknown strategy and bad tile size are input errors") {
   CHECK(parseRegionStrategy("static-tiles") == RegionStrategy::StaticTiles);
   CHECK_THROWS_WITH_AS(parseRegionStrategy("diagonal"), doctest::Contains("unknown region assignment 'diagonal'"),
