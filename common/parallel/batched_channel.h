@@ -29,7 +29,13 @@ class BatchedChannel {
 
   // batchSize >= 1 items per message. The handler runs on the receiving PE, once per batch.
   BatchedChannel(Runtime& runtime, std::string name, MessageKind kind, std::size_t batchSize, Handler handler)
-      : batchSize_(batchSize), channel_(runtime, std::move(name), kind, std::move(handler)), out_(size_t(runtime.pes())) {
+      : batchSize_(batchSize),
+        channel_(runtime, std::move(name), kind,
+                 [this, handler = std::move(handler)](Pe& pe, Batch&& batch) {
+                   handler(pe, std::move(batch));
+                   recycle(pe, std::move(batch));
+                 }),
+        out_(size_t(runtime.pes())) {
     PR_CHECK(batchSize >= 1, "BatchedChannel: a batch holds at least one item");
     for (PeOutboxes& o : out_) o.boxes.resize(size_t(runtime.pes()));
   }
@@ -37,8 +43,9 @@ class BatchedChannel {
   // On PE `from`: queues the item for `to` (bytes: its size on a wire) and sends the batch
   // when it is full.
   void send(Pe& from, int to, T item, std::size_t bytes = sizeof(T)) {
-    Outbox& box = out_[size_t(from.id())].boxes[size_t(to)];
-    if (box.items.empty()) box.items.reserve(batchSize_);
+    PeOutboxes& mine = out_[size_t(from.id())];
+    Outbox& box = mine.boxes[size_t(to)];
+    if (box.items.capacity() == 0) box.items = mine.storage(batchSize_);
     box.items.push_back(std::move(item));
     box.bytes += bytes;
     if (box.items.size() >= batchSize_) sendBox(from, to, box);
@@ -60,9 +67,23 @@ class BatchedChannel {
     Batch items;
     std::size_t bytes = 0;
   };
-  // Padded to a cache line: each PE writes only its own outboxes.
+  // Padded to a cache line: each PE writes only its own outboxes and spare storage.
   struct alignas(64) PeOutboxes {
     std::vector<Outbox> boxes;  // per destination
+    // Emptied batches this PE handled, reused for the batches it sends: a batch is allocated
+    // by one PE and freed by another, and recycling its storage spares the allocator both
+    // (a free from another thread takes the allocating thread's arena lock).
+    std::vector<Batch> spare;
+    Batch storage(std::size_t capacity) {
+      if (spare.empty()) {
+        Batch b;
+        b.reserve(capacity);
+        return b;
+      }
+      Batch b = std::move(spare.back());
+      spare.pop_back();
+      return b;
+    }
   };
 
   void sendBox(Pe& from, int to, Outbox& box) {
@@ -70,6 +91,15 @@ class BatchedChannel {
     channel_.send(from, to, std::move(box.items), bytes);
     box.items = Batch();
     box.bytes = 0;
+  }
+
+  // On the receiving PE, after the handler: keeps the batch's storage (a handler that moved
+  // the items out leaves none to keep). A few spares per destination cover what is in flight.
+  void recycle(Pe& pe, Batch&& batch) {
+    PeOutboxes& mine = out_[size_t(pe.id())];
+    if (batch.capacity() < batchSize_ || mine.spare.size() >= 4 * mine.boxes.size()) return;
+    batch.clear();
+    mine.spare.push_back(std::move(batch));
   }
 
   std::size_t batchSize_;

@@ -35,6 +35,25 @@ TEST_CASE("BatchedChannel: full batches at the batch size, the rest when the PE 
   CHECK(s.pes[1].messagesReceived == 3u);
 }
 
+TEST_CASE("BatchedChannel: a handled batch's storage carries the next batch its receiver sends") {
+  // PE 0 sends one full batch to PE 1; in the next stage PE 1 sends one to PE 0, in the
+  // storage it received (no allocation on one PE and free on the other per batch).
+  Runtime rt(2, "balanced");
+  std::vector<const int*> storage(2, nullptr);
+  BatchedChannel<int> ch(rt, "items", MessageKind::Rays, 4, [&](Pe& pe, std::vector<int>&& b) {
+    CHECK(b.size() == 4u);
+    storage[size_t(pe.id())] = b.data();
+  });
+  for (int sender : {0, 1})
+    rt.runStage("send", TaskSet::uniform(2), [&](Pe& pe, TaskId) {
+      if (pe.id() == sender)
+        for (int i = 0; i < 4; ++i) ch.send(pe, 1 - sender, i);
+      flushIfDry(pe, ch);
+    });
+  REQUIRE(storage[1] != nullptr);
+  CHECK(storage[0] == storage[1]);
+}
+
 TEST_CASE("BatchedChannel: batch size 1 is one message per item") {
   Runtime rt(2, "balanced");
   std::atomic<int> batches{0};
