@@ -57,6 +57,13 @@ void runGenerate(const GenerateOptions& options) {
   params.seed = options.seedOption->count() > 0 ? options.seed : scene.defaultSeed;
   const scenegen::GltfBuilder builder = scenegen::generateScene(entry, params);
   const std::string bytes = builder.serialize(ext == ".glb");
+  // A folder that does not exist yet is made, as `report -o` does (build/scenes/ on a fresh clone).
+  const std::filesystem::path parent = std::filesystem::absolute(options.output).parent_path();
+  std::error_code made;
+  std::filesystem::create_directories(parent, made);
+  if (!std::filesystem::is_directory(parent))
+    throw InputError("output file '" + options.output + "': cannot make the folder " + parent.string() +
+                     (made ? " (" + made.message() + ")" : std::string()));
   writeFileAtomically(options.output, bytes, "scene file");
   std::printf("wrote %s: scene %s, %zu triangles, %zu bytes\n", options.output.c_str(), entry.name.c_str(),
               builder.triangleCount(), bytes.size());

@@ -241,6 +241,9 @@ TEST_CASE("Generate: hotspot puts its sphere cluster in the top-left of the came
 TEST_CASE("Generate: bad arguments exit 2 with a message naming the problem") {
   auto dir = pr::test::scratchDir("generate_errors");
   const std::string out = " -o \"" + (dir / "x.gltf").string() + "\"";
+  // A file where the output's folder would have to be.
+  const fs::path blocker = pr::test::scratchDir("generate_errors_blocker") / "blocker";
+  std::ofstream(blocker) << "not a folder";
   struct Case {
     std::string args, expect;
   };
@@ -249,7 +252,7 @@ TEST_CASE("Generate: bad arguments exit 2 with a message naming the problem") {
                         Case{"generate cornell --size 100000" + out, "--size 100000"},
                         Case{"generate cornell --seed 3" + out, "--seed"},
                         Case{"generate cornell -o \"" + (dir / "x.obj").string() + "\"", ".obj"},
-                        Case{"generate cornell -o \"" + (dir / "missing" / "x.gltf").string() + "\"", "missing"},
+                        Case{"generate cornell -o \"" + (blocker / "x.gltf").string() + "\"", "cannot make the folder"},
                         Case{"generate cornell", "--output"},
                         Case{"generate cornell --size many" + out, "many"}}) {
     CAPTURE(c.args);
@@ -259,6 +262,14 @@ TEST_CASE("Generate: bad arguments exit 2 with a message naming the problem") {
   }
   // Nothing was written, not even a temporary file.
   CHECK(fs::is_empty(dir));
+}
+
+TEST_CASE("Generate: the output's missing folders are made") {
+  const fs::path out = pr::test::scratchDir("generate_folders") / "scenes" / "deeper" / "box.gltf";
+  auto result = pr::test::runParrender("generate cornell -o \"" + out.string() + "\"");
+  INFO(result.output);
+  CHECK(result.exitStatus == 0);
+  CHECK(fs::is_regular_file(out));
 }
 
 TEST_CASE("Generate: --help lists every scene with its description") {
