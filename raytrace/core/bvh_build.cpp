@@ -10,6 +10,7 @@
 
 #include <emmintrin.h>  // SSE2: part of every x86-64 target
 
+#include "common/util/allocator.h"
 #include "common/util/error.h"
 #include "common/util/limits.h"
 #include "raytrace/core/bvh.h"
@@ -342,8 +343,13 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   magnitude_ = 0.0f;
   if (subset.empty()) return;
 
-  std::vector<BvhTriangle> prepared(subset.size());
-  std::vector<PrimRef> refs(subset.size());
+  // The build writes each of its arrays once, front to back: 2 MiB pages spare most page faults.
+  std::vector<BvhTriangle> prepared;
+  reserveHugePages(prepared, subset.size());
+  prepared.resize(subset.size());
+  std::vector<PrimRef> refs;
+  reserveHugePages(refs, subset.size());
+  refs.resize(subset.size());
   for (size_t i = 0; i < subset.size(); ++i) {
     const uint32_t index = subset[i];
     PR_CHECK(index < triangles.size(), "triangle index " + std::to_string(index) + " out of range");
@@ -365,9 +371,9 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   }
 
   std::vector<BinaryNode> binary;
-  binary.reserve(2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
+  reserveHugePages(binary, 2 * subset.size() / std::max(1, options.maxLeafSize / 2) + 1);
   std::vector<BvhTriangle> leafTris;
-  leafTris.reserve(subset.size());
+  reserveHugePages(leafTris, subset.size());
   Builder builder(options, refs, prepared, binary, leafTris, stats_);
   builder.build(0, static_cast<uint32_t>(refs.size()), 0);
   // The traversal stack holds at most kBvhWidth - 1 entries per level (bvh_traverse.cpp).
@@ -375,8 +381,8 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   refs = {};
   prepared = {};
 
-  nodes_.reserve(binary.size() / 2 + 1);
-  leafBlocks_.reserve(stats_.leaves + leafTris.size() / kLeafLanes);
+  reserveHugePages(nodes_, binary.size() / 2 + 1);
+  reserveHugePages(leafBlocks_, stats_.leaves + leafTris.size() / kLeafLanes);
   root_ = collapse(binary, 0, leafTris, nodes_, leafBlocks_);
   nodes_.shrink_to_fit();
   leafBlocks_.shrink_to_fit();
