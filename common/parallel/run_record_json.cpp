@@ -3,7 +3,9 @@
 // "summary" block is written from metrics.cpp for readers; it is ignored when reading.
 // Timeline spans are compact arrays [pe, stage, task, start, end, messagesSent, bytesSent].
 #include <cmath>
+#include <cstdint>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -123,16 +125,60 @@ void writeText(const std::string& text, const std::filesystem::path& file, const
   writeFileAtomically(file, text, std::string(what) + " file");
 }
 
+// A JSON number as T, or InputError naming what: a value T cannot hold (a negative count, 1e300
+// as a PE, 2.5 as a task index) is malformed input, not a silent wrap or an undefined
+// conversion.
+template <class T>
+T numberAs(const json& v, const std::string& what) {
+  if (!v.is_number()) throw InputError(what + " must be a number");
+  if constexpr (std::is_floating_point_v<T>) {
+    const double d = v.get<double>();
+    if (std::isfinite(d) && std::abs(d) > static_cast<double>(std::numeric_limits<T>::max()))
+      throw InputError(what + " is out of range");
+    return static_cast<T>(d);
+  } else {
+    using Limits = std::numeric_limits<T>;
+    if (v.is_number_unsigned()) {
+      const auto u = v.get<std::uint64_t>();
+      if (u > static_cast<std::uint64_t>(Limits::max())) throw InputError(what + " is out of range");
+      return static_cast<T>(u);
+    }
+    if (v.is_number_integer()) {
+      const auto i = v.get<std::int64_t>();
+      if (i < 0 ? i < static_cast<std::int64_t>(Limits::min())
+                : static_cast<std::uint64_t>(i) > static_cast<std::uint64_t>(Limits::max()))
+        throw InputError(what + " is out of range");
+      return static_cast<T>(i);
+    }
+    // A float that is a whole number within T's range (2^digits is exact as a double).
+    const double d = v.get<double>();
+    const double bound = std::ldexp(1.0, Limits::digits);
+    if (!(d == std::trunc(d) && d < bound && d >= (Limits::is_signed ? -bound : 0.0)))
+      throw InputError(what + " must be a whole number in range");
+    return static_cast<T>(d);
+  }
+}
+
 // Reads key from object j, or throws InputError naming origin, where and key.
 template <class T>
 T field(const json& j, const char* key, const std::string& origin, const std::string& where) {
   auto it = j.find(key);
   if (it == j.end()) throw InputError(origin + ": " + where + " has no \"" + key + "\"");
-  try {
-    return it->get<T>();
-  } catch (const json::exception&) {
-    throw InputError(origin + ": " + where + " \"" + key + "\" has the wrong type");
+  if constexpr (std::is_arithmetic_v<T>) {
+    return numberAs<T>(*it, origin + ": " + where + " \"" + key + "\"");
+  } else {
+    try {
+      return it->get<T>();
+    } catch (const json::exception&) {
+      throw InputError(origin + ": " + where + " \"" + key + "\" has the wrong type");
+    }
   }
+}
+
+// Reads key from object j as T, or fallback when j has no such key.
+template <class T>
+T optionalField(const json& j, const char* key, T fallback, const std::string& origin, const std::string& where) {
+  return j.contains(key) ? field<T>(j, key, origin, where) : fallback;
 }
 
 RunRecord parseRunRecord(const std::string& text, const std::string& origin);
@@ -163,14 +209,15 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     throw InputError(origin + ": not valid JSON (" + e.what() + ")");
   }
   if (!j.is_object()) throw InputError(origin + ": expected a run record (a JSON object)");
+  const std::string top = "run record";
   RunRecord record;
-  record.pes = field<int>(j, "pes", origin, "run record");
+  record.pes = field<int>(j, "pes", origin, top);
   if (record.pes < 1) throw InputError(origin + ": \"pes\" must be at least 1");
   record.schedule = j.value("schedule", std::string());
-  record.grain = j.value("grain", 1);
-  record.wallSeconds = j.value("wallSeconds", 0.0);
+  record.grain = optionalField(j, "grain", 1, origin, top);
+  record.wallSeconds = optionalField(j, "wallSeconds", 0.0, origin, top);
   record.error = j.value("error", std::string());
-  const json stages = field<json>(j, "stages", origin, "run record");
+  const json stages = field<json>(j, "stages", origin, top);
   if (!stages.is_array()) throw InputError(origin + ": \"stages\" must be an array");
   for (std::size_t i = 0; i < stages.size(); ++i) {
     const json& js = stages[i];
@@ -178,54 +225,69 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     StageRecord s;
     s.name = field<std::string>(js, "name", origin, where);
     s.schedule = js.value("schedule", std::string());
-    s.grain = js.value("grain", 1);
-    s.startSeconds = js.value("startSeconds", 0.0);
+    s.grain = optionalField(js, "grain", 1, origin, where);
+    s.startSeconds = optionalField(js, "startSeconds", 0.0, origin, where);
     s.wallSeconds = field<double>(js, "wallSeconds", origin, where);
     for (const json& jp : js.value("pes", json::array())) {
+      const std::string pe = where + " PE " + std::to_string(s.pes.size());
+      const auto seconds = [&](const char* key) { return optionalField(jp, key, 0.0, origin, pe); };
+      const auto count = [&](const char* key) { return optionalField(jp, key, std::uint64_t{0}, origin, pe); };
       PeStageRecord r;
-      r.busySeconds = jp.value("busySeconds", 0.0);
-      r.idleSeconds = jp.value("idleSeconds", 0.0);
-      r.syncWaitSeconds = jp.value("syncWaitSeconds", 0.0);
-      r.sendReceiveSeconds = jp.value("sendReceiveSeconds", 0.0);
-      r.messageWaitSeconds = jp.value("messageWaitSeconds", 0.0);
-      r.tasks = jp.value("tasks", std::uint64_t{0});
-      r.messagesHandled = jp.value("messagesHandled", std::uint64_t{0});
-      r.messagesSent = jp.value("messagesSent", std::uint64_t{0});
-      r.bytesSent = jp.value("bytesSent", std::uint64_t{0});
-      r.messagesReceived = jp.value("messagesReceived", std::uint64_t{0});
-      r.bytesReceived = jp.value("bytesReceived", std::uint64_t{0});
-      r.schedulingMessages = jp.value("schedulingMessages", std::uint64_t{0});
-      r.schedulingBytes = jp.value("schedulingBytes", std::uint64_t{0});
-      r.broadcastsReceived = jp.value("broadcastsReceived", std::uint64_t{0});
-      r.broadcastBytesReceived = jp.value("broadcastBytesReceived", std::uint64_t{0});
-      r.cacheHits = jp.value("cacheHits", std::uint64_t{0});
-      r.cacheMisses = jp.value("cacheMisses", std::uint64_t{0});
-      r.prefetches = jp.value("prefetches", std::uint64_t{0});
+      r.busySeconds = seconds("busySeconds");
+      r.idleSeconds = seconds("idleSeconds");
+      r.syncWaitSeconds = seconds("syncWaitSeconds");
+      r.sendReceiveSeconds = seconds("sendReceiveSeconds");
+      r.messageWaitSeconds = seconds("messageWaitSeconds");
+      r.tasks = count("tasks");
+      r.messagesHandled = count("messagesHandled");
+      r.messagesSent = count("messagesSent");
+      r.bytesSent = count("bytesSent");
+      r.messagesReceived = count("messagesReceived");
+      r.bytesReceived = count("bytesReceived");
+      r.schedulingMessages = count("schedulingMessages");
+      r.schedulingBytes = count("schedulingBytes");
+      r.broadcastsReceived = count("broadcastsReceived");
+      r.broadcastBytesReceived = count("broadcastBytesReceived");
+      r.cacheHits = count("cacheHits");
+      r.cacheMisses = count("cacheMisses");
+      r.prefetches = count("prefetches");
       s.pes.push_back(r);
     }
-    for (const json& jt : js.value("traffic", json::array()))
-      s.traffic.push_back({jt.value("from", 0), jt.value("to", 0), jt.value("messages", std::uint64_t{0}),
-                           jt.value("bytes", std::uint64_t{0})});
-    for (const json& jc : js.value("channels", json::array()))
+    for (const json& jt : js.value("traffic", json::array())) {
+      const std::string link = where + " traffic";
+      s.traffic.push_back({optionalField(jt, "from", 0, origin, link), optionalField(jt, "to", 0, origin, link),
+                           optionalField(jt, "messages", std::uint64_t{0}, origin, link),
+                           optionalField(jt, "bytes", std::uint64_t{0}, origin, link)});
+    }
+    for (const json& jc : js.value("channels", json::array())) {
+      const std::string channel = where + " channel";
       s.channels.push_back({jc.value("name", std::string()), jc.value("kind", std::string()),
-                            jc.value("messages", std::uint64_t{0}), jc.value("bytes", std::uint64_t{0})});
+                            optionalField(jc, "messages", std::uint64_t{0}, origin, channel),
+                            optionalField(jc, "bytes", std::uint64_t{0}, origin, channel)});
+    }
     const json tasks = field<json>(js, "tasks", origin, where);
     for (const json& jt : tasks) {
-      if (!jt.is_array() || jt.size() != 3 || !jt[0].is_number())
+      if (!jt.is_array() || jt.size() != 3)
         throw InputError(origin + ": " + where + " \"tasks\" entries must be [costEstimate, x, y]");
-      s.tasks.push_back({jt[0].get<double>(), jt[1].get<float>(), jt[2].get<float>()});
+      const std::string task = origin + ": " + where + " task";
+      s.tasks.push_back({numberAs<double>(jt[0], task + " costEstimate"), numberAs<float>(jt[1], task + " x"),
+                         numberAs<float>(jt[2], task + " y")});
     }
-    s.owners = js.value("owners", std::vector<int>());
+    for (const json& owner : js.value("owners", json::array()))
+      s.owners.push_back(numberAs<int>(owner, origin + ": " + where + " owner"));
     if (!s.owners.empty() && s.owners.size() != s.tasks.size())
       throw InputError(origin + ": " + where + " \"owners\" must name one PE per task");
     record.stages.push_back(std::move(s));
   }
-  const json timeline = field<json>(j, "timeline", origin, "run record");
+  const json timeline = field<json>(j, "timeline", origin, top);
   for (const json& jt : timeline) {
     if (!jt.is_array() || jt.size() != 7)
       throw InputError(origin + ": \"timeline\" entries must be [pe, stage, task, start, end, messagesSent, bytesSent]");
-    TaskSpan span{jt[0].get<int>(), jt[1].get<int>(), jt[2].get<TaskId>(), jt[3].get<double>(),
-                  jt[4].get<double>(), jt[5].get<std::uint32_t>(), jt[6].get<std::uint64_t>()};
+    const std::string spanWhat = origin + ": timeline span";
+    TaskSpan span{numberAs<int>(jt[0], spanWhat + " pe"),           numberAs<int>(jt[1], spanWhat + " stage"),
+                  numberAs<TaskId>(jt[2], spanWhat + " task"),      numberAs<double>(jt[3], spanWhat + " start"),
+                  numberAs<double>(jt[4], spanWhat + " end"),       numberAs<std::uint32_t>(jt[5], spanWhat + " messagesSent"),
+                  numberAs<std::uint64_t>(jt[6], spanWhat + " bytesSent")};
     if (span.stage < 0 || span.stage >= static_cast<int>(record.stages.size()) || span.pe < 0 ||
         span.pe >= record.pes || span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
       throw InputError(origin + ": \"timeline\" span names a PE, stage or task the record does not have");
@@ -235,7 +297,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
   for (const json& jc : j.value("counters", json::array())) {
     CounterRecord c;
     c.name = field<std::string>(jc, "name", origin, "counter");
-    c.perPe = field<std::vector<double>>(jc, "perPe", origin, "counter " + c.name);
+    for (const json& v : field<json>(jc, "perPe", origin, "counter " + c.name))
+      c.perPe.push_back(numberAs<double>(v, origin + ": counter " + c.name + " value"));
     if (static_cast<int>(c.perPe.size()) != record.pes)
       throw InputError(origin + ": counter \"" + c.name + "\" needs one value per PE (" + std::to_string(record.pes) + ")");
     record.counters.push_back(std::move(c));

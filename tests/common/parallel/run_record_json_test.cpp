@@ -108,6 +108,24 @@ TEST_CASE("RunRecord: a value of the wrong type deep in the record is an input e
   CHECK_THROWS_AS(runRecordFromJsonText(text, "m.json"), pr::InputError);
 }
 
+TEST_CASE("RunRecord: a number the field's type cannot hold is an input error, a whole float is read") {
+  const auto record = [](const std::string& pes, const std::string& busy, const std::string& span) {
+    return "{\"pes\": " + pes + ", \"stages\": [{\"name\": \"s\", \"wallSeconds\": 1, \"pes\": [{\"tasks\": " +
+           busy + "}], \"tasks\": [[1, 0, 0]]}], \"timeline\": [" + span + "]}";
+  };
+  const std::string goodSpan = "[0, 0, 0, 0.0, 1.0, 2, 3]";
+  CHECK(runRecordFromJsonText(record("2.0", "5", goodSpan), "m.json").pes == 2);
+  CHECK(runRecordFromJsonText(record("1", "5.0", goodSpan), "m.json").stages[0].pes[0].tasks == 5);
+  CHECK_THROWS_WITH_AS(runRecordFromJsonText(record("1e300", "5", goodSpan), "m.json"),
+                       "m.json: run record \"pes\" must be a whole number in range", pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("2.5", "5", goodSpan), "m.json"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("4294967296", "5", goodSpan), "m.json"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("1", "-1", goodSpan), "m.json"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("1", "1e20", goodSpan), "m.json"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("1", "5", "[0, 0, 0, 0.0, 1.0, 5e9, 3]"), "m.json"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("1", "5", "[0, 0, 0, 0.0, 1.0, 2, -3]"), "m.json"), pr::InputError);
+}
+
 TEST_CASE("RunRecord: named per-PE counters add up, survive JSON and appear in the summary") {
   Runtime rt(3, "demand");
   rt.runStage("count", TaskSet::grid(6, 1), [&](Pe& pe, TaskId) { rt.addCounter("Test/items", pe.id(), 1.0); });
