@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
-#include <cstdlib>
 #include <cstring>
 #include <ctime>
 #include <limits>
@@ -20,6 +19,7 @@
 #include <thread>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
@@ -158,29 +158,13 @@ int main(int argc, char** argv) {
   std::size_t photonCount = 1000000, queryCount = 200000;
   int k = 50, repeat = 3;
   float radius = 0.05f;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) {
-        std::fprintf(stderr, "bench_photonmap: %s needs a value\n", a.c_str());
-        std::exit(2);
-      }
-      return argv[++i];
-    };
-    if (a == "--photons") photonCount = std::strtoull(value(), nullptr, 10);
-    else if (a == "--queries") queryCount = std::strtoull(value(), nullptr, 10);
-    else if (a == "--k") k = std::atoi(value());
-    else if (a == "--radius") radius = std::strtof(value(), nullptr);
-    else if (a == "--repeat") repeat = std::max(1, std::atoi(value()));
-    else {
-      std::fprintf(stderr, "bench_photonmap: unknown option '%s' (--photons N --queries N --k N --radius R --repeat N)\n", a.c_str());
-      return 2;
-    }
-  }
-  if (photonCount == 0 || queryCount == 0 || k <= 0 || !(radius > 0.0f)) {
-    std::fprintf(stderr, "bench_photonmap: --photons, --queries, --k and --radius must be positive\n");
-    return 2;
-  }
+  CLI::App app{"bench_photonmap: photon map storage, kd-tree build and k-nearest queries (against nanoflann when built with it)"};
+  app.add_option("--photons", photonCount, "photons in the map")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))->capture_default_str();
+  app.add_option("--queries", queryCount, "k-nearest queries")->check(CLI::Range(std::size_t{1}, std::size_t{1} << 32))->capture_default_str();
+  app.add_option("--k", k, "neighbours per query")->check(CLI::Range(1, 100000))->capture_default_str();
+  app.add_option("--radius", radius, "largest search radius")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--repeat", repeat, "passes, the best reported")->check(CLI::Range(1, 100))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
 
   const std::vector<Photon> photons = makePhotons(photonCount);
   const Queries queries = makeQueries(queryCount);

@@ -2,17 +2,16 @@
 // and size, then primary, shadow and diffuse-bounce rays (Mrays/s) on a generated ~1M-triangle
 // fBm terrain and an ~18k-triangle Cornell-like box, both built in code. Not part of ctest;
 // compare with the Embree anchor figures in shared/ANCHORS.md (same kind of machine).
-//   bench_rays [--res N] [--grid N] [--repeat N] [--leaf N] [--bins N] [--traversal-cost PERCENT]
+//   bench_rays [--res N] [--grid N] [--repeat N] [--leaf N] [--bins N] [--traversal-cost PERCENT] (--help)
 #include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <ctime>
 #include <string>
 #include <vector>
 
+#include <CLI/CLI.hpp>
 #include <glm/glm.hpp>
 
 #include "common/scene/scene.h"
@@ -240,31 +239,23 @@ void runScene(const char* name, const pr::scene::Scene& scene, const Camera& cam
   row("diffuse bounce", b, "hit");
 }
 
-int intArg(int argc, char** argv, const char* name, int fallback, int lo, int hi) {
-  for (int i = 1; i + 1 < argc; ++i)
-    if (std::strcmp(argv[i], name) == 0) {
-      const int v = std::atoi(argv[i + 1]);
-      if (v < lo || v > hi) {
-        std::fprintf(stderr, "bench_rays: %s must be in [%d, %d], got %s\n", name, lo, hi, argv[i + 1]);
-        std::exit(2);
-      }
-      return v;
-    }
-  return fallback;
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
   pr::retainFreedMemory();
-  const int res = intArg(argc, argv, "--res", 1024, 16, 8192);
-  const int grid = intArg(argc, argv, "--grid", 708, 2, 4096);  // 708^2 * 2 = 1.0M triangles
-  const int repeat = intArg(argc, argv, "--repeat", 2, 1, 100);
+  CLI::App app{"bench_rays: BVH build and primary, shadow and diffuse rays per second on one thread, on a generated terrain and a Cornell-like box"};
+  int res = 1024, grid = 708, repeat = 2;  // 708^2 * 2 = 1.0M triangles
   pr::rt::BvhBuildOptions options;
-  options.maxLeafSize = intArg(argc, argv, "--leaf", options.maxLeafSize, 1, 64);
-  options.bins = intArg(argc, argv, "--bins", options.bins, 2, 32);
-  // SAH traversal cost in percent of one triangle test.
-  options.traversalCost = float(intArg(argc, argv, "--traversal-cost", int(options.traversalCost * 100.0f), 1, 1000)) / 100.0f;
+  int traversalPercent = int(options.traversalCost * 100.0f);
+  app.add_option("--res", res, "image resolution of the ray sets (res x res)")->check(CLI::Range(16, 8192))->capture_default_str();
+  app.add_option("--grid", grid, "terrain grid (2 grid^2 triangles)")->check(CLI::Range(2, 4096))->capture_default_str();
+  app.add_option("--repeat", repeat, "passes over each ray set, the best reported")->check(CLI::Range(1, 100))->capture_default_str();
+  app.add_option("--leaf", options.maxLeafSize, "largest leaf, triangles")->check(CLI::Range(1, 16))->capture_default_str();
+  app.add_option("--bins", options.bins, "SAH bins per axis")->check(CLI::Range(2, 32))->capture_default_str();
+  app.add_option("--traversal-cost", traversalPercent, "SAH cost of a node visit, percent of one triangle test")
+      ->check(CLI::Range(1, 1000))->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  options.traversalCost = float(traversalPercent) / 100.0f;
   std::printf("BVH options: leaf <= %d, %d bins, traversal cost %.2f\n", options.maxLeafSize, options.bins, options.traversalCost);
   std::printf("bench_rays: ray tracing core, single-threaded (Embree anchors: shared/ANCHORS.md)\n");
 

@@ -16,6 +16,8 @@
 #include <thread>
 #include <vector>
 
+#include <CLI/CLI.hpp>
+
 #include "common/parallel/metrics.h"
 #include "common/parallel/runtime.h"
 #include "common/parallel/simulator.h"
@@ -196,8 +198,10 @@ void stageOverhead() {
 
 }  // namespace
 
-int main() {
+int main(int argc, char** argv) {
   pr::retainFreedMemory();
+  CLI::App app{"bench_runtime: the parallel runtime's worked examples, scheduling overhead, granularity, efficiency and the simulator's prediction and speed"};
+  CLI11_PARSE(app, argc, argv);
   std::printf("bench_runtime: %u hardware threads\n", std::thread::hardware_concurrency());
   workedExample(3, 5e-3);
   workedExample(2, 5e-3);
