@@ -206,6 +206,10 @@ void addReportCommand(CLI::App& app) {
       ->delimiter(',')
       ->check(CLI::Range(1, rt::kMaxSpp))
       ->capture_default_str();
+  cmd->add_option("--cache-mb", s.cacheMb, "image-space-cached: the cache sizes of the hit-ratio figure, MiB per PE, comma-separated")
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1048576.0))
+      ->capture_default_str();
   cmd->add_option("--caustic-photons", s.settings.ray.photonmap.causticPhotons, "photonmap: caustic photons")
       ->check(CLI::Range(std::size_t{0}, std::size_t{100000000}))
       ->capture_default_str();

@@ -108,13 +108,25 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   CHECK(html.find("Verdict") != std::string::npos);
   // The data beside every chart.
   int charts = 0;
-  for (const char* name : {"speedup", "efficiency", "per_pe", "gantt", "communication", "composite_analytic", "accuracy"}) {
+  for (const char* name : {"speedup", "efficiency", "per_pe", "gantt", "communication", "composite_analytic", "cache", "accuracy"}) {
     CAPTURE(name);
     std::ifstream in(out / "cornell" / (std::string(name) + ".json"));
     const nlohmann::json data = nlohmann::json::parse(in);
     CHECK(data.is_array());
     CHECK(data.size() > 0);
     ++charts;
+  }
+  // The data manager's hit ratio: one point per cache size, none at 0 MiB, most at the largest,
+  // and every cache size gave the same image.
+  {
+    std::ifstream in(out / "cornell" / "cache.json");
+    const nlohmann::json data = nlohmann::json::parse(in);
+    REQUIRE(data.size() == 6);
+    CHECK(data.front()["cacheMiB"].get<double>() == 0.0);
+    CHECK(data.front()["hitRatio"].get<double>() == 0.0);
+    CHECK(data.back()["hitRatio"].get<double>() > 0.5);
+    for (std::size_t i = 1; i < data.size(); ++i) CHECK(data[i]["hitRatio"].get<double>() >= data[0]["hitRatio"].get<double>());
+    CHECK(html.find("Every cache size gave the comparison's image bit for bit") != std::string::npos);
   }
   // The sort-last compositing bytes equal the analytic volume (full frame).
   {

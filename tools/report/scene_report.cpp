@@ -18,6 +18,7 @@
 #include "raster/composite/compositor.h"
 #include "tools/compare/comparison.h"
 #include "tools/compare/comparison_output.h"
+#include "tools/report/cache_sweep.h"
 #include "tools/report/classification.h"
 #include "tools/report/html.h"
 #include "tools/report/scaling_model.h"
@@ -364,6 +365,13 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                                  {"color", {{"field", "source"}, {"type", "nominal"}}},
                                  {"tooltip", {{{"field", "source"}}, {{"field", "bytes"}}}}}}},
                   analytic, "Sort-last compositing, measured against the analytic volume");
+
+  // Data management: the cached tracer's hit ratio against its cache size.
+  if (std::find(spec.methods.begin(), spec.methods.end(), "image-space-cached") != spec.methods.end()) {
+    const auto cached = scaling.find("image-space-cached");
+    const image::Image* expected = cached != scaling.end() && cached->second.largest ? &cached->second.largest->image : nullptr;
+    html += cacheSweepSection(spec, input, maxP, expected, dir, relDir);
+  }
 
   // Accuracy against time: the photon map against the path tracer.
   std::fprintf(stderr, "report: %s: accuracy sweep\n", stem.c_str());

@@ -29,6 +29,9 @@ struct ReportSpec {
   // settings from settings.ray.photonmap) and of the path tracer.
   std::vector<int> photonSpp = {1, 4, 16};
   std::vector<int> pathSpp = {1, 4, 16, 64};
+  // Cache sizes (MiB per PE) of the data-management figure, drawn when image-space-cached is
+  // among the methods.
+  std::vector<double> cacheMb = {0.0, 0.25, 1.0, 4.0, 16.0, 64.0};
   LightingOptions lighting;
 };
 
