@@ -1,5 +1,6 @@
 // Object partitioning's data split: scene objects cut into pieces of bounded size by spatial
-// median splits, and pieces dealt to PEs in runs of equal triangle count along a Morton curve.
+// median splits, the pieces rays reach most per triangle replicated within a budget, and the
+// others dealt to PEs in runs of equal triangle count along a Morton curve.
 // Built once per frame by the controlling thread, before the trace stage
 // (object_partition.cpp); read-only afterwards.
 #include "raytrace/partition/object_assignment.h"
@@ -114,33 +115,56 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
     if (!covered[t]) rest.push_back(t);
   if (!rest.empty()) splitPiece(s, static_cast<uint32_t>(s.objects.size()), std::move(rest), maxPiece, pieces_);
 
-  // Pieces in the order of a Morton curve through their centres, cut into P runs of about
-  // equal triangle count: each PE owns a compact region of the scene, so a ray is answered by
-  // few owners (often by its originator's own pieces alone) and an owner's part of the
-  // directory is one subtree the walk skips whole (owner_directory.h).
+  // Replicated pieces, most reached per triangle first (ties: the lower piece), while they fit
+  // the budget.
+  uint64_t budget = pes > 1 ? uint64_t(std::max(0.0, options.replicatedFraction) * double(total)) : 0;
+  if (budget > 0) {
+    auto exposure = [&](const ObjectPiece& p) {
+      const glm::vec3 e = p.bounds.extent();
+      return (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x) / double(p.triangles.size());
+    };
+    std::vector<uint32_t> order(pieces_.size());
+    std::iota(order.begin(), order.end(), 0u);
+    std::stable_sort(order.begin(), order.end(), [&](uint32_t x, uint32_t y) { return exposure(pieces_[x]) > exposure(pieces_[y]); });
+    for (uint32_t p : order) {
+      ObjectPiece& piece = pieces_[p];
+      if (piece.bounds.empty() || piece.triangles.size() > budget) continue;
+      budget -= piece.triangles.size();
+      piece.owner = kEveryPe;
+      replicated_.insert(replicated_.end(), piece.triangles.begin(), piece.triangles.end());
+    }
+    std::sort(replicated_.begin(), replicated_.end());
+  }
+
+  // The other pieces in the order of a Morton curve through their centres, cut into P runs of
+  // about equal triangle count: each PE owns a compact region of the scene, so a ray is
+  // answered by few owners (often by its originator's own pieces alone) and an owner's part of
+  // the directory is one subtree the walk skips whole (owner_directory.h).
   scene::Bounds all;
   for (const ObjectPiece& p : pieces_) all.extend(p.bounds);
   std::vector<uint64_t> key(pieces_.size());
   for (size_t p = 0; p < pieces_.size(); ++p) key[p] = mortonKey(pieces_[p].bounds.center(), all);
-  curveOrder_.resize(pieces_.size());
-  std::iota(curveOrder_.begin(), curveOrder_.end(), 0u);
+  for (uint32_t p = 0; p < pieces_.size(); ++p)
+    if (pieces_[p].owner != kEveryPe) curveOrder_.push_back(p);
   std::stable_sort(curveOrder_.begin(), curveOrder_.end(), [&](uint32_t x, uint32_t y) { return key[x] < key[y]; });
+  const uint64_t owned = total - replicated_.size();
   uint64_t before = 0;  // triangles of the pieces before this one on the curve
   for (uint32_t p : curveOrder_) {
     const uint64_t n = pieces_[p].triangles.size();
     // The PE whose share of the curve holds the piece's middle triangle.
     const uint64_t middle = before + n / 2;
-    pieces_[p].owner = int(std::min<uint64_t>(uint64_t(pes) - 1, middle * uint64_t(pes) / std::max<uint64_t>(1, total)));
+    pieces_[p].owner = int(std::min<uint64_t>(uint64_t(pes) - 1, middle * uint64_t(pes) / std::max<uint64_t>(1, owned)));
     before += n;
   }
 
   perPe_.assign(pes, {});
   piecesOf_.assign(pes, {});
-  for (uint32_t p = 0; p < pieces_.size(); ++p) {
+  for (uint32_t p : curveOrder_) {
     const ObjectPiece& piece = pieces_[p];
     piecesOf_[piece.owner].push_back(p);
     perPe_[piece.owner].insert(perPe_[piece.owner].end(), piece.triangles.begin(), piece.triangles.end());
   }
+  for (auto& pieces : piecesOf_) std::sort(pieces.begin(), pieces.end());
   for (auto& tris : perPe_) std::sort(tris.begin(), tris.end());
 }
 

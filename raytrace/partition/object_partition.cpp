@@ -9,6 +9,8 @@
 // order of Hit::closerThan, so the image does not depend on arrival order. A hit reply carries
 // the SurfaceInteraction the owner made from its own geometry; the originator shades with it
 // and originates the spawned rays. A shadow ray stops at the first owner with an occluder.
+// Replicated pieces (object_assignment.h) are in every PE's second BVH: the directory lists
+// them as the owner kEveryPe, which the originator answers itself, like its own pieces.
 #include "raytrace/partition/object_partition.h"
 
 #include <atomic>
@@ -47,14 +49,16 @@ using ReplyBatch = std::vector<HitReply>;
 
 class ObjectFrame {
  public:
-  ObjectFrame(const TraceJob& job, par::Runtime& rt, uint32_t maxPieceTriangles)
+  ObjectFrame(const TraceJob& job, par::Runtime& rt, uint32_t maxPieceTriangles, double replicatedFraction)
       : job_(job),
         rt_(rt),
-        assignment_(job.scene, {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position())}),
+        assignment_(job.scene,
+                    {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position()), replicatedFraction}),
         directory_(assignment_),
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
+        replicas_(rt.pes()),
         views_(job, rt.pes()),
         state_(rt.pes()) {}
 
@@ -64,7 +68,11 @@ class ObjectFrame {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
         bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);
-      views_.build(p, assignment_.triangles(p), integrator_->context().lights());
+      if (!assignment_.replicated().empty())
+        replicas_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.replicated(), job_.options.bvh);
+      std::vector<uint32_t> held(assignment_.triangles(p).begin(), assignment_.triangles(p).end());
+      held.insert(held.end(), assignment_.replicated().begin(), assignment_.replicated().end());
+      views_.build(p, held, integrator_->context().lights());
     });
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -85,8 +93,10 @@ class ObjectFrame {
     queries_ = &queries;
     hits_ = &hits;
     // Materials, textures, lights and the owner directory are replicated on every PE, and so
-    // are the emitters (area-light sampling); other geometry is not.
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
+    // are the emitters (area-light sampling) and the replicated pieces; other geometry is not.
+    if (!job_.sceneResident)
+      recordReplicatedData(rt_, job_.scene, integrator_->context().lights(),
+                           directory_.bytes() + assignment_.replicated().size() * kTriangleVertexBytes);
     rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
@@ -111,9 +121,9 @@ class ObjectFrame {
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
     PartitionHoldings held;
     for (int p = 0; p < pes; ++p) {
-      const uint64_t n = assignment_.triangles(p).size();
+      const uint64_t n = assignment_.triangles(p).size() + assignment_.replicated().size();
       held.triangles.push_back(n);
-      held.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + n * kTriangleVertexBytes);
+      held.geometryBytes.push_back(bvhs_[p].stats().memoryBytes + replicas_[p].stats().memoryBytes + n * kTriangleVertexBytes);
       held.partitionsOwned.push_back(assignment_.piecesOf(p).size());
     }
     std::vector<TraceStats> raysTraced;
@@ -191,8 +201,8 @@ class ObjectFrame {
       ++p.next;
       Ray ray = p.message.ray;
       if (p.best.found) ray.tMax = p.best.hit.t;  // inclusive: an equal t with a lower triangle still wins
-      if (e.owner == pe.id()) {
-        merge(p, answer(pe.id(), ray, slot, shadow));
+      if (e.owner == pe.id() || e.owner == kEveryPe) {
+        merge(p, answer(pe.id(), e.owner == kEveryPe ? replicas_[pe.id()] : bvhs_[pe.id()], ray, slot, shadow));
         continue;
       }
       queries_->send(pe, e.owner, RayQuery{ray, slot, uint16_t(pe.id()), shadow});
@@ -203,11 +213,11 @@ class ObjectFrame {
     resolve(pe, st, slot);
   }
 
-  // On an owner: the nearest hit among its own triangles (or whether any occludes).
-  HitReply answer(int pe, const Ray& ray, uint32_t slot, bool shadow) const {
+  // On an owner: the nearest hit among the triangles of `bvh`, its own or its replicas (or
+  // whether any occludes).
+  HitReply answer(int pe, const Bvh& bvh, const Ray& ray, uint32_t slot, bool shadow) const {
     HitReply r;
     r.slot = slot;
-    const Bvh& bvh = bvhs_[pe];
     if (shadow) {
       r.found = bvh.occluded(ray);
     } else if (bvh.intersect(ray, r.hit)) {
@@ -219,7 +229,7 @@ class ObjectFrame {
 
   void answerRemote(par::Pe& pe, const RayQuery& q) {
     PeState& st = state_[pe.id()];
-    HitReply r = answer(pe.id(), q.ray, q.slot, q.shadow);
+    HitReply r = answer(pe.id(), bvhs_[pe.id()], q.ray, q.slot, q.shadow);
     const size_t bytes = r.found && !q.shadow ? sizeof(HitReply) : kReplyHeaderBytes;
     hits_->send(pe, q.origin, std::move(r), bytes);
     ++st.repliesSent;
@@ -263,6 +273,7 @@ class ObjectFrame {
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;
+  std::vector<Bvh> replicas_;  // per PE: its copy of the replicated pieces
   SceneViews views_;
   std::vector<PeState> state_;
   par::BatchedChannel<RayQuery>* queries_ = nullptr;
@@ -273,7 +284,7 @@ class ObjectFrame {
 
 TraceResult ObjectPartition::render(const TraceJob& job, par::Runtime& rt) {
   checkRayBatch(job.options, "object partitioning");
-  ObjectFrame frame(job, rt, maxPieceTriangles_);
+  ObjectFrame frame(job, rt, maxPieceTriangles_, replicatedFraction_);
   return frame.run();
 }
 

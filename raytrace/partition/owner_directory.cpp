@@ -12,21 +12,23 @@ namespace pr::rt {
 
 OwnerDirectory::OwnerDirectory(const ObjectAssignment& assignment) {
   std::vector<scene::Bounds> ownerBounds(size_t(assignment.pes()));
+  scene::Bounds replicated;  // listed as one more owner, kEveryPe
   for (const ObjectPiece& p : assignment.pieces())
-    if (!p.bounds.empty()) ownerBounds[size_t(p.owner)].extend(p.bounds);
-  init(ownerBounds, assignment.margin());
+    if (!p.bounds.empty()) (p.owner == kEveryPe ? replicated : ownerBounds[size_t(p.owner)]).extend(p.bounds);
+  init(ownerBounds, assignment.margin(), replicated);
 }
 
-OwnerDirectory::OwnerDirectory(std::span<const scene::Bounds> boxes, float margin) { init(boxes, margin); }
+OwnerDirectory::OwnerDirectory(std::span<const scene::Bounds> boxes, float margin) { init(boxes, margin, {}); }
 
-void OwnerDirectory::init(std::span<const scene::Bounds> boxes, float margin) {
-  for (size_t o = 0; o < boxes.size(); ++o) {
-    scene::Bounds grown = boxes[o];
-    if (grown.empty()) continue;
+void OwnerDirectory::init(std::span<const scene::Bounds> boxes, float margin, const scene::Bounds& everyPe) {
+  auto add = [&](scene::Bounds grown, int owner) {
+    if (grown.empty()) return;
     grown.min -= glm::vec3(margin);
     grown.max += glm::vec3(margin);
-    leaves_.push_back({grown, int(o)});
-  }
+    leaves_.push_back({grown, owner});
+  };
+  for (size_t o = 0; o < boxes.size(); ++o) add(boxes[o], int(o));
+  add(everyPe, kEveryPe);
   if (leaves_.empty()) return;
   nodes_.reserve(2 * leaves_.size());
   nodes_.emplace_back();

@@ -27,7 +27,8 @@ struct OwnerEntry {
 class OwnerDirectory {
  public:
   OwnerDirectory() = default;
-  // Over the owners of the assignment's pieces, each with the union of its pieces' bounds.
+  // Over the owners of the assignment's pieces, each with the union of its pieces' bounds; the
+  // replicated pieces are one more owner, kEveryPe, which every PE answers for itself.
   explicit OwnerDirectory(const ObjectAssignment& assignment);
   // Over any boxes, grown by margin: entry i is box i (an empty box is never reached); the
   // "owners" it lists are box indices (the data items of image-space-cached).
@@ -75,7 +76,7 @@ class OwnerDirectory {
     scene::Bounds box;  // the owner's pieces' bounds, grown by the margin
     int owner = 0;
   };
-  void init(std::span<const scene::Bounds> boxes, float margin);
+  void init(std::span<const scene::Bounds> boxes, float margin, const scene::Bounds& everyPe);
   void build(uint32_t node, uint32_t begin, uint32_t end);
 
   std::vector<Node> nodes_;

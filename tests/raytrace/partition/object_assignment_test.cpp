@@ -97,6 +97,42 @@ TEST_CASE("ObjectAssignment: PEs are balanced by triangle count") {
   CHECK_THROWS_AS(ObjectAssignment(s, {0, 0, 0.0f}), pr::InputError);
 }
 
+TEST_CASE("ObjectAssignment: the small pieces rays reach most are replicated, within the budget") {
+  // The soups of objectsScene and a floor of two triangles under all of them: per triangle the
+  // floor's bounds are hundreds of times larger than a soup piece's, so it is replicated first;
+  // a soup piece (75 triangles) does not fit the rest of a 1% budget (12 triangles).
+  pr::scene::Scene s = objectsScene({900, 100, 100, 100});
+  pr::scene::Object floor;
+  floor.firstTriangle = uint32_t(s.triangles.size());
+  floor.triangleCount = 2;
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, -50}, {50, -5, 50});
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, 50}, {-50, -5, 50});
+  s.objects.push_back(floor);
+  const ObjectAssignment a(s, {4, 0, 0.0f, 0.01});
+  REQUIRE(a.replicated().size() == 2);
+  CHECK(a.replicated()[0] == floor.firstTriangle);
+  CHECK(a.replicated()[1] == floor.firstTriangle + 1);
+  size_t owned = 0;
+  for (int pe = 0; pe < 4; ++pe) {
+    owned += a.triangles(pe).size();
+    for (uint32_t t : a.triangles(pe)) CHECK(t < floor.firstTriangle);
+  }
+  CHECK(owned == 1200);
+  for (const auto& piece : a.pieces()) CHECK((piece.owner == pr::rt::kEveryPe) == (piece.object == 4));
+  CHECK(a.curveOrder().size() == a.pieces().size() - 1);
+  // The directory lists the replicated pieces as one owner, kEveryPe, where a ray meets them.
+  const pr::rt::OwnerDirectory directory(a);
+  std::vector<pr::rt::OwnerEntry> owners;
+  std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
+  directory.ownersNearestFirst(Ray{{20, 10, 20}, 0.0f, {0, -1, 0}, 100.0f}, -1, owners, heap);
+  REQUIRE(owners.size() == 1);
+  CHECK(owners[0].owner == pr::rt::kEveryPe);
+  CHECK(owners[0].t == doctest::Approx(15.0f));
+  // One PE, or no budget: nothing is replicated.
+  CHECK(ObjectAssignment(s, {1, 0, 0.0f, 0.01}).replicated().empty());
+  CHECK(ObjectAssignment(s, {4, 0, 0.0f, 0.0}).replicated().empty());
+}
+
 TEST_CASE("ObjectAssignment: triangles outside every object form one more object") {
   pr::scene::Scene s = pr::test::randomSoup(30);  // built in code: no Scene::objects
   const ObjectAssignment a(s, {2, 0, 0.0f});

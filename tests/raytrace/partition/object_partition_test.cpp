@@ -13,6 +13,8 @@
 #include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/integrators/integrator_scenes.h"
+#include "raytrace/partition/object_assignment.h"
+#include "raytrace/partition/object_partition.h"
 #include "raytrace/partition/partitioned_test_support.h"
 
 using namespace pr;
@@ -39,7 +41,9 @@ void checkScene(const std::filesystem::path& file, rt::IntegratorKind kind, int 
     test::checkTraffic(run, p);
     uint64_t held = 0;
     for (uint64_t n : run.figures.triangles) held += n;
-    CHECK(held == s.triangles.size());  // objects are not duplicated, unlike straddling voxels
+    // Objects are not duplicated, unlike straddling voxels, but for the replicated pieces.
+    const rt::ObjectAssignment assignment(s, {p, maxPieceTriangles, 0.0f, rt::kReplicatedFraction});
+    CHECK(held == s.triangles.size() + uint64_t(p - 1) * assignment.replicated().size());
   }
 }
 
@@ -155,7 +159,32 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
   }
 }
 
-TEST_CASE("ObjectPartition: PEs hold balanced, disjoint geometry") {
+TEST_CASE("ObjectPartition: replicated walls are answered on the originator, without a query") {
+  // The two walls of the test above, both replicated (a budget of every triangle): each PE
+  // holds both, and the ray that reached the other PE's wall is answered where it started.
+  scene::Scene s = test::emptyScene();
+  for (float x : {-3.0f, 3.0f}) {
+    scene::Object obj;
+    obj.firstTriangle = uint32_t(s.triangles.size());
+    obj.triangleCount = 2;
+    test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
+    test::addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
+    s.objects.push_back(obj);
+  }
+  const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
+  const image::Image reference = test::renderSequential(s, cam, 2, 1, opt);
+  rt::ObjectPartition partition(0, 1.0);
+  const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 2, 1, opt, 2);
+  test::checkTraffic(run, 2);
+  CHECK(run.image.pixels == reference.pixels);
+  CHECK(run.result.rays.total() == 2);
+  CHECK(run.figures.raysSent == 0u);
+  CHECK(run.figures.hitsSent == 0u);
+  CHECK(run.figures.triangles == std::vector<uint64_t>{4, 4});
+}
+
+TEST_CASE("ObjectPartition: PEs hold balanced geometry, disjoint but for the replicated pieces") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
   rt::ObjectPartition partition;
@@ -168,7 +197,9 @@ TEST_CASE("ObjectPartition: PEs hold balanced, disjoint geometry") {
     lo = std::min(lo, run.figures.triangles[p]);
     hi = std::max(hi, run.figures.triangles[p]);
   }
-  CHECK(triangles == s.triangles.size());
+  const rt::ObjectAssignment assignment(s, {4, 0, 0.0f, rt::kReplicatedFraction});
+  CHECK(!assignment.replicated().empty());  // the floor and the back wall
+  CHECK(triangles == s.triangles.size() + 3 * assignment.replicated().size());
   CHECK(double(hi) <= 1.1 * double(lo));  // LPT over pieces of at most 1/16 of the scene
   test::checkTraffic(run, 4);
   CHECK(run.figures.raysSent > 0);
