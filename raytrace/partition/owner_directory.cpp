@@ -107,6 +107,17 @@ bool OwnerDirectory::NearestFirst::next(float maxT, OwnerEntry& out) {
 void OwnerDirectory::ownersNearestFirst(const Ray& ray, int except, std::vector<OwnerEntry>& out,
                                         std::vector<NodeEntry>& heap) const {
   out.clear();
+  // A few owners: one box test each and a sort of what is reached costs less than the walk's
+  // inner boxes and heap (at P = 2 the walk was a tenth of object partitioning's trace time).
+  if (leaves_.size() <= kScannedOwners) {
+    const RaySlabs slabs(ray);
+    for (const Node& n : nodes_) {
+      float t;
+      if (n.leaf && leaves_[n.first].owner != except && slabs.entry(n.lo, n.hi, t)) out.push_back({t, leaves_[n.first].owner});
+    }
+    std::sort(out.begin(), out.end(), [](const OwnerEntry& x, const OwnerEntry& y) { return x.t < y.t || (x.t == y.t && x.owner < y.owner); });
+    return;
+  }
   NearestFirst walk(*this, ray, except, heap);
   OwnerEntry e;
   while (walk.next(kInfinity, e)) out.push_back(e);

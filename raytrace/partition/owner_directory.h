@@ -40,7 +40,10 @@ class OwnerDirectory {
     uint32_t node = 0;
   };
   // The owners other than `except` whose pieces the ray reaches for t in [tMin, tMax], each
-  // once with its nearest entry, nearest first. A pure function of the ray and `except`.
+  // once with its nearest entry, nearest first (equal entries: the lower owner first, up to
+  // kScannedOwners owners, which are tested one by one; the tree's order beyond). A pure
+  // function of the ray and `except`.
+  static constexpr size_t kScannedOwners = 8;
   void ownersNearestFirst(const Ray& ray, int except, std::vector<OwnerEntry>& out, std::vector<NodeEntry>& heap) const;
   // The owners a ray reaches, one at a time, nearest first, walking only as far as asked: the
   // cheap form when the search stops at the closest hit.

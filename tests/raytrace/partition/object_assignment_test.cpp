@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <limits>
 #include <random>
 #include <set>
 #include <vector>
@@ -143,50 +144,62 @@ TEST_CASE("ObjectAssignment: triangles outside every object form one more object
 TEST_CASE("OwnerDirectory: a ray lists every owner of a triangle it hits, nearest first, no later than the hit") {
   const pr::scene::Scene s = objectsScene({200, 150, 120, 90, 60, 30});
   const glm::vec3 eye(7.0f, 0.5f, 6.0f);
-  const ObjectAssignment a(s, {4, 50, pr::rt::partitionMargin(s, eye)});
-  const pr::rt::OwnerDirectory directory(a);
-  CHECK(directory.bytes() > 0u);
-  std::vector<pr::rt::Bvh> bvhs;
-  for (int pe = 0; pe < 4; ++pe) bvhs.emplace_back(s.positions, s.triangles, a.triangles(pe));
-  std::mt19937 rng(13);
-  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
-  std::vector<pr::rt::OwnerEntry> owners, others;
-  std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
-  size_t asked = 0, hits = 0;
-  for (int i = 0; i < 400; ++i) {
-    Ray ray;
-    ray.origin = eye;
-    // Aimed at a triangle's centroid (most rays hit), or anywhere near the objects.
-    const auto& tri = s.triangles[size_t(i * 7) % s.triangles.size()];
-    const glm::vec3 target = i % 3 == 0 ? glm::vec3(7.5f * u(rng) + 7.5f, u(rng), u(rng))
-                                        : (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) / 3.0f;
-    ray.direction = glm::normalize(target - eye);
-    if (i % 4 == 0) ray.tMax = 3.0f;  // short segments skip far owners
-    directory.ownersNearestFirst(ray, -1, owners, heap);
-    CHECK(std::is_sorted(owners.begin(), owners.end(), [](const auto& x, const auto& y) { return x.t < y.t; }));
-    std::set<int> distinct;
-    for (const auto& e : owners) distinct.insert(e.owner);
-    CHECK(distinct.size() == owners.size());
-    asked += owners.size();
-    for (int pe = 0; pe < 4; ++pe) {
-      pr::rt::Hit h;
-      if (!bvhs[pe].intersect(ray, h)) continue;
-      ++hits;
-      auto it = std::find_if(owners.begin(), owners.end(), [&](const auto& e) { return e.owner == pe; });
-      REQUIRE(it != owners.end());
-      CHECK(it->t <= h.t);
+  // 4 owners are tested one by one, 16 through the directory's tree.
+  for (int pes : {4, 16}) {
+    CAPTURE(pes);
+    const ObjectAssignment a(s, {pes, 10, pr::rt::partitionMargin(s, eye)});
+    const pr::rt::OwnerDirectory directory(a);
+    CHECK(directory.bytes() > 0u);
+    std::vector<pr::rt::Bvh> bvhs;
+    for (int pe = 0; pe < pes; ++pe) bvhs.emplace_back(s.positions, s.triangles, a.triangles(pe));
+    std::mt19937 rng(13);
+    std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+    std::vector<pr::rt::OwnerEntry> owners, others;
+    std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
+    size_t asked = 0, hits = 0;
+    for (int i = 0; i < 400; ++i) {
+      Ray ray;
+      ray.origin = eye;
+      // Aimed at a triangle's centroid (most rays hit), or anywhere near the objects.
+      const auto& tri = s.triangles[size_t(i * 7) % s.triangles.size()];
+      const glm::vec3 target = i % 3 == 0 ? glm::vec3(7.5f * u(rng) + 7.5f, u(rng), u(rng))
+                                          : (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) / 3.0f;
+      ray.direction = glm::normalize(target - eye);
+      if (i % 4 == 0) ray.tMax = 3.0f;  // short segments skip far owners
+      directory.ownersNearestFirst(ray, -1, owners, heap);
+      CHECK(std::is_sorted(owners.begin(), owners.end(), [](const auto& x, const auto& y) { return x.t < y.t; }));
+      std::set<int> distinct;
+      for (const auto& e : owners) distinct.insert(e.owner);
+      CHECK(distinct.size() == owners.size());
+      asked += owners.size();
+      // The same owners at the same entries as the walk through the directory's tree.
+      std::vector<std::pair<float, int>> listed, walked;
+      for (const auto& e : owners) listed.push_back({e.t, e.owner});
+      pr::rt::OwnerDirectory::NearestFirst walk(directory, ray, -1, heap);
+      for (pr::rt::OwnerEntry e; walk.next(std::numeric_limits<float>::infinity(), e);) walked.push_back({e.t, e.owner});
+      std::sort(listed.begin(), listed.end());
+      std::sort(walked.begin(), walked.end());
+      CHECK(listed == walked);
+      for (int pe = 0; pe < pes; ++pe) {
+        pr::rt::Hit h;
+        if (!bvhs[pe].intersect(ray, h)) continue;
+        ++hits;
+        auto it = std::find_if(owners.begin(), owners.end(), [&](const auto& e) { return e.owner == pe; });
+        REQUIRE(it != owners.end());
+        CHECK(it->t <= h.t);
+      }
+      // Leaving one owner out lists the others in the same order.
+      const int except = i % pes;
+      directory.ownersNearestFirst(ray, except, others, heap);
+      std::vector<int> expected, got;
+      for (const auto& e : owners)
+        if (e.owner != except) expected.push_back(e.owner);
+      for (const auto& e : others) got.push_back(e.owner);
+      CHECK(got == expected);
     }
-    // Leaving one owner out lists the others in the same order.
-    const int except = i % 4;
-    directory.ownersNearestFirst(ray, except, others, heap);
-    std::vector<int> expected, got;
-    for (const auto& e : owners)
-      if (e.owner != except) expected.push_back(e.owner);
-    for (const auto& e : others) got.push_back(e.owner);
-    CHECK(got == expected);
+    CHECK(hits > 100);
+    CHECK(asked < size_t(pes) * 400);  // bounds culling asks fewer owners than a broadcast would
   }
-  CHECK(hits > 100);
-  CHECK(asked < 4 * 400);  // bounds culling asks fewer owners than a broadcast would
 }
 
 TEST_CASE("ObjectAssignment: owners get compact regions along the Morton curve") {
