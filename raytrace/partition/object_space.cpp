@@ -1,11 +1,13 @@
-// The object-space tracer. Stage "build": each owner's voxels get a BVH over the triangles
-// they hold. Stage "trace": image tiles are tasks that make camera rays; a ray is traced on
+// The object-space tracer. Stage "build": each owner builds one BVH over the triangles its
+// voxels hold. Stage "trace": image tiles are tasks that make camera rays; a ray is traced on
 // the PE owning the voxel it is in, and sent (a TravellingRay in a batch on the "rays"
 // BatchedChannel) to the owner of the next voxel along it when it leaves without a hit; the
-// owner resumes the walk at that voxel. A voxel accepts only a
-// hit up to the end of the ray's span in it, so the first voxel that reports a hit reports the
-// ray's closest hit, the same one (bit for bit) as the BVH over the whole scene. Shadow rays
-// stop at the first voxel that reports any occluder. Shading and spawning happen on the PE
+// owner resumes the walk at that voxel. Each run of consecutive voxels of one owner along the
+// ray is one query of the owner's BVH, which accepts only a hit up to the end of the run, so
+// the first run that reports a hit reports the ray's closest hit, the same one (bit for bit)
+// as the BVH over the whole scene. A shadow ray is blocked by any occluder on it, found in
+// any order: it visits each owner on its way once, in the order of the owners' first voxels
+// along it, and stops at the first that reports one. Shading and spawning happen on the PE
 // that found the hit; new rays start from there. The stage ends when no tile, ray or message
 // is left (termination.h).
 #include "raytrace/partition/object_space.h"
@@ -53,20 +55,22 @@ class ObjectSpaceFrame {
         owners_(assignVoxelOwners(split_, rt.pes())),
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
-        bvhs_(split_.voxels()),
+        bvhs_(rt.pes()),
+        held_(rt.pes()),
         views_(job, rt.pes()),
         state_(rt.pes()) {}
 
   TraceResult run() {
     const int pes = rt_.pes();
-    // Each owner builds the BVHs of its own voxels (task t: the voxels of PE t).
+    // Each owner builds one BVH over its voxels' triangles (a triangle straddling two of them
+    // once): task t is PE t's.
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
-      std::vector<uint32_t> held;
+      std::vector<uint32_t>& held = held_[size_t(pe.id())];
       for (int v = 0; v < split_.voxels(); ++v)
-        if (owners_[v] == pe.id() && !split_.triangles(v).empty()) {
-          bvhs_[v] = Bvh(job_.scene.positions, job_.scene.triangles, split_.triangles(v), job_.options.bvh);
-          held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
-        }
+        if (owners_[v] == pe.id()) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
+      std::sort(held.begin(), held.end());
+      held.erase(std::unique(held.begin(), held.end()), held.end());
+      if (!held.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, held, job_.options.bvh);
       views_.build(pe.id(), held, integrator_->context().lights());
     });
 
@@ -105,10 +109,10 @@ class ObjectSpaceFrame {
     TraceResult result{films_[kAssemblerPe]->toImage(), {}, tiles.size()};
     PartitionHoldings held{std::vector<uint64_t>(size_t(pes), 0), std::vector<uint64_t>(size_t(pes), 0),
                            std::vector<uint64_t>(size_t(pes), 0)};
-    for (int v = 0; v < split_.voxels(); ++v) {
-      held.geometryBytes[owners_[v]] += bvhs_[v].stats().memoryBytes + split_.triangles(v).size() * kTriangleVertexBytes;
-      held.triangles[owners_[v]] += split_.triangles(v).size();
-      held.partitionsOwned[owners_[v]] += 1;
+    for (int v = 0; v < split_.voxels(); ++v) held.partitionsOwned[owners_[v]] += 1;
+    for (int p = 0; p < pes; ++p) {
+      held.triangles[p] = held_[size_t(p)].size();
+      held.geometryBytes[p] = bvhs_[size_t(p)].stats().memoryBytes + held_[size_t(p)].size() * kTriangleVertexBytes;
     }
     std::vector<TraceStats> raysTraced;
     for (int p = 0; p < pes; ++p) {
@@ -126,6 +130,7 @@ class ObjectSpaceFrame {
   struct alignas(64) PeState {
     std::vector<TravellingRay> work;  // rays to trace here, depth first
     std::vector<RayMessage> spawned;
+    std::vector<VoxelSpan> shadowOwners;  // a shadow ray's owners, each at its first voxel
     TraceStats stats;
     uint64_t raysSent = 0;
   };
@@ -142,19 +147,29 @@ class ObjectSpaceFrame {
     }
   }
 
-  // Walks the ray from where it entered this PE's voxel: traces it in each voxel this PE owns,
-  // in order along the ray, until it hits, is blocked, or reaches another owner's voxel.
+  // Walks the ray from where it entered this PE's voxel: traces it through each run of this
+  // PE's voxels along it, until it hits or reaches another owner's voxel.
   void advance(par::Pe& pe, PeState& st, const TravellingRay& item) {
     const RayMessage& m = item.message;
+    if (m.kind == RayKind::Shadow) return advanceShadow(pe, st, item);
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     bool reached = item.voxel == TravellingRay::kStartVoxel;  // at the voxel the walk resumes in
-    bool finished = false;  // hit, blocked or sent on
+    bool finished = false;  // hit or sent on
+    bool run = false;       // a run of this PE's voxels is open, up to runExit
+    float runExit = 0.0f;
     auto visit = [&](const VoxelSpan& s) {
       if (!reached) {
         if (s.voxel != item.voxel) return true;
         reached = true;
       }
-      finished = traceInVoxel(pe, st, m, s, emit);
+      if (split_.triangles(s.voxel).empty()) return true;  // nothing to hit: no owner needs the ray
+      if (owners_[s.voxel] == pe.id()) {
+        run = true;
+        runExit = s.tExit;
+        return true;
+      }
+      finished = (run && traceRun(pe, st, m, runExit, emit)) || sendOn(pe, st, m, s);
+      run = false;
       return !finished;
     };
     // The walk from tEnter gives the same spans from the voxel on as the walk from the origin,
@@ -165,28 +180,47 @@ class ObjectSpaceFrame {
     split_.walk(resume, visit);
     if (!reached) split_.walk(m.ray, visit);
     PR_CHECK(reached, "object-space: a ray sent to a voxel its walk does not pass");
-    if (!finished) integrator_->miss(m, emit);  // left the scene (a shadow ray: unoccluded)
+    if (!finished && run) finished = traceRun(pe, st, m, runExit, emit);
+    if (!finished) integrator_->miss(m, emit);  // left the scene
   }
 
-  // The ray in one voxel of its walk; true when the ray is done here (hit, blocked, or sent to
-  // the voxel's owner).
-  bool traceInVoxel(par::Pe& pe, PeState& st, const RayMessage& m, const VoxelSpan& s, Emit& emit) {
-    const uint32_t v = s.voxel;
-    if (split_.triangles(v).empty()) return false;  // nothing to hit: no owner needs the ray
-    if (owners_[v] != pe.id()) {
-      rays_->send(pe, owners_[v], TravellingRay{m, s.tEnter, v});
-      ++st.raysSent;
+  // A shadow ray: this PE tests the whole ray against its triangles once, then hands it to the
+  // owner whose first voxel along the ray comes next; a new ray goes to the first owner.
+  void advanceShadow(par::Pe& pe, PeState& st, const TravellingRay& item) {
+    const RayMessage& m = item.message;
+    std::vector<VoxelSpan>& owners = st.shadowOwners;
+    owners.clear();
+    split_.walk(m.ray, [&](const VoxelSpan& s) {
+      if (split_.triangles(s.voxel).empty()) return true;
+      const int owner = owners_[s.voxel];
+      if (std::none_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; }))
+        owners.push_back(s);
       return true;
+    });
+    auto me = std::find_if(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == pe.id(); });
+    if (item.voxel == TravellingRay::kStartVoxel && me != owners.begin()) {
+      me = owners.begin();  // a new ray starts at the first owner on it (or has none)
+    } else {
+      PR_CHECK(me != owners.end(), "object-space: a shadow ray sent to a PE that owns no voxel on it");
+      if (bvhs_[size_t(pe.id())].occluded(m.ray)) return;  // blocked
+      ++me;
     }
-    const Bvh& bvh = bvhs_[v];
-    // Any occluder anywhere on the segment blocks a shadow ray, wherever it lies along the ray.
-    if (m.kind == RayKind::Shadow) return bvh.occluded(m.ray);
-    // Only hits up to the end of the span: a farther one may be behind a nearer triangle held
+    if (me != owners.end()) {
+      sendOn(pe, st, m, *me);
+      return;
+    }
+    Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
+    integrator_->miss(m, emit);  // no owner holds an occluder: unoccluded
+  }
+
+  // The ray in a run of this PE's voxels that ends at runExit: true when it hits there.
+  bool traceRun(par::Pe& pe, PeState& st, const RayMessage& m, float runExit, Emit& emit) {
+    // Only hits up to the end of the run: a farther one may be behind a nearer triangle held
     // by a later voxel.
     Ray clipped = m.ray;
-    clipped.tMax = std::min(m.ray.tMax, s.tExit);
+    clipped.tMax = std::min(m.ray.tMax, runExit);
     Hit hit;
-    if (!bvh.intersect(clipped, hit)) return false;
+    if (!bvhs_[size_t(pe.id())].intersect(clipped, hit)) return false;
     integrator_->shade(makeInteraction(views_.of(pe.id()), m.ray, hit), m, emit);
     for (const RayMessage& r : st.spawned) {
       ++(r.kind == RayKind::Shadow ? st.stats.shadowRays : st.stats.continuationRays);
@@ -196,13 +230,21 @@ class ObjectSpaceFrame {
     return true;
   }
 
+  // Sends the ray to the owner of the voxel of span s, where its walk resumes. Always true.
+  bool sendOn(par::Pe& pe, PeState& st, const RayMessage& m, const VoxelSpan& s) {
+    rays_->send(pe, owners_[s.voxel], TravellingRay{m, s.tEnter, s.voxel});
+    ++st.raysSent;
+    return true;
+  }
+
   const TraceJob& job_;
   par::Runtime& rt_;
   VoxelSplit split_;
   std::vector<int> owners_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
-  std::vector<Bvh> bvhs_;
+  std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles
+  std::vector<std::vector<uint32_t>> held_;  // per PE: those triangles, ascending
   SceneViews views_;
   std::vector<PeState> state_;
   par::BatchedChannel<TravellingRay>* rays_ = nullptr;

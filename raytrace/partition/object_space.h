@@ -1,7 +1,7 @@
 // Object-space partitioning (seed section 5.1.2): space is split into voxels (voxel_split.h),
-// each owned by a PE that holds only its voxels' geometry and BVHs; rays are Channel messages
-// that travel from owner to owner in the order they pass the voxels, until they hit inside the
-// voxel being traversed or leave the scene. The owner of a hit shades and sends the rays it
+// each owned by a PE that holds only its voxels' geometry, in one BVH; rays are Channel
+// messages that travel from owner to owner in the order they pass the voxels, until they hit
+// inside the owner's voxels being traversed or leave the scene. The owner of a hit shades and sends the rays it
 // spawns on their way. Termination detection of the runtime ends the frame.
 #pragma once
 
