@@ -159,12 +159,12 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
 
   perPe_.assign(pes, {});
   piecesOf_.assign(pes, {});
-  for (uint32_t p : curveOrder_) {
+  for (uint32_t p = 0; p < pieces_.size(); ++p) {
     const ObjectPiece& piece = pieces_[p];
+    if (piece.owner == kEveryPe) continue;
     piecesOf_[piece.owner].push_back(p);
     perPe_[piece.owner].insert(perPe_[piece.owner].end(), piece.triangles.begin(), piece.triangles.end());
   }
-  for (auto& pieces : piecesOf_) std::sort(pieces.begin(), pieces.end());
   for (auto& tris : perPe_) std::sort(tris.begin(), tris.end());
 }
 

@@ -43,6 +43,12 @@ par::KindTraffic allTraffic(const ComparisonRow& row) {
   return all;
 }
 
+double counterTotal(const ComparisonRow& row, const std::string& name) {
+  for (const par::CounterSummary& c : row.summary.counters)
+    if (c.name == name) return c.total;
+  return 0.0;
+}
+
 std::vector<int> defaultThreadCounts() {
   const int cores = std::max(1, int(std::thread::hardware_concurrency()));
   std::vector<int> out;

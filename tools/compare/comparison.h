@@ -88,6 +88,8 @@ const std::vector<std::string>& comparisonKinds();
 // A row's traffic of one kind (nullptr when none), and of every kind together.
 const par::KindTraffic* kindTraffic(const ComparisonRow& row, const std::string& kind);
 par::KindTraffic allTraffic(const ComparisonRow& row);
+// A named per-PE counter of the row's run, summed over the PEs (0 when the run has none).
+double counterTotal(const ComparisonRow& row, const std::string& name);
 
 // The default values of P: 1, 2, 4, ... up to this machine's cores, and the core count itself.
 std::vector<int> defaultThreadCounts();

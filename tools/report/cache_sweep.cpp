@@ -16,12 +16,6 @@ namespace {
 
 constexpr const char* kMethod = "image-space-cached";
 
-double counterTotal(const par::RunSummary& summary, const std::string& name) {
-  for (const par::CounterSummary& c : summary.counters)
-    if (c.name == name) return c.total;
-  return 0.0;
-}
-
 }  // namespace
 
 std::string cacheSweepSection(const ReportSpec& spec, const RenderInput& input, int pes, const image::Image* expected,
@@ -60,8 +54,8 @@ std::string cacheSweepSection(const ReportSpec& spec, const RenderInput& input, 
     // A run that used no other PE's item has no hit ratio (the table says so, the chart leaves it out).
     if (r.cacheHitRatio >= 0.0) data.push_back({{"cacheMiB", mb}, {"hitRatio", r.cacheHitRatio}, {"wallSeconds", r.wall}});
     rows.push_back({formatNumber(mb, "%.4g"), r.cacheHitRatio >= 0.0 ? formatNumber(r.cacheHitRatio, "%.4f") : "- (no remote item used)",
-                    formatNumber(counterTotal(r.summary, "Cache/misses"), "%.0f"),
-                    formatNumber(counterTotal(r.summary, "Cache/prefetches"), "%.0f"),
+                    formatNumber(counterTotal(r, "Cache/misses"), "%.0f"),
+                    formatNumber(counterTotal(r, "Cache/prefetches"), "%.0f"),
                     formatBytes(fetched ? fetched->bytes : 0), formatNumber(waiting, "%.4f"), formatNumber(r.wall, "%.4f"),
                     same ? "identical" : "DIFFERS"});
   }

@@ -40,12 +40,6 @@ std::uint64_t kindBytes(const ComparisonRow& r, const std::string& kind, bool me
   return !k ? 0 : messages ? k->messages : k->bytes;
 }
 
-double counter(const ComparisonRow& r, const std::string& name) {
-  for (const par::CounterSummary& c : r.summary.counters)
-    if (c.name == name) return c.total;
-  return 0.0;
-}
-
 // The analytic compositing volume of sort-last over the full frame: b A (1 - 1/P) per PE.
 double analyticCompositeBytes(int width, int height, int pes) {
   return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1);
@@ -70,7 +64,7 @@ std::string measuredFigure(const ComparisonRow& r, int width, int height) {
     return std::to_string(kindBytes(r, "primitives", true)) + " primitive messages, " +
            formatBytes(kindBytes(r, "primitives")) + " (P=" + std::to_string(p) + ")";
   if (m == "sort-last")
-    return formatBytes(std::uint64_t(counter(r, "Sort/composite_bytes"))) + " composited, analytic " +
+    return formatBytes(std::uint64_t(counterTotal(r, "Sort/composite_bytes"))) + " composited, analytic " +
            formatBytes(std::uint64_t(analyticCompositeBytes(width, height, p))) + " (P=" + std::to_string(p) + ")";
   return "-";
 }
@@ -339,7 +333,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
         volume.push_back({{"run", r.what.method + " P=" + std::to_string(r.what.pes)}, {"kind", k.kind}, {"bytes", k.bytes},
                           {"messages", k.messages}});
     if (r.what.method == "sort-last" && r.what.pes > 1 && !spec.settings.raster.sparse) {
-      analytic.push_back({{"P", r.what.pes}, {"source", "measured"}, {"bytes", counter(r, "Sort/composite_bytes")}});
+      analytic.push_back({{"P", r.what.pes}, {"source", "measured"}, {"bytes", counterTotal(r, "Sort/composite_bytes")}});
       analytic.push_back({{"P", r.what.pes}, {"source", "analytic b A (P - 1)"},
                           {"bytes", analyticCompositeBytes(spec.width, spec.height, r.what.pes)}});
     }
