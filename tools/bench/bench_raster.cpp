@@ -275,10 +275,13 @@ void benchScene(const std::string& label, const std::string& path, const Options
   for (const raster::SortPointInfo& info : raster::sortPoints()) {
     add(info, std::string(info.name), false, "demand");
     if (info.name == "sort-last") {
-      // Sparse compositing (bounding rectangles), with geometry batches on demand and in equal
-      // contiguous portions (each PE's primitives then cover a part of the screen).
+      // Sparse compositing (bounding rectangles), with geometry batches on demand, in equal
+      // contiguous portions (each PE's primitives then cover a part of the screen), and from
+      // contiguous portions with a PE that finishes its own helping the other (preferred bias:
+      // mostly the same locality, the balance of demand).
       add(info, "sort-last --sparse", true, "demand");
       add(info, "sort-last --sparse --schedule balanced", true, "balanced");
+      add(info, "sort-last --sparse --schedule preferred-bias", true, "preferred-bias");
     }
   }
   // Rounds: every measurement once per round, llvmpipe's and ours taking turns, so that a slow
