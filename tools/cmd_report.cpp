@@ -165,7 +165,7 @@ void addReportCommand(CLI::App& app) {
   auto a = std::make_shared<ReportArgs>();
   report::ReportSpec& s = a->spec;
   for (std::string_view m : renderMethods().names()) s.methods.emplace_back(m);
-  s.schedules = {"demand", "balanced"};
+  s.schedules = {"demand", "balanced", "preferred-bias"};
   CLI::App* cmd = app.add_subcommand("report", "a self-contained HTML report classifying the methods, with the figures measured on each scene");
   cmd->add_option("scenes", a->scenes, "glTF 2.0 scenes (.gltf or .glb)")->required()->check(CLI::ExistingFile);
   cmd->add_option("-o,--output", a->output, "the report's folder (index.html inside; replaced whole when done)")->capture_default_str();
