@@ -343,13 +343,13 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
   magnitude_ = 0.0f;
   if (subset.empty()) return;
 
-  // The build writes each of its arrays once, front to back: 2 MiB pages spare most page faults.
+  // The build writes each of its arrays once, front to back: 2 MiB pages spare most page faults,
+  // and appending (no resize) spares writing zeros first; a build of a large scene is bound by
+  // its first writes to fresh memory, not by the SAH.
   std::vector<BvhTriangle> prepared;
   reserveHugePages(prepared, subset.size());
-  prepared.resize(subset.size());
   std::vector<PrimRef> refs;
   reserveHugePages(refs, subset.size());
-  refs.resize(subset.size());
   for (size_t i = 0; i < subset.size(); ++i) {
     const uint32_t index = subset[i];
     PR_CHECK(index < triangles.size(), "triangle index " + std::to_string(index) + " out of range");
@@ -357,9 +357,9 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
     for (uint32_t v : tri.v)
       PR_CHECK(v < positions.size(), "triangle " + std::to_string(index) + " names a missing vertex");
     bool degenerate = false;
-    prepared[i] = prepareTriangle(positions, tri, index, degenerate);
+    prepared.push_back(prepareTriangle(positions, tri, index, degenerate));
     stats_.degenerateTriangles += degenerate ? 1 : 0;
-    PrimRef& ref = refs[i];
+    PrimRef& ref = refs.emplace_back();
     ref.box.extend(prepared[i].p0);
     ref.box.extend(prepared[i].p1);
     ref.box.extend(prepared[i].p2);
@@ -383,9 +383,9 @@ void Bvh::build(std::span<const glm::vec3> positions, std::span<const scene::Tri
 
   reserveHugePages(nodes_, binary.size() / 2 + 1);
   reserveHugePages(leafBlocks_, stats_.leaves + leafTris.size() / kLeafLanes);
+  // The reserves are upper bounds and stay: what is never written costs no memory, while
+  // shrinking would copy both arrays into fresh memory once more.
   root_ = collapse(binary, 0, leafTris, nodes_, leafBlocks_);
-  nodes_.shrink_to_fit();
-  leafBlocks_.shrink_to_fit();
   bounds_.extend(binary[0].box.lower());
   bounds_.extend(binary[0].box.upper());
 
