@@ -54,10 +54,8 @@ void measureOnce(Run& out, const scene::Scene& s, const scene::Camera& cam, int 
   out.messagesPerRay = double(messages) / double(std::max<uint64_t>(1, result.rays.total()));
   for (const par::StageRecord& st : record.stages) {
     if (st.name == "build") out.buildSeconds = st.wallSeconds;
-    if (st.name == "trace") out.traceSeconds = st.wallSeconds;
-  }
-  for (const par::StageRecord& st : record.stages)
     if (st.name == "trace") {
+      out.traceSeconds = st.wallSeconds;
       double busiest = 0.0, mean = 0.0;
       for (const par::PeStageRecord& pe : st.pes) {
         busiest = std::max(busiest, pe.busySeconds);
@@ -65,6 +63,7 @@ void measureOnce(Run& out, const scene::Scene& s, const scene::Camera& cam, int 
       }
       out.imbalance = mean > 0.0 ? busiest / mean - 1.0 : 0.0;
     }
+  }
 }
 
 // The method at P = 1 and P = 2, taking turns for `rounds` rounds, each the fastest of its
