@@ -2,6 +2,7 @@
 // for `parrender simulate`. Keys are the C++ field names (shared/STYLE.md §2). The derived
 // "summary" block is written from metrics.cpp for readers; it is ignored when reading.
 // Timeline spans are compact arrays [pe, stage, task, start, end, messagesSent, bytesSent].
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <fstream>
@@ -107,6 +108,12 @@ json toJson(const RunRecord& record) {
     json tasks = json::array();
     for (const TaskInfo& t : s.tasks) tasks.push_back({t.costEstimate, t.x, t.y});
     js["tasks"] = tasks;  // [costEstimate, x, y]
+    // The PE holding each task's data, where a renderer named one (preferred-bias regions).
+    if (std::any_of(s.tasks.begin(), s.tasks.end(), [](const TaskInfo& t) { return t.preferredPe >= 0; })) {
+      json preferred = json::array();
+      for (const TaskInfo& t : s.tasks) preferred.push_back(t.preferredPe);
+      js["preferred"] = preferred;
+    }
     if (!s.owners.empty()) js["owners"] = s.owners;  // owner-pinned stages: the PE of each task
     stages.push_back(js);
   }
@@ -273,6 +280,11 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       s.tasks.push_back({numberAs<double>(jt[0], task + " costEstimate"), numberAs<float>(jt[1], task + " x"),
                          numberAs<float>(jt[2], task + " y")});
     }
+    const json preferred = js.value("preferred", json::array());
+    if (!preferred.empty() && preferred.size() != s.tasks.size())
+      throw InputError(origin + ": " + where + " \"preferred\" must name one PE (or -1) per task");
+    for (std::size_t t = 0; t < preferred.size(); ++t)
+      s.tasks[t].preferredPe = numberAs<int>(preferred[t], origin + ": " + where + " preferred PE");
     for (const json& owner : js.value("owners", json::array()))
       s.owners.push_back(numberAs<int>(owner, origin + ": " + where + " owner"));
     if (!s.owners.empty() && s.owners.size() != s.tasks.size())

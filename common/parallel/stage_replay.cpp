@@ -90,6 +90,16 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
                                       : "under --schedule " + r.schedule + " (recorded: " + stage.schedule + ")")
                                : "under its own recorded schedule";
     r.stage.owners.clear();
+    // A task's preferred PE names the PE holding its data in the recorded split; at another P
+    // the data lies elsewhere, so the regions fall back to contiguous portions.
+    if (pes != recordedPes) {
+      bool dropped = false;
+      for (TaskInfo& t : r.stage.tasks.tasks) {
+        dropped = dropped || t.preferredPe >= 0;
+        t.preferredPe = -1;
+      }
+      if (dropped) r.note += " (the tasks' preferred PEs are the recorded split's: dropped)";
+    }
     return r;
   }
 

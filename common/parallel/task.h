@@ -21,6 +21,10 @@ struct TaskInfo {
   // Position of the PDI in the problem domain (tile centre in tiles or pixels); spiral order
   // starts from the centre of the bounding box of these positions.
   float x = 0.0f, y = 0.0f;
+  // The PE that holds the data the task needs (a data-partitioned renderer's owner of what the
+  // tile's camera rays reach), or -1 when unknown. Preferred-bias makes each PE's conceptual
+  // region of the tasks that prefer it; the other strategies ignore it.
+  int preferredPe = -1;
 };
 
 struct TaskSet {

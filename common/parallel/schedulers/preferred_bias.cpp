@@ -1,9 +1,12 @@
-// Preferred-bias (conceptual) task allocation (seed 3.4.5): the tasks are divided into equal
-// contiguous conceptual regions, one per PE, as in the balanced data-driven model, but handed
-// out on demand. A PE takes from the front of its own region; once that is empty it helps the
-// region with the most estimated work left, taking from its back so the owner keeps coherence.
+// Preferred-bias (conceptual) task allocation (seed 3.4.5): the tasks are divided into conceptual
+// regions, one per PE, handed out on demand. A task that names the PE holding its data
+// (TaskInfo::preferredPe) is in that PE's region; the others are in the region of the PE whose
+// equal contiguous portion holds them, as in the balanced data-driven model. A PE takes from
+// the front of its own region; once that is empty it helps the region with the most estimated
+// work left, taking from its back so the owner keeps coherence.
 #include <algorithm>
 #include <mutex>
+#include <vector>
 
 #include "common/parallel/schedulers/scheduler.h"
 
@@ -18,15 +21,18 @@ class PreferredBiasScheduler : public Scheduler {
     grain_ = std::max(1, params.grain);
     costs_.resize(tasks.size());
     for (std::size_t i = 0; i < tasks.size(); ++i) costs_[i] = tasks.tasks[i].costEstimate;
-    regions_.clear();
+    regions_.assign(static_cast<std::size_t>(pes), Region{});
     const auto portions = balancedSplit(tasks.size(), pes);
-    for (const auto& portion : portions) {
-      Region region;
-      region.front = portion.empty() ? 0 : portion.front();
-      region.back = region.front + static_cast<TaskId>(portion.size());
-      for (TaskId id : portion) region.costLeft += costs_[id];
-      regions_.push_back(region);
+    std::vector<int> region(tasks.size());
+    for (int p = 0; p < pes; ++p)
+      for (TaskId id : portions[p]) region[id] = p;
+    for (std::size_t id = 0; id < tasks.size(); ++id) {
+      const int preferred = tasks.tasks[id].preferredPe;
+      Region& r = regions_[preferred >= 0 && preferred < pes ? preferred : region[id]];
+      r.ids.push_back(static_cast<TaskId>(id));
+      r.costLeft += costs_[id];
     }
+    for (Region& r : regions_) r.back = r.ids.size();
   }
 
   // One lock around the controller's bookkeeping: choosing the region to help needs a
@@ -36,8 +42,8 @@ class PreferredBiasScheduler : public Scheduler {
     std::lock_guard lock(mutex_);
     Region& own = regions_[pe];
     if (own.front < own.back) {
-      const TaskId end = std::min<TaskId>(own.back, own.front + grain_);
-      for (TaskId id = own.front; id < end; ++id) take(own, id, out);
+      const std::size_t end = std::min(own.back, own.front + grain_);
+      for (std::size_t i = own.front; i < end; ++i) take(own, i, out);
       own.front = end;
     } else {
       int helped = -1;
@@ -48,8 +54,8 @@ class PreferredBiasScheduler : public Scheduler {
       }
       if (helped < 0) return;
       Region& other = regions_[helped];
-      const TaskId start = std::max<TaskId>(other.front, other.back - grain_);
-      for (TaskId id = start; id < other.back; ++id) take(other, id, out);
+      const std::size_t start = other.back - std::min(grain_, other.back - other.front);
+      for (std::size_t i = start; i < other.back; ++i) take(other, i, out);
       other.back = start;
     }
     out.requests = 1;
@@ -59,13 +65,14 @@ class PreferredBiasScheduler : public Scheduler {
 
  private:
   struct Region {
-    TaskId front = 0, back = 0;  // tasks [front, back) not yet handed out
+    std::vector<TaskId> ids;          // in id order
+    std::size_t front = 0, back = 0;  // ids[front, back) not yet handed out
     double costLeft = 0.0;
   };
 
-  void take(Region& region, TaskId id, Grab& out) {
-    out.tasks.push_back(id);
-    region.costLeft -= costs_[id];
+  void take(Region& region, std::size_t i, Grab& out) {
+    out.tasks.push_back(region.ids[i]);
+    region.costLeft -= costs_[region.ids[i]];
   }
 
   std::size_t grain_ = 1;

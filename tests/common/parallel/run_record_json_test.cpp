@@ -154,3 +154,22 @@ TEST_CASE("RunRecord: named per-PE counters add up, survive JSON and appear in t
                       R"({"pes": 2, "stages": [], "timeline": [], "counters": [{"name": "x", "perPe": [1]}]})", "test"),
                   pr::InputError);
 }
+
+TEST_CASE("RunRecord: JSON round trip keeps the tasks' preferred PEs, and a record without them has none") {
+  Runtime rt(2, "preferred-bias");
+  TaskSet tasks = TaskSet::uniform(3);
+  tasks.tasks[0].preferredPe = 1;
+  tasks.tasks[2].preferredPe = 0;
+  rt.runStage("tiles", tasks, [](Pe&, TaskId) {});
+  const RunRecord b = runRecordFromJsonText(toJsonText(rt.record()), "test");
+  REQUIRE(b.stages.size() == 1);
+  REQUIRE(b.stages[0].tasks.size() == 3);
+  CHECK(b.stages[0].tasks[0].preferredPe == 1);
+  CHECK(b.stages[0].tasks[1].preferredPe == -1);
+  CHECK(b.stages[0].tasks[2].preferredPe == 0);
+  Runtime plain(2, "demand");
+  plain.runStage("tiles", TaskSet::uniform(2), [](Pe&, TaskId) {});
+  CHECK(toJsonText(plain.record()).find("preferred") == std::string::npos);
+  CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"preferred":[0,1]}],"timeline":[]})", "bad"),
+                  pr::InputError);
+}

@@ -134,6 +134,25 @@ TEST_CASE("StageReplay: --schedule replaces only the run's own schedule; fixed s
   CHECK_THROWS_AS(predict(table, "", at(2)), pr::InputError);
 }
 
+TEST_CASE("StageReplay: the tasks' preferred PEs are kept at the recorded P and dropped at another") {
+  SimStage traced;
+  traced.name = "trace";
+  traced.tasks = TaskSet::uniform(4);
+  traced.costs.assign(4, 1.0);
+  traced.schedule = "preferred-bias";
+  traced.runtimeSchedule = true;
+  for (TaskInfo& t : traced.tasks.tasks) t.preferredPe = 1;
+  const StageReplay same = planReplay(traced, 2, 2, "");
+  CHECK(same.stage.tasks.tasks[0].preferredPe == 1);
+  CHECK(same.note == "under the run's schedule");
+  // At P = 4 the data lies elsewhere: contiguous regions, one task each.
+  const StageReplay wider = planReplay(traced, 2, 4, "");
+  for (const TaskInfo& t : wider.stage.tasks.tasks) CHECK(t.preferredPe == -1);
+  CHECK(wider.note.find("preferred PEs") != std::string::npos);
+  const Prediction p = predict(recordedWorkload({traced}, 2), "", at(4));
+  CHECK(p.record.wallSeconds == doctest::Approx(1.0));
+}
+
 TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split evenly at another") {
   SimStage s;
   s.handlers = {{3.0, 6, 4, 400}, {1.0, 2, 0, 0}};
