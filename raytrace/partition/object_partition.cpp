@@ -11,6 +11,9 @@
 // and originates the spawned rays. A shadow ray stops at the first owner with an occluder.
 // Replicated pieces (object_assignment.h) are in every PE's second BVH: the directory lists
 // them as the owner kEveryPe, which the originator answers itself, like its own pieces.
+// Each tile names as its preferred PE the owner most of its probe rays hit first
+// (tile_affinity.h): under the preferred-bias schedule a tile starts where its rays are
+// answered without a message.
 #include "raytrace/partition/object_partition.h"
 
 #include <atomic>
@@ -18,10 +21,12 @@
 #include <vector>
 
 #include "common/parallel/batched_channel.h"
+#include "common/parallel/channel.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/object_assignment.h"
 #include "raytrace/partition/owner_directory.h"
 #include "raytrace/partition/partition_margin.h"
+#include "raytrace/partition/tile_affinity.h"
 
 namespace pr::rt {
 namespace {
@@ -64,6 +69,17 @@ class ObjectFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
+    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    // A pre-pass program's tasks are not image tiles: its tasks get no preferred PE.
+    const std::vector<Ray> probes = job_.assembleImage && pes > 1 ? affinityProbes(*integrator_, tiles) : std::vector<Ray>{};
+    std::vector<std::vector<float>> nearest(static_cast<size_t>(pes));  // on the controller's PE: every owner's probe hits
+    std::vector<float> shared;                            // the replicated pieces' probe hits
+    struct ProbeHits {
+      int from = 0;
+      std::vector<float> t;
+    };
+    par::Channel<ProbeHits> probeHits(rt_, "affinity", par::MessageKind::Results,
+                                      [&nearest](par::Pe&, ProbeHits&& h) { nearest[size_t(h.from)] = std::move(h.t); });
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
@@ -73,9 +89,22 @@ class ObjectFrame {
       std::vector<uint32_t> held(assignment_.triangles(p).begin(), assignment_.triangles(p).end());
       held.insert(held.end(), assignment_.replicated().begin(), assignment_.replicated().end());
       views_.build(p, held, integrator_->context().lights());
+      if (probes.empty()) return;
+      std::vector<float> mine = nearestHits(bvhs_[size_t(p)], probes);
+      if (p != kAssemblerPe) {
+        const size_t bytes = mine.size() * sizeof(float);
+        probeHits.send(pe, kAssemblerPe, ProbeHits{p, std::move(mine)}, bytes);
+        return;
+      }
+      nearest[size_t(p)] = std::move(mine);
+      if (!assignment_.replicated().empty()) shared = nearestHits(replicas_[size_t(p)], probes);
     });
+    par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx);
+    if (!probes.empty()) {
+      const std::vector<int> preferred = preferredPes(nearest, shared, tiles.size());
+      for (size_t t = 0; t < tiles.size(); ++t) tasks.tasks[t].preferredPe = preferred[t];
+    }
 
-    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};
     const auto batch = size_t(job_.options.rayBatch);
@@ -97,7 +126,7 @@ class ObjectFrame {
     if (!job_.sceneResident)
       recordReplicatedData(rt_, job_.scene, integrator_->context().lights(),
                            directory_.bytes() + assignment_.replicated().size() * kTriangleVertexBytes);
-    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
       integrator_->cameraRays(tiles[size_t(id)], st.start);
@@ -158,6 +187,17 @@ class ObjectFrame {
     uint64_t queriesSent = 0, repliesSent = 0;
     size_t live = 0;  // pending records in use
   };
+
+  // The nearest hit of each probe on bvh's triangles (kInfinity: none).
+  static std::vector<float> nearestHits(const Bvh& bvh, const std::vector<Ray>& probes) {
+    std::vector<float> t;
+    t.reserve(probes.size());
+    for (const Ray& r : probes) {
+      Hit hit;
+      t.push_back(bvh.intersect(r, hit) ? hit.t : kInfinity);
+    }
+    return t;
+  }
 
   // On the originator: starts every ray waiting in its start list.
   void drain(par::Pe& pe) {

@@ -9,7 +9,10 @@
 // any order: it visits each owner on its way once, in the order of the owners' first voxels
 // along it, and stops at the first that reports one. Shading and spawning happen on the PE
 // that found the hit; new rays start from there. The stage ends when no tile, ray or message
-// is left (termination.h).
+// is left (termination.h). A ray passes another owner's voxel without visiting it when it
+// misses the voxel's content boxes (voxel_split.h) there: through empty space. The voxels are
+// cut at equal work where the camera rays land (view_work.h), and each tile names as its
+// preferred PE the owner of the first voxel content its probe rays reach (tile_affinity.h).
 #include "raytrace/partition/object_space.h"
 
 #include <algorithm>
@@ -22,6 +25,7 @@
 #include "raytrace/partition/film_assembly.h"
 #include "common/util/error.h"
 #include "raytrace/partition/partition_margin.h"
+#include "raytrace/partition/tile_affinity.h"
 #include "raytrace/partition/voxel_split.h"
 
 namespace pr::rt {
@@ -32,6 +36,15 @@ constexpr int kMaxVoxels = 4096;  // VoxelSplit's limit
 
 // k·P voxels, k lowered where k·P would pass the split's limit (P up to 4096 PEs).
 int voxelCount(int voxelsPerPe, int pes) { return pes * std::max(1, std::min(voxelsPerPe, kMaxVoxels / pes)); }
+
+// The kd split of the job's scene into `voxels` voxels of about equal work where the camera
+// rays land (view_work.h); a pre-pass program's rays do not start at the camera, so its split
+// balances triangles.
+VoxelSplit makeSplit(const TraceJob& job, int voxels) {
+  const std::vector<WorkPoint> work =
+      job.assembleImage && voxels > 1 ? viewWork(job.scene, job.camera, job.width, job.height) : std::vector<WorkPoint>{};
+  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work});
+}
 
 // A ray on its way to the owner of the next voxel along it: the message with its path state,
 // and where the walk through the voxels resumes (the voxel and the ray parameter at which the
@@ -51,9 +64,9 @@ class ObjectSpaceFrame {
   ObjectSpaceFrame(const TraceJob& job, par::Runtime& rt, int voxelsPerPe)
       : job_(job),
         rt_(rt),
-        split_(job.scene, {voxelCount(voxelsPerPe, rt.pes()), partitionMargin(job.scene, job.camera.position())}),
-        owners_(assignVoxelOwners(split_, rt.pes())),
         integrator_(jobIntegrator(job)),
+        split_(makeSplit(job, voxelCount(voxelsPerPe, rt.pes()))),
+        owners_(assignVoxelOwners(split_, rt.pes())),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
         held_(rt.pes()),
@@ -76,6 +89,11 @@ class ObjectSpaceFrame {
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
+    par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx);
+    if (job_.assembleImage && pes > 1) {
+      const std::vector<int> preferred = firstOwners(tiles);
+      for (size_t t = 0; t < tiles.size(); ++t) tasks.tasks[t].preferredPe = preferred[t];
+    }
     std::atomic<int64_t> done{0};
     par::BatchedChannel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, size_t(job_.options.rayBatch),
                                             [this](par::Pe& pe, RayBatch&& batch) {
@@ -86,7 +104,7 @@ class ObjectSpaceFrame {
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
     if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
-    rt_.runStage(job_.stage("trace"), tileTaskSet(tiles, job_.options.tileSizePx), [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
       integrator_->cameraRays(tiles[size_t(id)], camera);
@@ -135,6 +153,23 @@ class ObjectSpaceFrame {
     uint64_t raysSent = 0;
   };
 
+  // Per tile, the owner of the first voxel with content that most of its probe rays reach
+  // (tile_affinity.h): a camera ray starting there is traced without being sent first. From
+  // the replicated kd tree and content boxes alone, on the controlling thread.
+  std::vector<int> firstOwners(const std::vector<PixelRect>& tiles) const {
+    const std::vector<Ray> probes = affinityProbes(*integrator_, tiles);
+    std::vector<std::vector<float>> first(size_t(rt_.pes()), std::vector<float>(probes.size(), kInfinity));
+    for (size_t i = 0; i < probes.size(); ++i) {
+      const RaySlabs slabs(probes[i]);
+      split_.walk(probes[i], [&](const VoxelSpan& s) {
+        if (split_.triangles(s.voxel).empty() || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+        first[size_t(owners_[s.voxel])][i] = s.tEnter;
+        return false;
+      });
+    }
+    return preferredPes(first, {}, tiles.size());
+  }
+
   // On PE pe, inside a tile task or the "rays" handler: traces the ray through this PE's
   // voxels and everything it spawns here, sending rays that reach another owner's voxel.
   void trace(par::Pe& pe, const TravellingRay& first) {
@@ -155,20 +190,25 @@ class ObjectSpaceFrame {
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     bool reached = item.voxel == TravellingRay::kStartVoxel;  // at the voxel the walk resumes in
     bool finished = false;  // hit or sent on
-    bool run = false;       // a run of this PE's voxels is open, up to runExit
-    float runExit = 0.0f;
+    bool run = false;       // a run of this PE's voxels is open, over [runEnter, runExit]
+    float runEnter = 0.0f, runExit = 0.0f;
+    const RaySlabs slabs(m.ray);
     auto visit = [&](const VoxelSpan& s) {
       if (!reached) {
         if (s.voxel != item.voxel) return true;
         reached = true;
       }
       if (split_.triangles(s.voxel).empty()) return true;  // nothing to hit: no owner needs the ray
+      // Another owner's voxel the ray crosses through empty space holds no hit in its span: the
+      // walk goes on, and a run of this PE's voxels stays open across it.
+      if (owners_[s.voxel] != pe.id() && !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
       if (owners_[s.voxel] == pe.id()) {
+        if (!run) runEnter = s.tEnter;
         run = true;
         runExit = s.tExit;
         return true;
       }
-      finished = (run && traceRun(pe, st, m, runExit, emit)) || sendOn(pe, st, m, s);
+      finished = (run && traceRun(pe, st, m, runEnter, runExit, emit)) || sendOn(pe, st, m, s);
       run = false;
       return !finished;
     };
@@ -180,7 +220,7 @@ class ObjectSpaceFrame {
     split_.walk(resume, visit);
     if (!reached) split_.walk(m.ray, visit);
     PR_CHECK(reached, "object-space: a ray sent to a voxel its walk does not pass");
-    if (!finished && run) finished = traceRun(pe, st, m, runExit, emit);
+    if (!finished && run) finished = traceRun(pe, st, m, runEnter, runExit, emit);
     if (!finished) integrator_->miss(m, emit);  // left the scene
   }
 
@@ -190,8 +230,9 @@ class ObjectSpaceFrame {
     const RayMessage& m = item.message;
     std::vector<VoxelSpan>& owners = st.shadowOwners;
     owners.clear();
+    const RaySlabs slabs(m.ray);
     split_.walk(m.ray, [&](const VoxelSpan& s) {
-      if (split_.triangles(s.voxel).empty()) return true;
+      if (split_.triangles(s.voxel).empty() || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
       const int owner = owners_[s.voxel];
       if (std::none_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; }))
         owners.push_back(s);
@@ -213,11 +254,14 @@ class ObjectSpaceFrame {
     integrator_->miss(m, emit);  // no owner holds an occluder: unoccluded
   }
 
-  // The ray in a run of this PE's voxels that ends at runExit: true when it hits there.
-  bool traceRun(par::Pe& pe, PeState& st, const RayMessage& m, float runExit, Emit& emit) {
+  // The ray in a run of this PE's voxels over [runEnter, runExit]: true when it hits there.
+  bool traceRun(par::Pe& pe, PeState& st, const RayMessage& m, float runEnter, float runExit, Emit& emit) {
     // Only hits up to the end of the run: a farther one may be behind a nearer triangle held
-    // by a later voxel.
+    // by a later voxel. And none before its start: a hit there lies in an earlier voxel, whose
+    // owner holds the triangle and found no hit up to this run (spans share their boundary
+    // value, and tMin and tMax are both inclusive), so the BVH skips the nodes behind the run.
     Ray clipped = m.ray;
+    clipped.tMin = std::max(m.ray.tMin, runEnter);
     clipped.tMax = std::min(m.ray.tMax, runExit);
     Hit hit;
     if (!bvhs_[size_t(pe.id())].intersect(clipped, hit)) return false;
@@ -239,9 +283,9 @@ class ObjectSpaceFrame {
 
   const TraceJob& job_;
   par::Runtime& rt_;
+  std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   VoxelSplit split_;
   std::vector<int> owners_;
-  std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles
   std::vector<std::vector<uint32_t>> held_;  // per PE: those triangles, ascending

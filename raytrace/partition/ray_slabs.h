@@ -1,6 +1,7 @@
 // RaySlabs: the slab test of one ray against many axis-aligned boxes, three axes in one SSE
 // register, conservative (never misses a box the ray touches, never reports an entry later
-// than the box's first point on the ray). Used by the owner directory (owner_directory.h).
+// than the box's first point on the ray). Used by the owner directory (owner_directory.h) and
+// the voxels' content boxes (voxel_split.h).
 #pragma once
 
 #include <algorithm>
@@ -40,6 +41,21 @@ class RaySlabs {
 
   // lo, hi: 16-byte aligned (x, y, z, lane 3 = (-inf, +inf)). t: the entry when reached.
   bool entry(const float* lo, const float* hi, float& t) const {
+    float near, far;
+    interval(lo, hi, near, far);
+    t = std::max(near, tMin_);
+    return t <= std::min(far, tMax_);
+  }
+  // Whether the ray touches the box for some t in [t0, t1].
+  bool overlaps(const float* lo, const float* hi, float t0, float t1) const {
+    float near, far;
+    interval(lo, hi, near, far);
+    return std::max(near, t0) <= std::min(far, t1);
+  }
+
+ private:
+  // The ray's parameters in the box (widened): near > far when it misses.
+  void interval(const float* lo, const float* hi, float& near, float& far) const {
     constexpr float kUlp = 0x1p-24f;
     constexpr float kSlack = 2.0f * (3.0f * kUlp) / (1.0f - 3.0f * kUlp);
     const __m128 l = _mm_load_ps(lo), h = _mm_load_ps(hi);
@@ -68,13 +84,10 @@ class RaySlabs {
     alignas(16) float n[4], f[4];
     _mm_store_ps(n, tNear);
     _mm_store_ps(f, tFar);
-    const float t0 = std::max(std::max(n[0], n[1]), std::max(n[2], tMin_));
-    const float t1 = std::min(std::min(f[0], f[1]), std::min(f[2], tMax_));
-    t = t0;
-    return t0 <= t1;
+    near = std::max(std::max(n[0], n[1]), n[2]);
+    far = std::min(std::min(f[0], f[1]), f[2]);
   }
 
- private:
   __m128 origin_, inverse_, parallel_;  // parallel_: all bits set in the lanes where d = 0
   float tMin_, tMax_;
 };

@@ -1,8 +1,9 @@
 // The kd split of object-space partitioning: space is cut recursively until there are as many
-// voxels as asked for, each cut placed so that both sides hold triangles in proportion to the
-// voxels they will become (the cost estimate is the triangle count, straddlers counted on both
-// sides), on the axis that balances best and duplicates the fewest triangles. Built once per
-// frame by the controlling thread before the trace stage (object_space.cpp).
+// voxels as asked for, each cut placed so that both sides hold estimated cost in proportion to
+// the voxels they will become (the weight of the work points on each side when given, else the
+// triangle count, straddlers counted on both sides), on the axis that balances best and
+// duplicates the fewest triangles. Then each voxel's content boxes. Built once per frame by
+// the controlling thread before the trace stage (object_space.cpp).
 #include "raytrace/partition/voxel_split.h"
 
 #include <algorithm>
@@ -27,7 +28,33 @@ struct VoxelSplit::Built {
   std::vector<scene::Bounds> bounds;  // per scene triangle
   std::vector<glm::vec3> centroids;
   scene::Bounds scene;                // of every finite triangle
+  std::span<const WorkPoint> work;    // the options' work points
 };
+
+namespace {
+
+// The plane on `axis` inside [lo, hi] with `below` of the points' weight under it: the weighted
+// quantile, found in bins (exact to a bin's width, interpolated within it).
+float workQuantile(std::span<const WorkPoint> work, const std::vector<uint32_t>& points, int axis, float lo, float hi,
+                   double below) {
+  constexpr int kBins = 1024;
+  if (!(hi > lo)) return lo;
+  std::vector<double> bins(kBins, 0.0);
+  const float scale = float(kBins) / (hi - lo);
+  auto bin = [&](float x) { return std::clamp(int((x - lo) * scale), 0, kBins - 1); };
+  for (uint32_t p : points) bins[size_t(bin(work[p].position[axis]))] += work[p].weight;
+  double sum = 0.0;
+  for (int i = 0; i < kBins; ++i) {
+    if (sum + bins[size_t(i)] >= below && bins[size_t(i)] > 0.0) {
+      const double frac = std::clamp((below - sum) / bins[size_t(i)], 0.0, 1.0);
+      return std::clamp(lo + (float(i) + float(frac)) / scale, lo, hi);
+    }
+    sum += bins[size_t(i)];
+  }
+  return hi;
+}
+
+}  // namespace
 
 VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options) : margin_(options.margin) {
   if (options.voxels < 1 || options.voxels > kMaxVoxels)
@@ -53,22 +80,82 @@ VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options) 
   }
   if (b.scene.empty()) b.scene = scene::Bounds{glm::vec3(-1.0f), glm::vec3(1.0f)};
 
+  // Work points that count: inside the finite scene, with weight.
+  std::vector<uint32_t> points;
+  for (size_t i = 0; i < options.work.size(); ++i) {
+    const WorkPoint& w = options.work[i];
+    if (w.weight > 0.0f && std::isfinite(w.weight) && std::isfinite(maxAbs(w.position))) points.push_back(uint32_t(i));
+  }
+  if (!points.empty()) {
+    b.work = options.work;
+    work_.reserve(size_t(options.voxels));
+  }
+
   const scene::Bounds everywhere{glm::vec3(-kInf), glm::vec3(kInf)};
   nodes_.reserve(2 * options.voxels);
-  build(b, everywhere, std::move(all), options.voxels, 0);
+  build(b, everywhere, std::move(all), std::move(points), options.voxels, 0);
+  buildContent(s, b);
+}
+
+void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
+  std::vector<uint32_t> objectOf(s.triangles.size(), static_cast<uint32_t>(s.objects.size()));
+  for (size_t o = 0; o < s.objects.size(); ++o)
+    for (uint32_t t = s.objects[o].firstTriangle; t < s.objects[o].firstTriangle + s.objects[o].triangleCount; ++t)
+      objectOf[t] = static_cast<uint32_t>(o);
+  const glm::vec3 grow(2.0f * margin_);  // the cell as its triangles were chosen, and more
+  contentFirst_.assign(1, 0);
+  std::vector<scene::Bounds> boxes;
+  for (size_t v = 0; v < cells_.size(); ++v) {
+    const scene::Bounds cell{cells_[v].min - grow, cells_[v].max + grow};
+    // A voxel's triangles ascend, and an object's are one range: one box per run of an object.
+    boxes.clear();
+    uint32_t object = ~0u;
+    for (uint32_t t : triangles_[v]) {
+      const scene::Bounds part{glm::max(b.bounds[t].min, cell.min), glm::min(b.bounds[t].max, cell.max)};
+      if (part.min.x > part.max.x || part.min.y > part.max.y || part.min.z > part.max.z) continue;
+      if (boxes.empty() || objectOf[t] != object) boxes.emplace_back();
+      object = objectOf[t];
+      boxes.back().extend(part);
+    }
+    auto area = [](const scene::Bounds& x) {
+      const glm::vec3 e = x.extent();
+      return double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x;
+    };
+    if (boxes.size() > size_t(kContentBoxes)) {
+      std::stable_sort(boxes.begin(), boxes.end(), [&](const scene::Bounds& x, const scene::Bounds& y) { return area(x) > area(y); });
+      for (size_t i = kContentBoxes; i < boxes.size(); ++i) boxes[kContentBoxes - 1].extend(boxes[i]);
+      boxes.resize(kContentBoxes);
+    }
+    for (const scene::Bounds& box : boxes) {
+      if (box.empty()) continue;
+      ContentBox c;
+      for (int a = 0; a < 3; ++a) {
+        c.lo[a] = box.min[a] - margin_;
+        c.hi[a] = box.max[a] + margin_;
+      }
+      c.lo[3] = -kInf;
+      c.hi[3] = kInf;
+      content_.push_back(c);
+    }
+    contentFirst_.push_back(static_cast<uint32_t>(content_.size()));
+  }
 }
 
 // Splits `cell` (holding `tris`: the triangles overlapping it grown by the margin) into
 // `leaves` voxels. Returns the node index.
-uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, int leaves, int depth) {
+uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, std::vector<uint32_t> points,
+                           int leaves, int depth) {
   PR_CHECK(depth < kMaxDepth, "VoxelSplit: kd tree deeper than kMaxDepth");
   const auto index = static_cast<uint32_t>(nodes_.size());
   nodes_.emplace_back();
+  double work = 0.0;
+  for (uint32_t p : points) work += b.work[p].weight;
   if (leaves == 1) {
     std::sort(tris.begin(), tris.end());
     nodes_[index].left = static_cast<uint32_t>(cells_.size());
     cells_.push_back(cell);
     triangles_.push_back(std::move(tris));
+    if (!b.work.empty()) work_.push_back(work);
     return index;
   }
 
@@ -88,11 +175,23 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
     // The plane with nLeft/leaves of the triangles' centroids below it (clamped into the
     // region, since a straddler's centroid may lie outside this cell).
     coords.clear();
-    for (uint32_t t : tris) coords.push_back(std::clamp(b.centroids[t][a], region.min[a], region.max[a]));
+    if (!(work > 0.0))
+      for (uint32_t t : tris) coords.push_back(std::clamp(b.centroids[t][a], region.min[a], region.max[a]));
     float plane = 0.5f * (region.min[a] + region.max[a]);
     const size_t m = coords.size();
     const size_t k = (m * nLeft + leaves / 2) / leaves;
-    if (k > 0 && k < m) {
+    if (work > 0.0) {
+      // The quantile, moved to the middle of the gap between the points on either side of it
+      // (as the median is between centroids), so a plane between two walls stays clear of both.
+      const float q = workQuantile(b.work, points, a, region.min[a], region.max[a], work * nLeft / leaves);
+      float lower = -kInf, upper = kInf;
+      for (uint32_t p : points) {
+        const float x = std::clamp(b.work[p].position[a], region.min[a], region.max[a]);
+        if (x <= q) lower = std::max(lower, x);
+        else upper = std::min(upper, x);
+      }
+      plane = lower > -kInf && upper < kInf ? lower + 0.5f * (upper - lower) : q;
+    } else if (k > 0 && k < m) {
       std::nth_element(coords.begin(), coords.begin() + k, coords.end());
       const float above = coords[k];
       const float below = *std::max_element(coords.begin(), coords.begin() + k);
@@ -104,7 +203,16 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
       if (b.bounds[t].min[a] <= plane + margin_) ++left;
       if (b.bounds[t].max[a] >= plane - margin_) ++right;
     }
-    const double score = std::max(double(left) / nLeft, double(right) / nRight);
+    double score = std::max(double(left) / nLeft, double(right) / nRight);
+    if (work > 0.0) {
+      // The work per voxel against an even share (1 when balanced), plus the fraction of the
+      // triangles the plane duplicates.
+      double workLeft = 0.0;
+      for (uint32_t p : points)
+        if (b.work[p].position[a] < plane) workLeft += b.work[p].weight;
+      const double balance = std::max(workLeft / nLeft, (work - workLeft) / nRight) / (work / leaves);
+      score = balance + double(left + right - tris.size()) / double(std::max<size_t>(1, tris.size()));
+    }
     const float extent = region.max[a] - region.min[a];
     const bool better = bestAxis < 0 || score < bestScore ||
                         (score == bestScore && extent > region.max[bestAxis] - region.min[bestAxis]);
@@ -123,11 +231,16 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
   }
   tris.clear();
   tris.shrink_to_fit();
+  // A point on the plane belongs to the upper side, as in voxelAt.
+  std::vector<uint32_t> leftPoints, rightPoints;
+  for (uint32_t p : points) (b.work[p].position[a] < bestPlane ? leftPoints : rightPoints).push_back(p);
+  points.clear();
+  points.shrink_to_fit();
   scene::Bounds leftCell = cell, rightCell = cell;
   leftCell.max[a] = bestPlane;
   rightCell.min[a] = bestPlane;
-  const uint32_t l = build(b, leftCell, std::move(leftTris), nLeft, depth + 1);
-  const uint32_t r = build(b, rightCell, std::move(rightTris), nRight, depth + 1);
+  const uint32_t l = build(b, leftCell, std::move(leftTris), std::move(leftPoints), nLeft, depth + 1);
+  const uint32_t r = build(b, rightCell, std::move(rightTris), std::move(rightPoints), nRight, depth + 1);
   nodes_[index] = Node{a, bestPlane, l, r};
   return index;
 }
@@ -165,16 +278,18 @@ std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes) {
     std::iota(owners.begin(), owners.end(), 0);
     return owners;
   }
+  double totalWork = 0.0;
+  for (int v = 0; v < n; ++v) totalWork += split.work(v);
+  // An empty voxel still costs its traversal: count it as one triangle.
+  auto cost = [&](int v) { return totalWork > 0.0 ? split.work(v) : double(std::max<size_t>(1, split.triangles(v).size())); };
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](int x, int y) { return split.triangles(x).size() > split.triangles(y).size(); });
-  std::vector<size_t> load(pes, 0);
+  std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return cost(x) > cost(y); });
+  std::vector<double> load(pes, 0.0);
   for (int v : order) {
     const int pe = static_cast<int>(std::min_element(load.begin(), load.end()) - load.begin());
     owners[v] = pe;
-    // An empty voxel still costs its traversal: count it as one triangle.
-    load[pe] += std::max<size_t>(1, split.triangles(v).size());
+    load[pe] += cost(v);
   }
   return owners;
 }

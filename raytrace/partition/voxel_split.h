@@ -1,6 +1,7 @@
 // VoxelSplit: the object-space partitioning of the scene (seed section 5.1.2): its space cut
-// by a kd split into P or k·P voxels balanced by estimated cost (triangle count per side, not
-// equal sizes), each voxel holding the triangles that overlap it. object_space.cpp gives each
+// by a kd split into P or k·P voxels balanced by estimated cost (work where the camera rays
+// land, or triangle count per side; not equal sizes), each voxel holding the triangles that
+// overlap it. object_space.cpp gives each
 // voxel an owner PE, builds that PE's BVHs over its voxels only, and moves rays from owner to
 // owner in the order walk() visits the voxels along them.
 #pragma once
@@ -13,6 +14,8 @@
 
 #include "common/scene/scene.h"
 #include "raytrace/core/ray.h"
+#include "raytrace/partition/ray_slabs.h"
+#include "raytrace/partition/view_work.h"
 
 namespace pr::rt {
 
@@ -22,6 +25,10 @@ struct VoxelSplitOptions {
   // every side (partitionMargin, partition_margin.h): conservative, so a hit computed at a ray
   // parameter inside a voxel's span is always on a triangle that voxel holds.
   float margin = 0.0f;
+  // Where the render's work lies (view_work.h; any unit): when given (and not all zero), each
+  // cut puts on each side work in proportion to the voxels it will become, on the axis that
+  // balances it best and duplicates the fewest triangles; else triangle counts are balanced.
+  std::span<const WorkPoint> work{};
 };
 
 // The part of a ray inside one voxel: t in [tEnter, tExit]. Consecutive spans of a walk share
@@ -52,8 +59,24 @@ class VoxelSplit {
   int voxelAt(glm::vec3 p) const;
   // Total triangles over all voxels (> the scene's when triangles straddle splits).
   size_t storedTriangles() const;
-  // Bytes of the kd tree itself, which every PE keeps a copy of to route rays.
-  size_t treeBytes() const { return nodes_.size() * sizeof(Node); }
+  // The estimated work in the voxel: the weight of the work points inside its cell (0 for
+  // every voxel of a split made without work points).
+  double work(int voxel) const { return work_.empty() ? 0.0 : work_[size_t(voxel)]; }
+  // Bytes of the kd tree and the voxels' content boxes, which every PE keeps a copy of to
+  // route rays.
+  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(ContentBox); }
+
+  // What a voxel holds, as up to kContentBoxes boxes inside its cell: per scene object the
+  // bounds of its triangles' parts in the cell, the largest (by surface area) kept apart and
+  // the rest merged, all grown by the margin. False when the ray (slabs) touches none of them
+  // for t in [t0, t1]: then no triangle of the voxel has a hit in that span, and a ray that
+  // crosses the voxel through empty space need not visit its owner. Conservative.
+  static constexpr int kContentBoxes = 6;
+  bool reachesContent(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
+    for (uint32_t i = contentFirst_[voxel]; i < contentFirst_[voxel + 1]; ++i)
+      if (slabs.overlaps(content_[i].lo, content_[i].hi, t0, t1)) return true;
+    return false;
+  }
 
   // Calls visit(const VoxelSpan&) for each voxel the ray passes through for t in
   // [tMin, tMax], nearest first, until visit returns false. A ray lying in a split plane
@@ -72,18 +95,28 @@ class VoxelSplit {
     uint32_t left = 0, right = 0;
   };
   struct Built;
+  // A box as 4 lanes for the SSE slab test; lane 3 is (-inf, +inf), which never limits.
+  struct ContentBox {
+    alignas(16) float lo[4];
+    alignas(16) float hi[4];
+  };
 
-  uint32_t build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, int leaves, int depth);
+  uint32_t build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, std::vector<uint32_t> points, int leaves,
+                 int depth);
+  void buildContent(const scene::Scene& scene, const Built& b);
 
   std::vector<Node> nodes_;
   std::vector<scene::Bounds> cells_;
   std::vector<std::vector<uint32_t>> triangles_;
+  std::vector<ContentBox> content_;      // voxel v's: [contentFirst_[v], contentFirst_[v + 1])
+  std::vector<uint32_t> contentFirst_;
+  std::vector<double> work_;  // per voxel, when built with work points
   float margin_ = 0.0f;
 };
 
-// Owners of k·P voxels: longest processing time first by triangle count (ties to the lower
-// voxel, then the lower PE), so every PE holds about the same geometry; with as many voxels
-// as PEs, voxel i goes to PE i.
+// Owners of k·P voxels: longest processing time first by estimated work, or by triangle count
+// for a split made without work points (ties to the lower voxel, then the lower PE), so every
+// PE gets about the same work (or geometry); with as many voxels as PEs, voxel i goes to PE i.
 std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes);
 
 template <class Visit>

@@ -188,7 +188,9 @@ TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   uint64_t triangles = 0;
   for (int p = 0; p < 4; ++p) {
     CHECK(run.figures.triangles[p] > 0);
-    CHECK(run.figures.triangles[p] < s.triangles.size() * 6 / 10);  // a balanced share, not the world
+    // Not the world: the cluster of spheres, most of the triangles but little of the view's
+    // work, is cut in two and the rest of the voxels hold parts of the walls.
+    CHECK(run.figures.triangles[p] < s.triangles.size() * 7 / 10);
     CHECK(run.figures.geometryBytes[p] > run.figures.triangles[p] * rt::kTriangleVertexBytes);
     triangles += run.figures.triangles[p];
   }
