@@ -11,6 +11,7 @@
 // Figures come from the runtime's run record; ratios are measured in the same run, P = 1 and
 // P = 2 taking turns round by round.
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <string>
 #include <thread>
@@ -30,6 +31,9 @@ using namespace pr;
 
 struct Run {
   double seconds = 1e30;  // best wall time of the whole render (every stage)
+  // ... of the same render's call, also counting the controlling thread's work before the
+  // first stage (the partitioned tracers' data split: kd tree or object pieces, view work)
+  double callSeconds = 0.0;
   double messagesPerRay = 0.0;  // ray messages (rays, queries, replies) per ray traced
   double imbalance = 0.0;
   double buildSeconds = 0.0;  // the fastest render's stages: the owners' BVH builds
@@ -39,14 +43,18 @@ struct Run {
 
 // One render of `method` at P = pes, kept in `out` when it is the fastest so far.
 void measureOnce(Run& out, const scene::Scene& s, const scene::Camera& cam, int w, int h, rt::TraceOptions opt,
-                 const std::string& method, int pes, int batch, const image::Image& reference) {
+                 const std::string& method, int pes, int batch, const image::Image& reference,
+                 const std::string& schedule = "demand") {
   opt.rayBatch = batch;
-  par::Runtime runtime(pes, "demand");
+  par::Runtime runtime(pes, schedule);
+  const auto start = std::chrono::steady_clock::now();
   const rt::TraceResult result = rt::renderRays(s, cam, w, h, opt, method, runtime);
+  const double call = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   const par::RunRecord& record = runtime.record();
   out.sameImage = out.sameImage && result.image.pixels == reference.pixels;
   if (record.wallSeconds >= out.seconds) return;
   out.seconds = record.wallSeconds;
+  out.callSeconds = call;
   uint64_t messages = 0;
   for (const par::StageRecord& st : record.stages)
     for (const par::ChannelTraffic& c : st.channels)
@@ -66,15 +74,18 @@ void measureOnce(Run& out, const scene::Scene& s, const scene::Camera& cam, int 
   }
 }
 
-// The method at P = 1 and P = 2, taking turns for `rounds` rounds, each the fastest of its
-// rounds: a slow spell of a shared machine (the second core taken by another job for tens of
-// seconds) then lands on both sides of the speed-up, not on P = 2's runs alone.
-std::pair<Run, Run> measureP1P2(const scene::Scene& s, const scene::Camera& cam, int w, int h, const rt::TraceOptions& opt,
-                                const std::string& method, int rounds, const image::Image& reference) {
-  Run p1, p2;
+// The method at P = 1 and at P = 2 under each schedule, taking turns for `rounds` rounds, each
+// the fastest of its rounds: a slow spell of a shared machine (the second core taken by another
+// job for tens of seconds) then lands on both sides of the speed-up, not on P = 2's runs alone.
+std::pair<Run, std::vector<Run>> measureP1P2(const scene::Scene& s, const scene::Camera& cam, int w, int h,
+                                             const rt::TraceOptions& opt, const std::string& method, int rounds,
+                                             const image::Image& reference, const std::vector<std::string>& schedules) {
+  Run p1;
+  std::vector<Run> p2(schedules.size());
   for (int r = 0; r < rounds; ++r) {
     measureOnce(p1, s, cam, w, h, opt, method, 1, rt::kDefaultRayBatch, reference);
-    measureOnce(p2, s, cam, w, h, opt, method, 2, rt::kDefaultRayBatch, reference);
+    for (size_t i = 0; i < schedules.size(); ++i)
+      measureOnce(p2[i], s, cam, w, h, opt, method, 2, rt::kDefaultRayBatch, reference, schedules[i]);
   }
   return {p1, p2};
 }
@@ -87,23 +98,33 @@ int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& op
   std::printf("\n%s: %zu triangles, %dx%d, %s spp %d, best of %d\n", file.c_str(), s.triangles.size(), w, h,
               opt.integrator.kind == rt::IntegratorKind::Whitted ? "whitted" : "path", opt.integrator.spp, repeats);
   int failures = 0;
+  // Demand-driven tiles, and preferred-bias, whose regions are the tiles' preferred PEs where
+  // the tracer names them (object partitioning: tile_affinity.h), else contiguous image bands.
+  const std::vector<std::string> schedules = {"demand", "preferred-bias"};
   for (const std::string method : {"object-space", "object"}) {
-    const auto [p1, p2] = measureP1P2(s, cam, w, h, opt, method, repeats, reference);
+    const auto [p1, p2s] = measureP1P2(s, cam, w, h, opt, method, repeats, reference, schedules);
     Run unbatched;
     measureOnce(unbatched, s, cam, w, h, opt, method, 2, 1, reference);
-    const double speedup = p1.seconds / p2.seconds;
-    const double fewer = unbatched.messagesPerRay / std::max(1e-12, p2.messagesPerRay);
-    std::printf("  %-12s P=1 %.3f s, P=2 %.3f s: speed-up over its own P=1 %.2f (target >= 1.6), load imbalance %.3f\n",
-                method.c_str(), p1.seconds, p2.seconds, speedup, p2.imbalance);
-    // The build writes its BVHs into fresh memory and is bound by page faults, which vary from
-    // run to run on a shared machine; the trace stage is the method's own parallel work.
-    std::printf("  %-12s stages of those runs: build P=1 %.3f s, P=2 %.3f s (%.2f); trace P=1 %.3f s, P=2 %.3f s (%.2f)\n",
-                method.c_str(), p1.buildSeconds, p2.buildSeconds, p1.buildSeconds / std::max(1e-12, p2.buildSeconds),
-                p1.traceSeconds, p2.traceSeconds, p1.traceSeconds / std::max(1e-12, p2.traceSeconds));
-    std::printf("  %-12s ray messages per ray at P=2: %.4f with batch %d, %.4f one ray per message: %.1fx fewer (target >= 10)\n",
-                method.c_str(), p2.messagesPerRay, rt::kDefaultRayBatch, unbatched.messagesPerRay, fewer);
-    std::printf("  %-12s batch size at P=2:", method.c_str());
-    bool same = p1.sameImage && p2.sameImage && unbatched.sameImage;
+    bool same = p1.sameImage && unbatched.sameImage;
+    for (size_t i = 0; i < schedules.size(); ++i) {
+      const Run& p2 = p2s[i];
+      same = same && p2.sameImage;
+      const double speedup = p1.seconds / p2.seconds;
+      std::printf("  %-12s %s: P=1 %.3f s, P=2 %.3f s: speed-up over its own P=1 %.2f (target >= 1.6), load imbalance %.3f\n",
+                  method.c_str(), schedules[i].c_str(), p1.seconds, p2.seconds, speedup, p2.imbalance);
+      std::printf("  %-12s %s: with the data split before the first stage: P=1 %.3f s, P=2 %.3f s: %.2f\n", method.c_str(),
+                  schedules[i].c_str(), p1.callSeconds, p2.callSeconds, p1.callSeconds / std::max(1e-12, p2.callSeconds));
+      // The build writes its BVHs into fresh memory and is bound by page faults, which vary
+      // from run to run on a shared machine; the trace stage is the method's own parallel work.
+      std::printf("  %-12s %s: stages of those runs: build P=1 %.3f s, P=2 %.3f s (%.2f); trace P=1 %.3f s, P=2 %.3f s (%.2f)\n",
+                  method.c_str(), schedules[i].c_str(), p1.buildSeconds, p2.buildSeconds,
+                  p1.buildSeconds / std::max(1e-12, p2.buildSeconds), p1.traceSeconds, p2.traceSeconds,
+                  p1.traceSeconds / std::max(1e-12, p2.traceSeconds));
+      const double fewer = unbatched.messagesPerRay / std::max(1e-12, p2.messagesPerRay);
+      std::printf("  %-12s %s: ray messages per ray at P=2: %.4f with batch %d, %.4f one ray per message (demand): %.1fx fewer (target >= 10)\n",
+                  method.c_str(), schedules[i].c_str(), p2.messagesPerRay, rt::kDefaultRayBatch, unbatched.messagesPerRay, fewer);
+    }
+    std::printf("  %-12s batch size at P=2 (demand):", method.c_str());
     for (int batch : batches) {
       Run b;
       measureOnce(b, s, cam, w, h, opt, method, 2, batch, reference);
@@ -131,8 +152,10 @@ int benchCached(const std::string& file, int w, int h, rt::TraceOptions opt, int
   par::Runtime sequential(1, "demand");
   const image::Image reference = rt::renderRays(s, cam, w, h, opt, "sequential", sequential).image;
   std::printf("\n%s: image-space-cached (data manager), %dx%d, best of %d\n", file.c_str(), w, h, repeats);
-  const auto [world1, world2] = measureP1P2(s, cam, w, h, opt, "image-space", repeats, reference);
-  const auto [cached1, cached2] = measureP1P2(s, cam, w, h, opt, "image-space-cached", repeats, reference);
+  const auto [world1, worlds2] = measureP1P2(s, cam, w, h, opt, "image-space", repeats, reference, {"demand"});
+  const auto [cached1, cacheds2] = measureP1P2(s, cam, w, h, opt, "image-space-cached", repeats, reference, {"demand"});
+  const Run& world2 = worlds2.front();
+  const Run& cached2 = cacheds2.front();
   std::printf("  image-space        P=1 %.3f s, P=2 %.3f s, speed-up %.2f\n", world1.seconds, world2.seconds, world1.seconds / world2.seconds);
   std::printf("  image-space-cached P=1 %.3f s, P=2 %.3f s, speed-up %.2f; P=1 time / image-space's %.2f\n", cached1.seconds,
               cached2.seconds, cached1.seconds / cached2.seconds, cached1.seconds / world1.seconds);
