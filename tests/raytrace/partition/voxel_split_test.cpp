@@ -185,6 +185,56 @@ TEST_CASE("VoxelSplit: voxel by voxel first hits equal the full BVH bit for bit"
   CHECK(hits > 200);
 }
 
+TEST_CASE("VoxelSplit: a voxel's content boxes are reached wherever it has a hit, and not across empty space") {
+  // Every span in which the voxel's own BVH has a hit must reach its content (else object-space
+  // would skip the owner of the hit); a ray through the gap between two far clusters reaches
+  // neither's content although it crosses their voxels.
+  pr::scene::Scene s = pr::test::randomSoup(400, 0.5f, glm::vec3(-3.0f, 0.0f, 0.0f), 5);
+  const pr::scene::Scene right = pr::test::randomSoup(400, 0.5f, glm::vec3(3.0f, 0.0f, 0.0f), 6);
+  const uint32_t base = uint32_t(s.positions.size());
+  s.positions.insert(s.positions.end(), right.positions.begin(), right.positions.end());
+  for (pr::scene::Triangle t : right.triangles) {
+    for (uint32_t& v : t.v) v += base;
+    s.triangles.push_back(t);
+  }
+  const glm::vec3 eye(0.0f, 0.5f, 6.0f);
+  const VoxelSplit split(s, {8, pr::rt::partitionMargin(s, eye)});
+  const std::vector<Bvh> bvhs = voxelBvhs(s, split);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<float> u(-4.0f, 4.0f);
+  int hitSpans = 0;
+  for (int i = 0; i < 800; ++i) {
+    Ray ray;
+    ray.origin = i % 2 == 0 ? eye : glm::vec3(u(rng), u(rng) * 0.3f, u(rng) * 0.3f);
+    ray.direction = i % 2 == 0 ? glm::normalize(glm::vec3(u(rng), u(rng) * 0.2f, 0.0f) - eye) : pr::test::randomDirection(rng);
+    const pr::rt::RaySlabs slabs(ray);
+    split.walk(ray, [&](const VoxelSpan& span) {
+      Ray clipped = ray;
+      clipped.tMin = span.tEnter;
+      clipped.tMax = span.tExit;
+      Hit h;
+      if (bvhs[span.voxel].intersect(clipped, h)) {
+        ++hitSpans;
+        CHECK(split.reachesContent(span.voxel, slabs, span.tEnter, span.tExit));
+      }
+      return true;
+    });
+  }
+  CHECK(hitSpans > 50);
+  // Straight down through the middle, between the clusters (x = +-3, radius about 0.5).
+  Ray gap;
+  gap.origin = glm::vec3(0.0f, 5.0f, 0.0f);
+  gap.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+  const pr::rt::RaySlabs slabs(gap);
+  int crossed = 0;
+  split.walk(gap, [&](const VoxelSpan& span) {
+    ++crossed;
+    CHECK_FALSE(split.reachesContent(span.voxel, slabs, span.tEnter, span.tExit));
+    return true;
+  });
+  CHECK(crossed > 0);
+}
+
 TEST_CASE("VoxelSplit: rays lying in split planes find the same hits as the full BVH") {
   // A closed box tessellated into a grid: its vertices, edges and the split planes coincide,
   // so rays along a plane pass exactly through shared edges and triangles lying in it.
