@@ -37,13 +37,22 @@ constexpr int kMaxVoxels = 4096;  // VoxelSplit's limit
 // k·P voxels, k lowered where k·P would pass the split's limit (P up to 4096 PEs).
 int voxelCount(int voxelsPerPe, int pes) { return pes * std::max(1, std::min(voxelsPerPe, kMaxVoxels / pes)); }
 
+// An owner's BVH build per triangle, in the time of one camera path sample's tracing: 0.27-0.28
+// on both the hot-spot scene and the landscape in bench_partitioned at P = 1 (build stage per
+// triangle over trace stage per sample, path tracer).
+constexpr float kBuildSamplesPerTriangle = 0.28f;
+
 // The kd split of the job's scene into `voxels` voxels of about equal work where the camera
-// rays land (view_work.h); a pre-pass program's rays do not start at the camera, so its split
-// balances triangles.
-VoxelSplit makeSplit(const TraceJob& job, int voxels) {
-  const std::vector<WorkPoint> work =
-      job.assembleImage && voxels > 1 ? viewWork(job.scene, job.camera, job.width, job.height) : std::vector<WorkPoint>{};
-  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work});
+// rays land (view_work.h, in samples: pixels times spp), dealt to PEs by that work plus their
+// BVH builds; a pre-pass program's rays do not start at the camera, so its split balances
+// triangles.
+VoxelSplit makeSplit(const TraceJob& job, int voxels, int spp) {
+  std::vector<WorkPoint> work;
+  if (job.assembleImage && voxels > 1) {
+    work = viewWork(job.scene, job.camera, job.width, job.height);
+    for (WorkPoint& w : work) w.weight *= float(spp);
+  }
+  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work, kBuildSamplesPerTriangle});
 }
 
 // A ray on its way to the owner of the next voxel along it: the message with its path state,
@@ -65,7 +74,7 @@ class ObjectSpaceFrame {
       : job_(job),
         rt_(rt),
         integrator_(jobIntegrator(job)),
-        split_(makeSplit(job, voxelCount(voxelsPerPe, rt.pes()))),
+        split_(makeSplit(job, voxelCount(voxelsPerPe, rt.pes()), integrator_->options().spp)),
         owners_(assignVoxelOwners(split_, rt.pes())),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),

@@ -56,11 +56,13 @@ float workQuantile(std::span<const WorkPoint> work, const std::vector<uint32_t>&
 
 }  // namespace
 
-VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options) : margin_(options.margin) {
+VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
+    : triangleWork_(options.triangleWork), margin_(options.margin) {
   if (options.voxels < 1 || options.voxels > kMaxVoxels)
     throw InputError("object-space partitioning: " + std::to_string(options.voxels) +
                      " voxels requested, expected 1 to " + std::to_string(kMaxVoxels));
   PR_CHECK(std::isfinite(margin_) && margin_ >= 0.0f, "VoxelSplit: margin must be finite and >= 0");
+  PR_CHECK(std::isfinite(triangleWork_) && triangleWork_ >= 0.0f, "VoxelSplit: triangle work must be finite and >= 0");
 
   Built b;
   b.bounds.resize(s.triangles.size());
@@ -281,7 +283,10 @@ std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes) {
   double totalWork = 0.0;
   for (int v = 0; v < n; ++v) totalWork += split.work(v);
   // An empty voxel still costs its traversal: count it as one triangle.
-  auto cost = [&](int v) { return totalWork > 0.0 ? split.work(v) : double(std::max<size_t>(1, split.triangles(v).size())); };
+  auto cost = [&](int v) {
+    const double triangles = double(split.triangles(v).size());
+    return totalWork > 0.0 ? split.work(v) + double(split.triangleWork()) * triangles : std::max(1.0, triangles);
+  };
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int x, int y) { return cost(x) > cost(y); });

@@ -29,6 +29,10 @@ struct VoxelSplitOptions {
   // cut puts on each side work in proportion to the voxels it will become, on the axis that
   // balances it best and duplicates the fewest triangles; else triangle counts are balanced.
   std::span<const WorkPoint> work{};
+  // The work of holding one triangle (its share of the owner's BVH build), in the work points'
+  // unit: added to a voxel's work when voxels are dealt to PEs (assignVoxelOwners), not when
+  // cutting, so a cluster of many triangles but little view work is not dealt to one PE whole.
+  float triangleWork = 0.0f;
 };
 
 // The part of a ray inside one voxel: t in [tEnter, tExit]. Consecutive spans of a walk share
@@ -62,6 +66,7 @@ class VoxelSplit {
   // The estimated work in the voxel: the weight of the work points inside its cell (0 for
   // every voxel of a split made without work points).
   double work(int voxel) const { return work_.empty() ? 0.0 : work_[size_t(voxel)]; }
+  float triangleWork() const { return triangleWork_; }
   // Bytes of the kd tree and the voxels' content boxes, which every PE keeps a copy of to
   // route rays.
   size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(ContentBox); }
@@ -111,12 +116,14 @@ class VoxelSplit {
   std::vector<ContentBox> content_;      // voxel v's: [contentFirst_[v], contentFirst_[v + 1])
   std::vector<uint32_t> contentFirst_;
   std::vector<double> work_;  // per voxel, when built with work points
+  float triangleWork_ = 0.0f;
   float margin_ = 0.0f;
 };
 
-// Owners of k·P voxels: longest processing time first by estimated work, or by triangle count
-// for a split made without work points (ties to the lower voxel, then the lower PE), so every
-// PE gets about the same work (or geometry); with as many voxels as PEs, voxel i goes to PE i.
+// Owners of k·P voxels: longest processing time first by estimated work (the voxel's work plus
+// triangleWork per triangle it holds), or by triangle count for a split made without work
+// points (ties to the lower voxel, then the lower PE), so every PE gets about the same work (or
+// geometry); with as many voxels as PEs, voxel i goes to PE i.
 std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes);
 
 template <class Visit>

@@ -235,6 +235,33 @@ TEST_CASE("VoxelSplit: a voxel's content boxes are reached wherever it has a hit
   CHECK(crossed > 0);
 }
 
+TEST_CASE("VoxelSplit: with work points the cuts balance work, and dealing counts the triangles held too") {
+  // A cluster of 600 triangles around x = -3 with a tenth of the work, and a wall of two
+  // triangles at x = +3 with the rest, spread over its face.
+  pr::scene::Scene s = pr::test::randomSoup(600, 0.5f, glm::vec3(-3.0f, 0.0f, 0.0f), 8);
+  pr::test::addTriangle(s, {3, -2, -2}, {3, 2, -2}, {3, 2, 2});
+  pr::test::addTriangle(s, {3, -2, -2}, {3, 2, 2}, {3, -2, 2});
+  std::vector<pr::rt::WorkPoint> work;
+  for (int i = 0; i < 90; ++i) work.push_back({glm::vec3(3.0f, -1.9f + 0.04f * float(i), 0.5f * float(i % 7) - 1.5f), 1.0f});
+  for (int i = 0; i < 10; ++i) work.push_back({glm::vec3(-3.0f + 0.01f * float(i), 0.05f * float(i), 0.0f), 1.0f});
+  for (float triangleWork : {0.0f, 1.0f}) {
+    CAPTURE(triangleWork);
+    const VoxelSplit split(s, {4, 0.0f, work, triangleWork});
+    // Equal work per voxel: the cluster's 600 triangles fall in two of them, the wall's two
+    // triangles in the other two.
+    for (int v = 0; v < 4; ++v) CHECK(split.work(v) == doctest::Approx(25.0));
+    REQUIRE(split.triangles(0).size() == 2);
+    REQUIRE(split.triangles(1).size() > 300);
+    REQUIRE(split.triangles(2).size() > 300);
+    REQUIRE(split.triangles(3).size() == 2);
+    // Longest first: by work alone the four are equal and dealt in turn (0, 1, 0, 1); with a
+    // triangle's work the cluster's voxels go first, one to each PE, and the wall's two voxels
+    // to the lighter PE (PE 1, holding 321 triangles against 361).
+    const std::vector<int> owners = pr::rt::assignVoxelOwners(split, 2);
+    CHECK(owners == (triangleWork == 0.0f ? std::vector<int>{0, 1, 0, 1} : std::vector<int>{1, 0, 1, 1}));
+  }
+}
+
 TEST_CASE("VoxelSplit: rays lying in split planes find the same hits as the full BVH") {
   // A closed box tessellated into a grid: its vertices, edges and the split planes coincide,
   // so rays along a plane pass exactly through shared edges and triangles lying in it.
