@@ -283,8 +283,13 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     const json preferred = js.value("preferred", json::array());
     if (!preferred.empty() && preferred.size() != s.tasks.size())
       throw InputError(origin + ": " + where + " \"preferred\" must name one PE (or -1) per task");
-    for (std::size_t t = 0; t < preferred.size(); ++t)
-      s.tasks[t].preferredPe = numberAs<int>(preferred[t], origin + ": " + where + " preferred PE");
+    for (std::size_t t = 0; t < preferred.size(); ++t) {
+      const int pe = numberAs<int>(preferred[t], origin + ": " + where + " preferred PE");
+      if (pe < -1 || pe >= record.pes)
+        throw InputError(origin + ": " + where + " preferred PE " + std::to_string(pe) + " is not -1 or one of the " +
+                         std::to_string(record.pes) + " PEs");
+      s.tasks[t].preferredPe = pe;
+    }
     for (const json& owner : js.value("owners", json::array()))
       s.owners.push_back(numberAs<int>(owner, origin + ": " + where + " owner"));
     if (!s.owners.empty() && s.owners.size() != s.tasks.size())

@@ -247,6 +247,11 @@ class ObjectSpaceFrame {
         owners.push_back(s);
       return true;
     });
+    if (owners.empty()) {  // no voxel content on the ray: nothing can occlude it
+      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
+      integrator_->miss(m, emit);
+      return;
+    }
     auto me = std::find_if(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == pe.id(); });
     if (item.voxel == TravellingRay::kStartVoxel && me != owners.begin()) {
       me = owners.begin();  // a new ray starts at the first owner on it (or has none)

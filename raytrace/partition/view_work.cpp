@@ -13,23 +13,27 @@ namespace {
 // than the image or crosses the camera plane): 4^24 pieces of a triangle at most, though only
 // the pieces near the eye are cut that often.
 constexpr int kMaxCutDepth = 24;
+// Cuts of a piece across the camera plane before it is dropped.
+constexpr int kMaxCrossingCutDepth = 8;
 
+// Pieces are cut and projected in view space (the camera at the origin looking down -z), where
+// the camera plane is a coordinate; their centroids go back to world space.
 struct Projector {
-  glm::mat4 view;
+  glm::mat4 toWorld;
   bool orthographic = false;
   float sx = 1.0f, sy = 1.0f;  // view-space units per half image (at unit depth for perspective)
   float znear = 0.0f;
   float width = 0.0f, height = 0.0f;
 
-  // False when the point is not in front of the camera.
-  bool toPixels(glm::vec3 world, glm::vec2& out) const {
-    const glm::vec3 q = glm::vec3(view * glm::vec4(world, 1.0f));
-    if (!(-q.z > znear)) return false;
+  bool inFront(glm::vec3 q) const { return -q.z > znear; }
+  // False when the projection of the (view-space, in front) point is not finite.
+  bool toPixels(glm::vec3 q, glm::vec2& out) const {
     const float depth = orthographic ? 1.0f : -q.z;
     const float x = q.x / (depth * sx), y = q.y / (depth * sy);  // in [-1, 1] on the image
     out = {0.5f * (x + 1.0f) * width, 0.5f * (1.0f - y) * height};
     return std::isfinite(out.x) && std::isfinite(out.y);
   }
+  glm::vec3 world(glm::vec3 q) const { return glm::vec3(toWorld * glm::vec4(q, 1.0f)); }
 };
 
 // Area of triangle abc clipped to the image rectangle (Sutherland-Hodgman, then the shoelace).
@@ -61,9 +65,12 @@ float clippedArea(glm::vec2 a, glm::vec2 b, glm::vec2 c, float width, float heig
 }
 
 void addPiece(const Projector& pr, glm::vec3 a, glm::vec3 b, glm::vec3 c, int depth, std::vector<WorkPoint>& out) {
-  glm::vec2 pa, pb, pc;
-  const bool ina = pr.toPixels(a, pa), inb = pr.toPixels(b, pb), inc = pr.toPixels(c, pc);
-  if (ina && inb && inc) {
+  const int front = (pr.inFront(a) ? 1 : 0) + (pr.inFront(b) ? 1 : 0) + (pr.inFront(c) ? 1 : 0);
+  if (front == 0) return;  // every corner behind the camera plane: so is the whole (convex) piece
+  if (front == 3) {
+    glm::vec2 pa, pb, pc;
+    // A corner whose projection overflows: dropped (cutting it would not end).
+    if (!pr.toPixels(a, pa) || !pr.toPixels(b, pb) || !pr.toPixels(c, pc)) return;
     // Wholly outside one side of the image: nothing of it is seen.
     const glm::vec2 lo = glm::min(pa, glm::min(pb, pc)), hi = glm::max(pa, glm::max(pb, pc));
     if (hi.x <= 0.0f || hi.y <= 0.0f || lo.x >= pr.width || lo.y >= pr.height) return;
@@ -72,19 +79,16 @@ void addPiece(const Projector& pr, glm::vec3 a, glm::vec3 b, glm::vec3 c, int de
     const float huge = 4.0f * (pr.width + pr.height);
     if (hi.x - lo.x <= huge && hi.y - lo.y <= huge) {
       const float pixels = clippedArea(pa, pb, pc, pr.width, pr.height);
-      if (pixels <= 0.0f) return;
+      if (!(pixels > 0.0f)) return;
       if (pixels <= kViewWorkPiecePixels || depth >= kMaxCutDepth) {
-        out.push_back({(a + b + c) * (1.0f / 3.0f), pixels});
+        out.push_back({pr.world((a + b + c) * (1.0f / 3.0f)), pixels});
         return;
       }
     }
-  } else if (!ina && !inb && !inc) {
-    // Every corner behind the camera plane: so is the whole (convex) piece.
-    const glm::vec3 qa = glm::vec3(pr.view * glm::vec4(a, 1.0f)), qb = glm::vec3(pr.view * glm::vec4(b, 1.0f)),
-                    qc = glm::vec3(pr.view * glm::vec4(c, 1.0f));
-    if (-qa.z <= pr.znear && -qb.z <= pr.znear && -qc.z <= pr.znear) return;
+  } else if (depth >= kMaxCrossingCutDepth) {
+    return;  // still across the camera plane (viewWork clips triangles first: only by rounding)
   }
-  if (depth >= kMaxCutDepth) return;  // still crossing the camera plane: dropped
+  if (depth >= kMaxCutDepth) return;
   const glm::vec3 ab = 0.5f * (a + b), bc = 0.5f * (b + c), ca = 0.5f * (c + a);
   addPiece(pr, a, ab, ca, depth + 1, out);
   addPiece(pr, ab, b, bc, depth + 1, out);
@@ -96,7 +100,8 @@ void addPiece(const Projector& pr, glm::vec3 a, glm::vec3 b, glm::vec3 c, int de
 
 std::vector<WorkPoint> viewWork(const scene::Scene& scene, const scene::Camera& camera, int width, int height) {
   Projector pr;
-  pr.view = camera.view();
+  pr.toWorld = camera.cameraToWorld;
+  const glm::mat4 view = camera.view();
   pr.orthographic = camera.projection == scene::Projection::Orthographic;
   const float aspect = float(width) / float(height);
   const float tanY = pr.orthographic ? camera.ymag : std::tan(0.5f * camera.yfov);
@@ -107,27 +112,34 @@ std::vector<WorkPoint> viewWork(const scene::Scene& scene, const scene::Camera& 
   pr.height = float(height);
   // A triangle through the camera plane is clipped to its part in front first (a fan of one or
   // two triangles): cutting alone would leave pieces across the plane near the eye, where the
-  // most pixels are.
-  const float plane = -(pr.znear + 1e-6f + 1e-3f * pr.znear);  // view-space z just in front of the eye
+  // most pixels are. The new corners get the clip plane's z exactly, in front of the eye.
+  const float plane = -(pr.znear + 1e-6f + 1e-3f * pr.znear);
   std::vector<WorkPoint> out;
   for (const scene::Triangle& t : scene.triangles) {
-    const glm::vec3 p[3] = {scene.positions[t.v[0]], scene.positions[t.v[1]], scene.positions[t.v[2]]};
-    float z[3];
-    int front = 0;
+    glm::vec3 q[3];
+    bool finite = true;  // a triangle with a non-finite vertex is never hit (the BVH makes it unhittable)
     for (int i = 0; i < 3; ++i) {
-      z[i] = (pr.view * glm::vec4(p[i], 1.0f)).z;
-      front += z[i] < plane ? 1 : 0;
+      const glm::vec3 p = scene.positions[t.v[size_t(i)]];
+      finite = finite && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+      q[i] = glm::vec3(view * glm::vec4(p, 1.0f));
     }
+    if (!finite) continue;
+    int front = 0;
+    for (const glm::vec3& v : q) front += v.z < plane ? 1 : 0;
     if (front == 3 || front == 0) {
-      if (front == 3) addPiece(pr, p[0], p[1], p[2], 0, out);
+      if (front == 3) addPiece(pr, q[0], q[1], q[2], 0, out);
       continue;
     }
     glm::vec3 poly[4];
     int n = 0;
     for (int i = 0; i < 3; ++i) {
       const int j = (i + 1) % 3;
-      if (z[i] < plane) poly[n++] = p[i];
-      if ((z[i] < plane) != (z[j] < plane)) poly[n++] = p[i] + (p[j] - p[i]) * ((plane - z[i]) / (z[j] - z[i]));
+      if (q[i].z < plane) poly[n++] = q[i];
+      if ((q[i].z < plane) != (q[j].z < plane)) {
+        glm::vec3 cut = q[i] + (q[j] - q[i]) * ((plane - q[i].z) / (q[j].z - q[i].z));
+        cut.z = plane;
+        poly[n++] = cut;
+      }
     }
     for (int i = 1; i + 1 < n; ++i) addPiece(pr, poly[0], poly[i], poly[i + 1], 0, out);
   }

@@ -40,14 +40,14 @@ float workQuantile(std::span<const WorkPoint> work, const std::vector<uint32_t>&
   constexpr int kBins = 1024;
   if (!(hi > lo)) return lo;
   std::vector<double> bins(kBins, 0.0);
-  const float scale = float(kBins) / (hi - lo);
-  auto bin = [&](float x) { return std::clamp(int((x - lo) * scale), 0, kBins - 1); };
+  const double scale = double(kBins) / (double(hi) - double(lo));
+  auto bin = [&](float x) { return int(std::clamp((double(x) - double(lo)) * scale, 0.0, double(kBins - 1))); };
   for (uint32_t p : points) bins[size_t(bin(work[p].position[axis]))] += work[p].weight;
   double sum = 0.0;
   for (int i = 0; i < kBins; ++i) {
     if (sum + bins[size_t(i)] >= below && bins[size_t(i)] > 0.0) {
       const double frac = std::clamp((below - sum) / bins[size_t(i)], 0.0, 1.0);
-      return std::clamp(lo + (float(i) + float(frac)) / scale, lo, hi);
+      return std::clamp(float(double(lo) + (double(i) + frac) / scale), lo, hi);
     }
     sum += bins[size_t(i)];
   }
@@ -82,7 +82,7 @@ VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
   }
   if (b.scene.empty()) b.scene = scene::Bounds{glm::vec3(-1.0f), glm::vec3(1.0f)};
 
-  // Work points that count: inside the finite scene, with weight.
+  // Work points that count: finite, with weight.
   std::vector<uint32_t> points;
   for (size_t i = 0; i < options.work.size(); ++i) {
     const WorkPoint& w = options.work[i];
@@ -282,7 +282,7 @@ std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes) {
   }
   double totalWork = 0.0;
   for (int v = 0; v < n; ++v) totalWork += split.work(v);
-  // An empty voxel still costs its traversal: count it as one triangle.
+  // Without work points an empty voxel still costs its traversal: it counts as one triangle.
   auto cost = [&](int v) {
     const double triangles = double(split.triangles(v).size());
     return totalWork > 0.0 ? split.work(v) + double(split.triangleWork()) * triangles : std::max(1.0, triangles);

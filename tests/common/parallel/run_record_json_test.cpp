@@ -172,4 +172,8 @@ TEST_CASE("RunRecord: JSON round trip keeps the tasks' preferred PEs, and a reco
   CHECK(toJsonText(plain.record()).find("preferred") == std::string::npos);
   CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"preferred":[0,1]}],"timeline":[]})", "bad"),
                   pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"preferred":[1]}],"timeline":[]})", "bad"),
+                  pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"preferred":[-2]}],"timeline":[]})", "bad"),
+                  pr::InputError);
 }

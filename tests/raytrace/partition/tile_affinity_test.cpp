@@ -5,8 +5,10 @@
 
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/integrators/integrator_scenes.h"
+#include "raytrace/partition/object_assignment.h"
 #include "raytrace/partition/object_partition.h"
 #include "raytrace/partition/object_space.h"
+#include "raytrace/partition/partition_margin.h"
 #include "raytrace/partition/partitioned_test_support.h"
 #include "raytrace/partition/tile_affinity.h"
 
@@ -77,10 +79,17 @@ TEST_CASE("TileAffinity: the partitioned tracers' tiles prefer the owner of the 
     CHECK(run.image.pixels == reference.pixels);
     const par::StageRecord& trace = test::traceStage(run.record);
     REQUIRE(trace.tasks.size() == 2);
-    const int left = trace.tasks[0].preferredPe, right = trace.tasks[1].preferredPe;
-    CHECK((left == 0 || left == 1));
-    CHECK((right == 0 || right == 1));
-    CHECK(left != right);  // each wall is one PE's
+    // The left tile shows the left wall (triangles 0 and 1): its owner is the object
+    // assignment's (object partitioning) or voxel 0's, PE 0, below the split plane x = 0
+    // (object-space, one voxel per PE).
+    int leftOwner = 0;
+    if (which == 0) {
+      const rt::ObjectAssignment assignment(s, {2, 0, rt::partitionMargin(s, cam.position()), 0.0});
+      for (const rt::ObjectPiece& piece : assignment.pieces())
+        if (piece.triangles.front() == 0) leftOwner = piece.owner;
+    }
+    CHECK(trace.tasks[0].preferredPe == leftOwner);
+    CHECK(trace.tasks[1].preferredPe == 1 - leftOwner);
     // At P = 1 there is no one else to prefer.
     const test::PartitionedRun one = which == 0 ? test::renderPartitioned(object, s, cam, 32, 16, opt, 1, "preferred-bias")
                                                 : test::renderPartitioned(objectSpace, s, cam, 32, 16, opt, 1, "preferred-bias");

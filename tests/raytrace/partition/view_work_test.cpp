@@ -3,6 +3,8 @@
 // floor crossing the camera plane the lower half of the image, in pieces in front of it.
 #include <doctest/doctest.h>
 
+#include <limits>
+
 #include "raytrace/core/geometry_builders.h"
 #include "raytrace/integrators/integrator_scenes.h"
 #include "raytrace/partition/view_work.h"
@@ -54,4 +56,14 @@ TEST_CASE("ViewWork: a floor through the camera plane covers the lower half, in 
   const std::vector<rt::WorkPoint> work = rt::viewWork(floor, cam, 64, 32);
   CHECK(total(work) == doctest::Approx(64.0 * 16.0).epsilon(0.05));
   for (const rt::WorkPoint& w : work) CHECK(w.position.z < 0.0f);
+}
+
+TEST_CASE("ViewWork: a triangle with a non-finite vertex, or beyond float range in view, gives no work") {
+  const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  scene::Scene s = test::emptyScene();
+  test::addTriangle(s, {-1, -1, -5}, {1, -1, -5}, {nan, 1, -5});
+  test::addTriangle(s, {-1, -1, -5}, {inf, -1, -5}, {0, 1, -5});
+  test::addTriangle(s, {-1e38f, -1e38f, -1e-30f}, {1e38f, -1e38f, -1e-30f}, {0, 1e38f, -1e-30f});
+  CHECK(total(rt::viewWork(s, cam, 64, 32)) == 0.0);
 }
