@@ -91,8 +91,9 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
                                : "under its own recorded schedule";
     r.stage.owners.clear();
     // A task's preferred PE names the PE holding its data in the recorded split; at another P
-    // the data lies elsewhere, so the regions fall back to contiguous portions.
-    if (pes != recordedPes) {
+    // the data lies elsewhere, so the regions fall back to contiguous portions. (A cost table,
+    // recordedPes = 0, keeps the preferences it was given.)
+    if (recordedPes > 0 && pes != recordedPes) {
       bool dropped = false;
       for (TaskInfo& t : r.stage.tasks.tasks) {
         dropped = dropped || t.preferredPe >= 0;

@@ -83,7 +83,7 @@ TEST_CASE("FrameAssembly: static tiles send every tile PE 1 owns, one message ea
   }
 }
 
-TEST_CASE("FrameAssembly: the Cornell box at P = 2 sends results for every sort point; P = 1 moves no bytes") {
+TEST_CASE("FrameAssembly: the Cornell box at P = 2 sends results for every sort point, P = 1 moves no bytes") {
   setQuiet(true);
   const scene::Scene s = scene::loadGltf(test::sourceDir() / "scenes" / "cornell.gltf");
   const int w = 64, h = 48;

@@ -85,7 +85,7 @@ TEST_CASE("Lighting: every sort point lights a model without lights by image-bas
   CHECK(pr::image::readImage(dir / "headlight.exr").pixels[0] == glm::vec3(0.0f));
 }
 
-TEST_CASE("Lighting: --env lights a scene from an equirectangular image; a missing file exits 2") {
+TEST_CASE("Lighting: --env lights a scene from an equirectangular image, a missing file exits 2") {
   const std::filesystem::path dir = pr::test::scratchDir("lighting_env");
   pr::image::Image sky(16, 8, glm::vec3(0.5f));
   pr::image::writeImage(dir / "sky.exr", sky);

@@ -107,7 +107,7 @@ TEST_CASE("StageReplay: owners of an undescribed distribution are excluded, with
   CHECK(one.record.wallSeconds == doctest::Approx(4.0 + 2.0));
 }
 
-TEST_CASE("StageReplay: --schedule replaces only the run's own schedule; fixed strategies stay") {
+TEST_CASE("StageReplay: --schedule replaces only the run's own schedule, fixed strategies stay") {
   SimStage traced;
   traced.name = "trace";
   traced.tasks = TaskSet::uniform(4);
@@ -171,7 +171,7 @@ TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split
   CHECK(planReplay(SimStage{}, 2, 3, "demand").handlers.size() == 3);  // none recorded: zero on every PE
 }
 
-TEST_CASE("StageReplay: on one PE no data message is charged; the work stays") {
+TEST_CASE("StageReplay: on one PE no data message is charged, the work stays") {
   SimStage s;
   s.name = "trace";
   s.tasks = TaskSet::uniform(2);

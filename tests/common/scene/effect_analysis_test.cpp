@@ -96,7 +96,7 @@ TEST_CASE("EffectAnalysis: the hot-spot room has a point light, an area light, g
              {Effect::Emission, true, {"light"}}});
 }
 
-TEST_CASE("EffectAnalysis: without lights nothing transports light; without emitters no emission") {
+TEST_CASE("EffectAnalysis: without lights nothing transports light, without emitters no emission") {
   scene::Scene s;
   const uint32_t white = test::addMaterial(s, test::diffuse(0.5f));
   test::addGround(s, 2.0f, white);

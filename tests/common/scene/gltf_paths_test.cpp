@@ -102,7 +102,7 @@ TEST_CASE("GltfPaths: the same bytes load from memory, and an external reference
                        pr::InputError);
 }
 
-TEST_CASE("GltfPaths: a node hierarchy 1000 levels deep loads (the limit; one more is refused)") {
+TEST_CASE("GltfPaths: a node hierarchy 1000 levels deep loads (the limit, one more is refused)") {
   auto dir = pr::test::scratchDir("gltf_deep_hierarchy");
   pr::test::GltfWriter w = pr::test::oneTriangle();
   w.doc["nodes"][0].erase("mesh");

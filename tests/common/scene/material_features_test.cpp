@@ -76,7 +76,7 @@ TEST_CASE("MaterialFeatures: the loader reads KHR_materials_specular, clearcoat 
   CHECK(r.dielectricF90() == 0.25f);
 }
 
-TEST_CASE("MaterialFeatures: KHR_materials_variants picks the mapped material; an unknown name is an input error") {
+TEST_CASE("MaterialFeatures: KHR_materials_variants picks the mapped material, an unknown name is an input error") {
   const auto dir = test::scratchDir("material_features_variants");
   test::GltfWriter w = quad(false, {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 1}}}}});
   w.doc["materials"].push_back({{"pbrMetallicRoughness", {{"baseColorFactor", {0, 0, 1, 1}}}}});

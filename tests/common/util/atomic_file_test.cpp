@@ -22,7 +22,7 @@ size_t filesIn(const std::filesystem::path& dir) {
 }
 }  // namespace
 
-TEST_CASE("AtomicFile: the target appears whole on commit; a failed write leaves the old file") {
+TEST_CASE("AtomicFile: the target appears whole on commit, a failed write leaves the old file") {
   auto dir = pr::test::scratchDir("atomic_file");
   const auto target = dir / "out.txt";
   pr::writeFileAtomically(target, "first");

@@ -23,7 +23,7 @@ RegionFramebuffer stripes(uint32_t primitive, float depth, int every) {
   return fb;
 }
 
-TEST_CASE("Compositor: full and sparse messages carry the same pixels; sparse only the drawn rectangle") {
+TEST_CASE("Compositor: full and sparse messages carry the same pixels, sparse only the drawn rectangle") {
   const RegionFramebuffer a = stripes(1, 0.5f, 2);
   const Rect region{1, 1, 5, 4}, drawn{0, 2, 3, 4};  // a's fragments drawn in rows 2..3, columns 0..2 only
   RegionFramebuffer only(a.rect());

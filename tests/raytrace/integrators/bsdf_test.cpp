@@ -51,7 +51,7 @@ TEST_CASE("Bsdf: sampled weight is f cos / pdf, and f is reciprocal") {
   }
 }
 
-TEST_CASE("Bsdf: a rough dielectric is Lambertian with albedo = base colour; glossy lobes do not create energy") {
+TEST_CASE("Bsdf: a rough dielectric is Lambertian with albedo = base colour, glossy lobes do not create energy") {
   const glm::vec3 wo = glm::normalize(glm::vec3(0.5f, 0.0f, 0.7f));
   // Cosine sampling of a Lambertian lobe has weight = albedo exactly for every sample.
   CHECK(albedo(material(0.5f, 0.0f, 1.0f), wo, 1000) == doctest::Approx(0.5).epsilon(1e-5));

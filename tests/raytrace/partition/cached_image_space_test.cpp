@@ -99,7 +99,7 @@ TEST_CASE("CachedImageSpace: with every PE's foreign geometry poisoned the image
   }
 }
 
-TEST_CASE("CachedImageSpace: each PE holds only its own items; P = 1 moves nothing") {
+TEST_CASE("CachedImageSpace: each PE holds only its own items, P = 1 moves nothing") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);

@@ -42,7 +42,7 @@ TEST_CASE("Sequential: Cornell box renders finite, lit and repeatable") {
   }
 }
 
-TEST_CASE("Sequential: the seed selects the random streams; the same seed gives the same image") {
+TEST_CASE("Sequential: the seed selects the random streams, the same seed gives the same image") {
   const scene::Scene s = scene::loadGltf(test::sourceDir() / "scenes" / "cornell-diffuse.gltf");
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
   auto render = [&](uint64_t seed) {

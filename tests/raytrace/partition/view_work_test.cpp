@@ -40,7 +40,7 @@ TEST_CASE("ViewWork: a quad over the whole view covers every pixel, in pieces of
   }
 }
 
-TEST_CASE("ViewWork: half the view gives half the pixels; behind the camera, none") {
+TEST_CASE("ViewWork: half the view gives half the pixels, behind the camera, none") {
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   const scene::Scene right = quad({0, -100, -5}, {100, -100, -5}, {100, 100, -5}, {0, 100, -5});
   CHECK(total(rt::viewWork(right, cam, 64, 32)) == doctest::Approx(32.0 * 32.0).epsilon(1e-3));

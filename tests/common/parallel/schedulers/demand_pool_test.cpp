@@ -35,7 +35,7 @@ TEST_CASE("DemandPool: random order is a permutation, fixed by its seed") {
   CHECK(a != ids);
 }
 
-TEST_CASE("DemandPool: hot-spots by decreasing estimate, ties in image order; serial is identity") {
+TEST_CASE("DemandPool: hot-spots by decreasing estimate, ties in image order, serial is identity") {
   const TaskSet set = TaskSet::fromCosts({1, 5, 2, 5, 3});
   CHECK(hotSpotsOrder(set, {}) == std::vector<TaskId>{1, 3, 4, 2, 0});
   CHECK(serialOrder(set, {}) == std::vector<TaskId>{0, 1, 2, 3, 4});
