@@ -15,8 +15,9 @@ jobs="${JOBS:-2}"
 # rays, the data-managed tracer with latency hiding; TilePull
 # (raster/sort): PEs waiting on each other's messages inside a task, and the abort;
 # GatherToRoot and PhotonPass (photonmap): per-PE results written during a pre-pass program
-# in every tracer and merged on PE 0.
-runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*"
+# in every tracer and merged on PE 0; TileAffinity (raytrace/partition): probe hits sent to PE 0
+# in the build stage.
+runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*"
 
 cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests
