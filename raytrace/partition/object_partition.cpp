@@ -12,8 +12,8 @@
 // Replicated pieces (object_assignment.h) are in every PE's second BVH: the directory lists
 // them as the owner kEveryPe, which the originator answers itself, like its own pieces.
 // Each tile names as its preferred PE the owner most of its probe rays hit first
-// (tile_affinity.h): under the preferred-bias schedule a tile starts where its rays are
-// answered without a message.
+// (tile_affinity.h; stage "affinity" gathers the owners' probe hits on PE 0): under the
+// preferred-bias schedule a tile starts where its rays are answered without a message.
 #include "raytrace/partition/object_partition.h"
 
 #include <atomic>
@@ -21,7 +21,7 @@
 #include <vector>
 
 #include "common/parallel/batched_channel.h"
-#include "common/parallel/channel.h"
+#include "common/parallel/gather_to_root.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/object_assignment.h"
 #include "raytrace/partition/owner_directory.h"
@@ -72,14 +72,8 @@ class ObjectFrame {
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     // A pre-pass program's tasks are not image tiles: its tasks get no preferred PE.
     const std::vector<Ray> probes = job_.assembleImage && pes > 1 ? affinityProbes(*integrator_, tiles) : std::vector<Ray>{};
-    std::vector<std::vector<float>> nearest(static_cast<size_t>(pes));  // on the controller's PE: every owner's probe hits
-    std::vector<float> shared;                            // the replicated pieces' probe hits
-    struct ProbeHits {
-      int from = 0;
-      std::vector<float> t;
-    };
-    par::Channel<ProbeHits> probeHits(rt_, "affinity", par::MessageKind::Results,
-                                      [&nearest](par::Pe&, ProbeHits&& h) { nearest[size_t(h.from)] = std::move(h.t); });
+    std::vector<std::vector<float>> nearest(static_cast<size_t>(pes));  // per PE: its probe hits
+    std::vector<float> shared;  // the replicated pieces' probe hits, on the controller's PE
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       const int p = pe.id();
       if (!assignment_.triangles(p).empty())
@@ -90,20 +84,15 @@ class ObjectFrame {
       held.insert(held.end(), assignment_.replicated().begin(), assignment_.replicated().end());
       views_.build(p, held, integrator_->context().lights());
       if (probes.empty()) return;
-      std::vector<float> mine = nearestHits(bvhs_[size_t(p)], probes);
-      if (p != kAssemblerPe) {
-        const size_t bytes = mine.size() * sizeof(float);
-        probeHits.send(pe, kAssemblerPe, ProbeHits{p, std::move(mine)}, bytes);
-        return;
-      }
-      nearest[size_t(p)] = std::move(mine);
-      if (!assignment_.replicated().empty()) shared = nearestHits(replicas_[size_t(p)], probes);
+      nearest[size_t(p)] = nearestHits(bvhs_[size_t(p)], probes);
+      if (p == kAssemblerPe && !assignment_.replicated().empty()) shared = nearestHits(replicas_[size_t(p)], probes);
     });
-    par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx);
-    if (!probes.empty()) {
-      const std::vector<int> preferred = preferredPes(nearest, shared, tiles.size());
-      for (size_t t = 0; t < tiles.size(); ++t) tasks.tasks[t].preferredPe = preferred[t];
-    }
+    // The probe hits travel to the controller's PE, where the tiles' preferred PEs are chosen.
+    if (!probes.empty())
+      nearest = par::gatherToRoot(rt_, job_.stage("affinity"), "affinity", par::MessageKind::Results, std::move(nearest),
+                                  sizeof(float), kAssemblerPe);
+    const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx,
+                                           probes.empty() ? std::vector<int>{} : preferredPes(nearest, shared, tiles.size()));
 
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};

@@ -98,11 +98,8 @@ class ObjectSpaceFrame {
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
-    par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx);
-    if (job_.assembleImage && pes > 1) {
-      const std::vector<int> preferred = firstOwners(tiles);
-      for (size_t t = 0; t < tiles.size(); ++t) tasks.tasks[t].preferredPe = preferred[t];
-    }
+    const par::TaskSet tasks =
+        tileTaskSet(tiles, job_.options.tileSizePx, job_.assembleImage && pes > 1 ? firstOwners(tiles) : std::vector<int>{});
     std::atomic<int64_t> done{0};
     par::BatchedChannel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, size_t(job_.options.rayBatch),
                                             [this](par::Pe& pe, RayBatch&& batch) {
@@ -171,7 +168,7 @@ class ObjectSpaceFrame {
     for (size_t i = 0; i < probes.size(); ++i) {
       const RaySlabs slabs(probes[i]);
       split_.walk(probes[i], [&](const VoxelSpan& s) {
-        if (split_.triangles(s.voxel).empty() || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+        if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
         first[size_t(owners_[s.voxel])][i] = s.tEnter;
         return false;
       });
@@ -241,7 +238,7 @@ class ObjectSpaceFrame {
     owners.clear();
     const RaySlabs slabs(m.ray);
     split_.walk(m.ray, [&](const VoxelSpan& s) {
-      if (split_.triangles(s.voxel).empty() || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+      if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;  // empty, or crossed through empty space
       const int owner = owners_[s.voxel];
       if (std::none_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; }))
         owners.push_back(s);

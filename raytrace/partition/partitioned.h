@@ -130,11 +130,16 @@ inline double tileCostEstimate(uint64_t raysTraced, const PixelRect& rect, int64
   return std::max(cost, 1.0);
 }
 
-inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx) {
+// The tasks of the camera-ray tiles; preferred: per tile, the PE holding what its rays need
+// (tile_affinity.h), or empty when none is known.
+inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx, std::span<const int> preferred = {}) {
+  PR_CHECK(preferred.empty() || preferred.size() == tiles.size(), "tileTaskSet: one preferred PE per tile");
   par::TaskSet set;
-  for (const PixelRect& r : tiles)
+  for (size_t t = 0; t < tiles.size(); ++t) {
+    const PixelRect& r = tiles[t];
     set.tasks.push_back({double(r.pixels()), float(r.x0 + r.x1) * 0.5f / float(tileSizePx),
-                         float(r.y0 + r.y1) * 0.5f / float(tileSizePx)});
+                         float(r.y0 + r.y1) * 0.5f / float(tileSizePx), preferred.empty() ? -1 : preferred[t]});
+  }
   return set;
 }
 

@@ -1,12 +1,12 @@
 // Tile affinity: the data-aware conceptual regions of the preferred-bias schedule (seed 3.4.5)
 // for the data-partitioned tracers. A few probe camera rays per tile stand for its rays; in
-// object partitioning every owner traces them against its own geometry and sends the nearest
-// hits to PE 0, where the scheduler reads them; object-space walks them through the replicated
-// kd tree. The owner most of a tile's probes reach first is the tile's preferred PE
-// (TaskInfo::preferredPe): a tile that starts there has its camera rays answered by the
-// originator's own data, and so do most of the rays they spawn nearby, instead of each going to
-// another PE. The probes are a pure function of the camera and the tiles, so the regions, like
-// the image, do not depend on timing.
+// object partitioning every owner traces them against its own geometry in the build stage and
+// the nearest hits are gathered on PE 0 (gather_to_root.h), where the scheduler reads them;
+// object-space walks them through the replicated kd tree. The owner most of a tile's probes
+// reach first is the tile's preferred PE (TaskInfo::preferredPe): a tile that starts there has
+// its camera rays answered by the originator's own data, and so do most of the rays they spawn
+// nearby, instead of each going to another PE. The probes are a pure function of the camera
+// and the tiles, so the regions, like the image, do not depend on timing.
 #pragma once
 
 #include <cstddef>

@@ -10,11 +10,8 @@ namespace pr::rt {
 namespace {
 
 // Cuts of a piece in four before it is taken as it is (or dropped, when it is still far larger
-// than the image or crosses the camera plane): 4^24 pieces of a triangle at most, though only
-// the pieces near the eye are cut that often.
+// than the image): only the pieces near the eye that overlap the image are cut that often.
 constexpr int kMaxCutDepth = 24;
-// Cuts of a piece across the camera plane before it is dropped.
-constexpr int kMaxCrossingCutDepth = 8;
 
 // Pieces are cut and projected in view space (the camera at the origin looking down -z), where
 // the camera plane is a coordinate; their centroids go back to world space.
@@ -25,9 +22,9 @@ struct Projector {
   float znear = 0.0f;
   float width = 0.0f, height = 0.0f;
 
-  bool inFront(glm::vec3 q) const { return -q.z > znear; }
-  // False when the projection of the (view-space, in front) point is not finite.
+  // False when the projection of the (view-space) point is not in front or not finite.
   bool toPixels(glm::vec3 q, glm::vec2& out) const {
+    if (!(-q.z > znear)) return false;
     const float depth = orthographic ? 1.0f : -q.z;
     const float x = q.x / (depth * sx), y = q.y / (depth * sy);  // in [-1, 1] on the image
     out = {0.5f * (x + 1.0f) * width, 0.5f * (1.0f - y) * height};
@@ -64,31 +61,27 @@ float clippedArea(glm::vec2 a, glm::vec2 b, glm::vec2 c, float width, float heig
   return 0.5f * std::fabs(twice);
 }
 
+// A piece in front of the camera (viewWork clips triangles to the camera plane first, and the
+// midpoints of points in front are in front).
 void addPiece(const Projector& pr, glm::vec3 a, glm::vec3 b, glm::vec3 c, int depth, std::vector<WorkPoint>& out) {
-  const int front = (pr.inFront(a) ? 1 : 0) + (pr.inFront(b) ? 1 : 0) + (pr.inFront(c) ? 1 : 0);
-  if (front == 0) return;  // every corner behind the camera plane: so is the whole (convex) piece
-  if (front == 3) {
-    glm::vec2 pa, pb, pc;
-    // A corner whose projection overflows: dropped (cutting it would not end).
-    if (!pr.toPixels(a, pa) || !pr.toPixels(b, pb) || !pr.toPixels(c, pc)) return;
-    // Wholly outside one side of the image: nothing of it is seen.
-    const glm::vec2 lo = glm::min(pa, glm::min(pb, pc)), hi = glm::max(pa, glm::max(pb, pc));
-    if (hi.x <= 0.0f || hi.y <= 0.0f || lo.x >= pr.width || lo.y >= pr.height) return;
-    // Far larger than the image (near the eye): clipping it in 2D would lose the image's
-    // pixels in the rounding of its far corners, so it is cut first.
-    const float huge = 4.0f * (pr.width + pr.height);
-    if (hi.x - lo.x <= huge && hi.y - lo.y <= huge) {
-      const float pixels = clippedArea(pa, pb, pc, pr.width, pr.height);
-      if (!(pixels > 0.0f)) return;
-      if (pixels <= kViewWorkPiecePixels || depth >= kMaxCutDepth) {
-        out.push_back({pr.world((a + b + c) * (1.0f / 3.0f)), pixels});
-        return;
-      }
+  glm::vec2 pa, pb, pc;
+  // A corner whose projection overflows: dropped (cutting it would not end).
+  if (!pr.toPixels(a, pa) || !pr.toPixels(b, pb) || !pr.toPixels(c, pc)) return;
+  // Wholly outside one side of the image: nothing of it is seen.
+  const glm::vec2 lo = glm::min(pa, glm::min(pb, pc)), hi = glm::max(pa, glm::max(pb, pc));
+  if (hi.x <= 0.0f || hi.y <= 0.0f || lo.x >= pr.width || lo.y >= pr.height) return;
+  // Far larger than the image (near the eye): clipping it in 2D would lose the image's pixels
+  // in the rounding of its far corners, so it is cut first.
+  const float huge = 4.0f * (pr.width + pr.height);
+  if (hi.x - lo.x <= huge && hi.y - lo.y <= huge) {
+    const float pixels = clippedArea(pa, pb, pc, pr.width, pr.height);
+    if (!(pixels > 0.0f)) return;
+    if (pixels <= kViewWorkPiecePixels || depth >= kMaxCutDepth) {
+      out.push_back({pr.world((a + b + c) * (1.0f / 3.0f)), pixels});
+      return;
     }
-  } else if (depth >= kMaxCrossingCutDepth) {
-    return;  // still across the camera plane (viewWork clips triangles first: only by rounding)
   }
-  if (depth >= kMaxCutDepth) return;
+  if (depth >= kMaxCutDepth) return;  // still far larger than the image
   const glm::vec3 ab = 0.5f * (a + b), bc = 0.5f * (b + c), ca = 0.5f * (c + a);
   addPiece(pr, a, ab, ca, depth + 1, out);
   addPiece(pr, ab, b, bc, depth + 1, out);

@@ -74,8 +74,9 @@ class VoxelSplit {
   // What a voxel holds, as up to kContentBoxes boxes inside its cell: per scene object the
   // bounds of its triangles' parts in the cell, the largest (by surface area) kept apart and
   // the rest merged, all grown by the margin. False when the ray (slabs) touches none of them
-  // for t in [t0, t1]: then no triangle of the voxel has a hit in that span, and a ray that
-  // crosses the voxel through empty space need not visit its owner. Conservative.
+  // for t in [t0, t1] (always for a voxel without triangles, which has none): then no triangle
+  // of the voxel has a hit in that span, and a ray that crosses the voxel through empty space
+  // need not visit its owner. Conservative.
   static constexpr int kContentBoxes = 6;
   bool reachesContent(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
     for (uint32_t i = contentFirst_[voxel]; i < contentFirst_[voxel + 1]; ++i)

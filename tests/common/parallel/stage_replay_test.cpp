@@ -33,6 +33,17 @@ Workload recordedWorkload(std::vector<SimStage> stages, int pes) {
   return w;
 }
 
+// Four tasks of cost 1 under the run's own schedule.
+SimStage traceStage(const std::string& schedule) {
+  SimStage s;
+  s.name = "trace";
+  s.tasks = TaskSet::uniform(4);
+  s.costs.assign(4, 1.0);
+  s.schedule = schedule;
+  s.runtimeSchedule = true;
+  return s;
+}
+
 SimOptions at(int pes) {
   SimOptions options;
   options.pes = pes;
@@ -108,12 +119,7 @@ TEST_CASE("StageReplay: owners of an undescribed distribution are excluded, with
 }
 
 TEST_CASE("StageReplay: --schedule replaces only the run's own schedule, fixed strategies stay") {
-  SimStage traced;
-  traced.name = "trace";
-  traced.tasks = TaskSet::uniform(4);
-  traced.costs.assign(4, 1.0);
-  traced.schedule = "demand";
-  traced.runtimeSchedule = true;
+  const SimStage traced = traceStage("demand");
   SimStage prePass = traced;
   prePass.name = "cost pre-pass";
   prePass.schedule = "balanced";
@@ -135,12 +141,7 @@ TEST_CASE("StageReplay: --schedule replaces only the run's own schedule, fixed s
 }
 
 TEST_CASE("StageReplay: the tasks' preferred PEs are kept at the recorded P and dropped at another") {
-  SimStage traced;
-  traced.name = "trace";
-  traced.tasks = TaskSet::uniform(4);
-  traced.costs.assign(4, 1.0);
-  traced.schedule = "preferred-bias";
-  traced.runtimeSchedule = true;
+  SimStage traced = traceStage("preferred-bias");
   for (TaskInfo& t : traced.tasks.tasks) t.preferredPe = 1;
   const StageReplay same = planReplay(traced, 2, 2, "");
   CHECK(same.stage.tasks.tasks[0].preferredPe == 1);

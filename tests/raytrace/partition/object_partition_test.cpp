@@ -47,20 +47,6 @@ void checkScene(const std::filesystem::path& file, rt::IntegratorKind kind, int 
   }
 }
 
-// Walls x = -3 (object 0) and x = +3 (object 1), two triangles each.
-scene::Scene twoWalls() {
-  scene::Scene s = test::emptyScene();
-  for (float x : {-3.0f, 3.0f}) {
-    scene::Object obj;
-    obj.firstTriangle = uint32_t(s.triangles.size());
-    obj.triangleCount = 2;
-    test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
-    test::addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
-    s.objects.push_back(obj);
-  }
-  return s;
-}
-
 }  // namespace
 
 TEST_CASE("ObjectPartition: Cornell box, Whitted and path tracer, = sequential for P in {1,2,3,4,8}") {
@@ -133,7 +119,7 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
   // left wall's bounds and pixel 1's only the right's. One tile makes both rays on one PE: it
   // answers its own wall's ray itself and sends one query for the other, which returns one
   // hit record. Diffuse, no lights, Whitted: nothing is spawned. P = 1: no message.
-  const scene::Scene s = twoWalls();
+  const scene::Scene s = test::twoWalls();
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   const image::Image reference = test::renderSequential(s, cam, 2, 1, opt);
@@ -168,7 +154,7 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
 TEST_CASE("ObjectPartition: replicated walls are answered on the originator, without a query") {
   // The two walls of the test above, both replicated (a budget of every triangle): each PE
   // holds both, and the ray that reached the other PE's wall is answered where it started.
-  const scene::Scene s = twoWalls();
+  const scene::Scene s = test::twoWalls();
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   const image::Image reference = test::renderSequential(s, cam, 2, 1, opt);

@@ -156,11 +156,7 @@ TEST_CASE("ObjectSpace: two walls, one tile: exactly one ray message") {
   // voxel 1 (one voxel per PE: voxel i is PE i's). One tile makes both rays on one PE: the ray
   // of the other PE's voxel is sent once, traced there, and (diffuse, no lights, Whitted)
   // spawns nothing. P = 1: no message.
-  scene::Scene s = test::emptyScene();
-  for (float x : {-3.0f, 3.0f}) {
-    test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
-    test::addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
-  }
+  const scene::Scene s = test::twoWalls();
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   for (int p : {1, 2}) {

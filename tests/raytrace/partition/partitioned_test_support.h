@@ -14,12 +14,28 @@
 #include "common/parallel/runtime.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
+#include "raytrace/core/geometry_builders.h"
 #include "raytrace/partition/object_partition.h"
 #include "raytrace/partition/object_space.h"
 #include "raytrace/partition/partition.h"
 #include "test_support.h"
 
 namespace pr::test {
+
+// Walls x = -3 (object 0) and x = +3 (object 1), two triangles each, reaching from z = 1 to
+// z = -2000: seen from the origin, the left half of the image shows the left wall.
+inline scene::Scene twoWalls() {
+  scene::Scene s = emptyScene();
+  for (float x : {-3.0f, 3.0f}) {
+    scene::Object obj;
+    obj.firstTriangle = uint32_t(s.triangles.size());
+    obj.triangleCount = 2;
+    addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
+    addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
+    s.objects.push_back(obj);
+  }
+  return s;
+}
 
 // The partitioned tracer's figures as its run record holds them (Partition/ counters).
 struct PartitionFigures {

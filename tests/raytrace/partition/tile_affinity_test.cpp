@@ -18,21 +18,6 @@ namespace {
 
 constexpr float kInf = rt::kInfinity;
 
-// Walls x = -3 and x = +3 (an object each), seen from the origin: the left half of the image
-// shows the left wall, the right half the right one.
-scene::Scene twoWalls() {
-  scene::Scene s = test::emptyScene();
-  for (float x : {-3.0f, 3.0f}) {
-    scene::Object obj;
-    obj.firstTriangle = uint32_t(s.triangles.size());
-    obj.triangleCount = 2;
-    test::addTriangle(s, {x, -100, 1}, {x, 100, 1}, {x, 100, -2000});
-    test::addTriangle(s, {x, -100, 1}, {x, 100, -2000}, {x, -100, -2000});
-    s.objects.push_back(obj);
-  }
-  return s;
-}
-
 }  // namespace
 
 TEST_CASE("TileAffinity: a tile prefers the PE whose geometry most of its probes hit first") {
@@ -49,7 +34,7 @@ TEST_CASE("TileAffinity: a tile prefers the PE whose geometry most of its probes
 }
 
 TEST_CASE("TileAffinity: probes are camera rays through each tile's quarters") {
-  const scene::Scene s = twoWalls();
+  const scene::Scene s = test::twoWalls();
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   const rt::TraceJob job{s, cam, 32, 16, opt};
@@ -65,7 +50,7 @@ TEST_CASE("TileAffinity: probes are camera rays through each tile's quarters") {
 }
 
 TEST_CASE("TileAffinity: the partitioned tracers' tiles prefer the owner of the wall they show") {
-  const scene::Scene s = twoWalls();
+  const scene::Scene s = test::twoWalls();
   const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
   rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
   opt.tileSizePx = 16;
