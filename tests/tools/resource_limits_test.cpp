@@ -10,11 +10,29 @@
 #include <chrono>
 #include <fstream>
 #include <iterator>
+#include <string>
 #include <thread>
 
 #include "tests/test_support.h"
 
 namespace {
+// Whether the process has a handler for SIGINT (the SigCgt mask of /proc/PID/status), polled
+// until it has one or the wait runs out.
+bool catchesSigint(pid_t pid, std::chrono::seconds wait) {
+  const auto until = std::chrono::steady_clock::now() + wait;
+  const std::string path = "/proc/" + std::to_string(pid) + "/status";
+  while (std::chrono::steady_clock::now() < until) {
+    std::ifstream status(path);
+    for (std::string line; std::getline(status, line);) {
+      if (line.rfind("SigCgt:", 0) != 0) continue;
+      const unsigned long long caught = std::stoull(line.substr(7), nullptr, 16);
+      if (caught & (1ull << (SIGINT - 1))) return true;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
 const std::string kCornell = pr::test::quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf");
 }
 
@@ -64,7 +82,7 @@ TEST_CASE("ResourceLimits: SIGINT stops a long render promptly with exit 130 and
   const auto out = dir / "render.png";
   std::ofstream(out) << "earlier output";
   // A render of minutes, started directly (a shell's background job would inherit SIGINT as
-  // ignored) and interrupted after 1 s.
+  // ignored) and interrupted once it runs.
   const std::string scene = (pr::test::sourceDir() / "scenes" / "cornell.gltf").string(), output = out.string();
   const pid_t child = fork();
   REQUIRE(child >= 0);
@@ -76,7 +94,10 @@ TEST_CASE("ResourceLimits: SIGINT stops a long render promptly with exit 130 and
             "--quiet", "-o", output.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::seconds(1));
+  // Interrupt only once the handler is in place: on a loaded machine the start-up (loading the
+  // shared libraries) can take longer than any fixed wait, and a signal before it kills the child.
+  REQUIRE(catchesSigint(child, std::chrono::seconds(60)));
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const auto sent = std::chrono::steady_clock::now();
   ::kill(child, SIGINT);
   int status = 0;
