@@ -1,8 +1,8 @@
 // Object partitioning's data split: scene objects cut into pieces of bounded size by spatial
 // median splits, the pieces rays reach most per triangle replicated within a budget, and the
 // others dealt to PEs in runs of equal triangle count along a Morton curve.
-// Built once per frame by the controlling thread, before the trace stage
-// (object_partition.cpp); read-only afterwards.
+// Built once per frame on the assembler's PE in the "split" stage (object_partition.cpp);
+// read-only afterwards.
 #include "raytrace/partition/object_assignment.h"
 
 #include <algorithm>
@@ -25,18 +25,23 @@ scene::Bounds boundsOf(const scene::Scene& s, std::span<const uint32_t> tris) {
   return b;
 }
 
-glm::vec3 centroid(const scene::Scene& s, uint32_t t) {
-  const scene::Triangle& tri = s.triangles[t];
-  return (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) * (1.0f / 3.0f);
+// Every triangle's centroid, computed once: the cuts read them at every level.
+std::vector<glm::vec3> centroids(const scene::Scene& s) {
+  std::vector<glm::vec3> out(s.triangles.size());
+  for (size_t t = 0; t < s.triangles.size(); ++t) {
+    const scene::Triangle& tri = s.triangles[t];
+    out[t] = (s.positions[tri.v[0]] + s.positions[tri.v[1]] + s.positions[tri.v[2]]) * (1.0f / 3.0f);
+  }
+  return out;
 }
 
 // Cuts `tris` in two at the middle of its centroids' extent on the longest axis until each
 // part holds at most maxTriangles; when every centroid lies on one side of the middle (all at
 // one point), the cut falls back to the median triangle so it always makes progress.
-void splitPiece(const scene::Scene& s, uint32_t object, std::vector<uint32_t> tris, uint32_t maxTriangles,
-                std::vector<ObjectPiece>& out) {
+void splitPiece(const scene::Scene& s, std::span<const glm::vec3> centroid, uint32_t object, std::vector<uint32_t> tris,
+                uint32_t maxTriangles, std::vector<ObjectPiece>& out) {
   if (tris.size() <= maxTriangles) {
-    std::sort(tris.begin(), tris.end());
+    if (!std::is_sorted(tris.begin(), tris.end())) std::sort(tris.begin(), tris.end());  // after a median cut
     ObjectPiece piece;
     piece.object = object;
     piece.bounds = boundsOf(s, tris);
@@ -45,22 +50,23 @@ void splitPiece(const scene::Scene& s, uint32_t object, std::vector<uint32_t> tr
     return;
   }
   scene::Bounds c;
-  for (uint32_t t : tris) c.extend(centroid(s, t));
+  for (uint32_t t : tris) c.extend(centroid[t]);
   const glm::vec3 e = c.extent();
   const int axis = e.x >= e.y ? (e.x >= e.z ? 0 : 2) : (e.y >= e.z ? 1 : 2);
   const float middle = c.center()[axis];
-  auto mid = std::partition(tris.begin(), tris.end(), [&](uint32_t t) { return centroid(s, t)[axis] < middle; });
+  // Stable, so each part stays in ascending order.
+  auto mid = std::stable_partition(tris.begin(), tris.end(), [&](uint32_t t) { return centroid[t][axis] < middle; });
   if (mid == tris.begin() || mid == tris.end()) {
     mid = tris.begin() + tris.size() / 2;
     std::nth_element(tris.begin(), mid, tris.end(), [&](uint32_t x, uint32_t y) {
-      const float cx = centroid(s, x)[axis], cy = centroid(s, y)[axis];
+      const float cx = centroid[x][axis], cy = centroid[y][axis];
       return cx < cy || (cx == cy && x < y);
     });
   }
   std::vector<uint32_t> upper(mid, tris.end());
   tris.erase(mid, tris.end());
-  splitPiece(s, object, std::move(tris), maxTriangles, out);
-  splitPiece(s, object, std::move(upper), maxTriangles, out);
+  splitPiece(s, centroid, object, std::move(tris), maxTriangles, out);
+  splitPiece(s, centroid, object, std::move(upper), maxTriangles, out);
 }
 
 // 21 bits per axis of the point's place in the cube around the box, interleaved (a cube, so
@@ -101,6 +107,7 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
 
   // Objects as the loader recorded them; triangles outside every object (scenes built in code)
   // form one more object.
+  const std::vector<glm::vec3> centroid = centroids(s);
   std::vector<bool> covered(total, false);
   for (size_t o = 0; o < s.objects.size(); ++o) {
     const scene::Object& obj = s.objects[o];
@@ -108,12 +115,12 @@ ObjectAssignment::ObjectAssignment(const scene::Scene& s, const ObjectAssignment
     std::vector<uint32_t> tris(obj.triangleCount);
     std::iota(tris.begin(), tris.end(), obj.firstTriangle);
     for (uint32_t t : tris) covered[t] = true;
-    if (!tris.empty()) splitPiece(s, static_cast<uint32_t>(o), std::move(tris), maxPiece, pieces_);
+    if (!tris.empty()) splitPiece(s, centroid, static_cast<uint32_t>(o), std::move(tris), maxPiece, pieces_);
   }
   std::vector<uint32_t> rest;
   for (uint32_t t = 0; t < total; ++t)
     if (!covered[t]) rest.push_back(t);
-  if (!rest.empty()) splitPiece(s, static_cast<uint32_t>(s.objects.size()), std::move(rest), maxPiece, pieces_);
+  if (!rest.empty()) splitPiece(s, centroid, static_cast<uint32_t>(s.objects.size()), std::move(rest), maxPiece, pieces_);
 
   // Replicated pieces, most reached per triangle first (ties: the lower piece), while they fit
   // the budget.

@@ -107,18 +107,48 @@ std::vector<WorkPoint> viewWork(const scene::Scene& scene, const scene::Camera& 
   // two triangles): cutting alone would leave pieces across the plane near the eye, where the
   // most pixels are. The new corners get the clip plane's z exactly, in front of the eye.
   const float plane = -(pr.znear + 1e-6f + 1e-3f * pr.znear);
+
+  // Each vertex once (a mesh's vertex is shared by about six triangles): in view space, and its
+  // pixel position where it is in front and projects to finite pixels.
+  struct Projected {
+    glm::vec3 q;
+    glm::vec2 pixel;
+    bool finite, front, projects;
+  };
+  std::vector<Projected> vertices(scene.positions.size());
+  for (size_t i = 0; i < scene.positions.size(); ++i) {
+    const glm::vec3 p = scene.positions[i];
+    Projected& v = vertices[i];
+    v.finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
+    v.q = glm::vec3(view * glm::vec4(p, 1.0f));
+    v.front = v.q.z < plane;
+    v.projects = v.front && pr.toPixels(v.q, v.pixel);
+  }
+
   std::vector<WorkPoint> out;
   for (const scene::Triangle& t : scene.triangles) {
-    glm::vec3 q[3];
-    bool finite = true;  // a triangle with a non-finite vertex is never hit (the BVH makes it unhittable)
-    for (int i = 0; i < 3; ++i) {
-      const glm::vec3 p = scene.positions[t.v[size_t(i)]];
-      finite = finite && std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(p.z);
-      q[i] = glm::vec3(view * glm::vec4(p, 1.0f));
+    const Projected& a = vertices[t.v[0]];
+    const Projected& b = vertices[t.v[1]];
+    const Projected& c = vertices[t.v[2]];
+    if (!(a.finite && b.finite && c.finite)) continue;  // never hit: the BVH makes it unhittable
+    // The common case, a small triangle wholly inside the image: its area needs no clipping,
+    // and its centroid is that of its world-space corners.
+    if (a.projects && b.projects && c.projects) {
+      const glm::vec2 lo = glm::min(a.pixel, glm::min(b.pixel, c.pixel)), hi = glm::max(a.pixel, glm::max(b.pixel, c.pixel));
+      if (hi.x <= 0.0f || hi.y <= 0.0f || lo.x >= pr.width || lo.y >= pr.height) continue;  // outside one side
+      if (lo.x >= 0.0f && lo.y >= 0.0f && hi.x <= pr.width && hi.y <= pr.height) {
+        const glm::vec2 ab = b.pixel - a.pixel, ac = c.pixel - a.pixel;
+        const float pixels = 0.5f * std::fabs(ab.x * ac.y - ab.y * ac.x);
+        if (!(pixels > 0.0f)) continue;
+        if (pixels <= kViewWorkPiecePixels) {
+          const glm::vec3 centroid = (scene.positions[t.v[0]] + scene.positions[t.v[1]] + scene.positions[t.v[2]]) * (1.0f / 3.0f);
+          out.push_back({centroid, pixels});
+          continue;
+        }
+      }
     }
-    if (!finite) continue;
-    int front = 0;
-    for (const glm::vec3& v : q) front += v.z < plane ? 1 : 0;
+    const glm::vec3 q[3] = {a.q, b.q, c.q};
+    const int front = int(a.front) + int(b.front) + int(c.front);
     if (front == 3 || front == 0) {
       if (front == 3) addPiece(pr, q[0], q[1], q[2], 0, out);
       continue;

@@ -5,7 +5,7 @@
 // their work near it. A triangle is cut into four by its edges' midpoints until each piece
 // covers at most kViewWorkPiecePixels, so a wall or floor of two triangles gives work along its
 // whole visible extent, not at one point. Occlusion is ignored: an estimate, cheap enough for
-// the controlling thread (one projection per triangle), not a render.
+// one PE (one projection per vertex), not a render.
 #pragma once
 
 #include <vector>

@@ -2,8 +2,8 @@
 // voxels as asked for, each cut placed so that both sides hold estimated cost in proportion to
 // the voxels they will become (the weight of the work points on each side when given, else the
 // triangle count, straddlers counted on both sides), on the axis that balances best and
-// duplicates the fewest triangles. Then each voxel's content boxes. Built once per frame by
-// the controlling thread before the trace stage (object_space.cpp).
+// duplicates the fewest triangles. Then each voxel's content boxes. Built once per frame on
+// the assembler's PE in the "split" stage (object_space.cpp).
 #include "raytrace/partition/voxel_split.h"
 
 #include <algorithm>
@@ -20,13 +20,12 @@ namespace {
 constexpr int kMaxVoxels = 4096;
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-float maxAbs(glm::vec3 v) { return std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}); }
+bool allFinite(glm::vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
 
 }  // namespace
 
 struct VoxelSplit::Built {
   std::vector<scene::Bounds> bounds;  // per scene triangle
-  std::vector<glm::vec3> centroids;
   scene::Bounds scene;                // of every finite triangle
   std::span<const WorkPoint> work;    // the options' work points
 };
@@ -66,17 +65,15 @@ VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
 
   Built b;
   b.bounds.resize(s.triangles.size());
-  b.centroids.resize(s.triangles.size());
   std::vector<uint32_t> all;
   all.reserve(s.triangles.size());
   for (size_t i = 0; i < s.triangles.size(); ++i) {
     scene::Bounds box;
     for (uint32_t v : s.triangles[i].v) box.extend(s.positions[v]);
     b.bounds[i] = box;
-    b.centroids[i] = box.center();
     // A triangle with a non-finite vertex can never be hit (the BVH makes it unhittable), so
     // no voxel needs it.
-    if (!std::isfinite(maxAbs(box.min)) || !std::isfinite(maxAbs(box.max))) continue;
+    if (!(allFinite(box.min) && allFinite(box.max))) continue;
     b.scene.extend(box);
     all.push_back(static_cast<uint32_t>(i));
   }
@@ -86,7 +83,7 @@ VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
   std::vector<uint32_t> points;
   for (size_t i = 0; i < options.work.size(); ++i) {
     const WorkPoint& w = options.work[i];
-    if (w.weight > 0.0f && std::isfinite(w.weight) && std::isfinite(maxAbs(w.position))) points.push_back(uint32_t(i));
+    if (w.weight > 0.0f && std::isfinite(w.weight) && allFinite(w.position)) points.push_back(uint32_t(i));
   }
   if (!points.empty()) {
     b.work = options.work;
@@ -153,7 +150,8 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
   double work = 0.0;
   for (uint32_t p : points) work += b.work[p].weight;
   if (leaves == 1) {
-    std::sort(tris.begin(), tris.end());
+    // Ascending already: the cuts keep the order of the scene's triangles.
+    PR_CHECK(std::is_sorted(tris.begin(), tris.end()), "VoxelSplit: a voxel's triangles out of order");
     nodes_[index].left = static_cast<uint32_t>(cells_.size());
     cells_.push_back(cell);
     triangles_.push_back(std::move(tris));
@@ -168,20 +166,12 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
   for (int a = 0; a < 3; ++a)
     if (region.min[a] > region.max[a]) region.min[a] = region.max[a] = std::clamp(b.scene.center()[a], cell.min[a], cell.max[a]);
 
-  int bestAxis = -1;
-  float bestPlane = 0.0f;
-  double bestScore = std::numeric_limits<double>::infinity();
+  // Per axis, the plane with nLeft/leaves of the cost below it.
+  float planes[3];
   std::vector<float> coords;
-  coords.reserve(tris.size());
+  coords.reserve(work > 0.0 ? 0 : tris.size());
   for (int a = 0; a < 3; ++a) {
-    // The plane with nLeft/leaves of the triangles' centroids below it (clamped into the
-    // region, since a straddler's centroid may lie outside this cell).
-    coords.clear();
-    if (!(work > 0.0))
-      for (uint32_t t : tris) coords.push_back(std::clamp(b.centroids[t][a], region.min[a], region.max[a]));
     float plane = 0.5f * (region.min[a] + region.max[a]);
-    const size_t m = coords.size();
-    const size_t k = (m * nLeft + leaves / 2) / leaves;
     if (work > 0.0) {
       // The quantile, moved to the middle of the gap between the points on either side of it
       // (as the median is between centroids), so a plane between two walls stays clear of both.
@@ -193,19 +183,40 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
         else upper = std::min(upper, x);
       }
       plane = lower > -kInf && upper < kInf ? lower + 0.5f * (upper - lower) : q;
-    } else if (k > 0 && k < m) {
-      std::nth_element(coords.begin(), coords.begin() + k, coords.end());
-      const float above = coords[k];
-      const float below = *std::max_element(coords.begin(), coords.begin() + k);
-      plane = below + 0.5f * (above - below);
+    } else {
+      // The triangles' centroids (clamped into the region, since a straddler's centroid may lie
+      // outside this cell): the median, between the centroids on either side of it.
+      coords.clear();
+      for (uint32_t t : tris) coords.push_back(std::clamp(b.bounds[t].center()[a], region.min[a], region.max[a]));
+      const size_t m = coords.size();
+      const size_t k = (m * nLeft + leaves / 2) / leaves;
+      if (k > 0 && k < m) {
+        std::nth_element(coords.begin(), coords.begin() + k, coords.end());
+        const float above = coords[k];
+        const float below = *std::max_element(coords.begin(), coords.begin() + k);
+        plane = below + 0.5f * (above - below);
+      }
     }
+    planes[a] = plane;
+  }
+  // The triangles each side of each axis's plane will hold (straddlers on both), in one pass
+  // over the triangles' bounds (the cost of a cut on a million triangles is reading them).
+  size_t left[3] = {0, 0, 0}, right[3] = {0, 0, 0};
+  for (uint32_t t : tris) {
+    const scene::Bounds& box = b.bounds[t];
+    for (int a = 0; a < 3; ++a) {
+      left[a] += box.min[a] <= planes[a] + margin_ ? 1 : 0;
+      right[a] += box.max[a] >= planes[a] - margin_ ? 1 : 0;
+    }
+  }
+
+  int bestAxis = -1;
+  float bestPlane = 0.0f;
+  double bestScore = std::numeric_limits<double>::infinity();
+  for (int a = 0; a < 3; ++a) {
+    const float plane = planes[a];
     // Estimated cost per side: the triangles each side will hold, per voxel it becomes.
-    size_t left = 0, right = 0;
-    for (uint32_t t : tris) {
-      if (b.bounds[t].min[a] <= plane + margin_) ++left;
-      if (b.bounds[t].max[a] >= plane - margin_) ++right;
-    }
-    double score = std::max(double(left) / nLeft, double(right) / nRight);
+    double score = std::max(double(left[a]) / nLeft, double(right[a]) / nRight);
     if (work > 0.0) {
       // The work per voxel against an even share (1 when balanced), plus the fraction of the
       // triangles the plane duplicates.
@@ -213,7 +224,7 @@ uint32_t VoxelSplit::build(Built& b, const scene::Bounds& cell, std::vector<uint
       for (uint32_t p : points)
         if (b.work[p].position[a] < plane) workLeft += b.work[p].weight;
       const double balance = std::max(workLeft / nLeft, (work - workLeft) / nRight) / (work / leaves);
-      score = balance + double(left + right - tris.size()) / double(std::max<size_t>(1, tris.size()));
+      score = balance + double(left[a] + right[a] - tris.size()) / double(std::max<size_t>(1, tris.size()));
     }
     const float extent = region.max[a] - region.min[a];
     const bool better = bestAxis < 0 || score < bestScore ||
