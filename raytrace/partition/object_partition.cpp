@@ -1,5 +1,6 @@
-// The object-partitioning tracer. Stage "build": each owner builds one BVH over its pieces'
-// triangles. Stage "trace": image tiles are tasks that make camera rays on their PE, which
+// The object-partitioning tracer. Stage "split": the assembler's PE cuts the scene into object
+// pieces, deals them to the PEs and makes the owner directory. Stage "build": each owner builds
+// one BVH over its pieces' triangles. Stage "trace": image tiles are tasks that make camera rays on their PE, which
 // becomes the rays' originator. The originator looks up, in the replicated owner directory
 // (owner_directory.h), the owners the ray can reach and where, and asks them one at a time,
 // nearest first: each RayQuery carries the closest hit so far as its tMax, and the ray is
@@ -57,9 +58,8 @@ class ObjectFrame {
   ObjectFrame(const TraceJob& job, par::Runtime& rt, uint32_t maxPieceTriangles, double replicatedFraction)
       : job_(job),
         rt_(rt),
-        assignment_(job.scene,
-                    {rt.pes(), maxPieceTriangles, partitionMargin(job.scene, job.camera.position()), replicatedFraction}),
-        directory_(assignment_),
+        maxPieceTriangles_(maxPieceTriangles),
+        replicatedFraction_(replicatedFraction),
         integrator_(jobIntegrator(job)),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
@@ -69,6 +69,13 @@ class ObjectFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
+    // The pieces, their owners and the owner directory, on the assembler's PE alone: a serial
+    // part of the method, timed as such.
+    rt_.runPinned(job_.stage("split"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+      assignment_ = ObjectAssignment(
+          job_.scene, {pes, maxPieceTriangles_, partitionMargin(job_.scene, job_.camera.position()), replicatedFraction_});
+      directory_ = OwnerDirectory(assignment_);
+    });
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     // A pre-pass program's tasks are not image tiles: its tasks get no preferred PE.
     const std::vector<Ray> probes = job_.assembleImage && pes > 1 ? affinityProbes(*integrator_, tiles) : std::vector<Ray>{};
@@ -297,7 +304,9 @@ class ObjectFrame {
 
   const TraceJob& job_;
   par::Runtime& rt_;
-  ObjectAssignment assignment_;
+  uint32_t maxPieceTriangles_;
+  double replicatedFraction_;
+  ObjectAssignment assignment_;  // and directory_: made in the "split" stage
   OwnerDirectory directory_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image

@@ -1,4 +1,5 @@
-// The object-space tracer. Stage "build": each owner builds one BVH over the triangles its
+// The object-space tracer. Stage "split": the assembler's PE cuts the scene into voxels and deals
+// them to the PEs. Stage "build": each owner builds one BVH over the triangles its
 // voxels hold. Stage "trace": image tiles are tasks that make camera rays; a ray is traced on
 // the PE owning the voxel it is in, and sent (a TravellingRay in a batch on the "rays"
 // BatchedChannel) to the owner of the next voxel along it when it leaves without a hit; the
@@ -74,8 +75,7 @@ class ObjectSpaceFrame {
       : job_(job),
         rt_(rt),
         integrator_(jobIntegrator(job)),
-        split_(makeSplit(job, voxelCount(voxelsPerPe, rt.pes()), integrator_->options().spp)),
-        owners_(assignVoxelOwners(split_, rt.pes())),
+        voxelsPerPe_(voxelsPerPe),
         films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
         bvhs_(rt.pes()),
         held_(rt.pes()),
@@ -84,6 +84,11 @@ class ObjectSpaceFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
+    // The split, on the assembler's PE alone: a serial part of the method, timed as such.
+    rt_.runPinned(job_.stage("split"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+      split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp);
+      owners_ = assignVoxelOwners(split_, pes);
+    });
     // Each owner builds one BVH over its voxels' triangles (a triangle straddling two of them
     // once): task t is PE t's.
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
@@ -295,7 +300,8 @@ class ObjectSpaceFrame {
   const TraceJob& job_;
   par::Runtime& rt_;
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
-  VoxelSplit split_;
+  int voxelsPerPe_;
+  VoxelSplit split_;  // and owners_: made in the "split" stage
   std::vector<int> owners_;
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles
