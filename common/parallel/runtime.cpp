@@ -104,6 +104,10 @@ void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>&
   });
 }
 
+void Runtime::runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work) {
+  runPinned(name, TaskSet::uniform(1), {pe}, [&](Pe& p, TaskId) { work(p); });
+}
+
 void Runtime::recordBroadcast(std::size_t bytesPerPe) {
   PR_CHECK(!inStage_, "recordBroadcast is called between stages");
   pendingBroadcasts_ += 1;

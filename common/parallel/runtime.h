@@ -121,6 +121,9 @@ class Runtime {
   // One task on each PE, task p on PE p: owner-local work (build my BVHs, clear my buffers,
   // composite my rectangle) that no other PE may do for it (shared/DESIGN.md rule 1).
   void runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work);
+  // One task, on PE pe: serial work (a data split, the world BVH) timed as a stage of its own,
+  // which the simulator keeps on one PE at any P.
+  void runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work);
 
   // Replicated read-only data (scene, photon map) of bytesPerPe, sent once to every PE:
   // counted as one broadcast message per receiving PE in the next stage run.

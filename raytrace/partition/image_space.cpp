@@ -39,7 +39,7 @@ class ImageSpacePartition final : public Partition {
     // caller (TraceOptions::worldBvh) is not rebuilt: its build is then outside the record.
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)
-      rt.runPinned(job.stage("build"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+      rt.runOnOnePe(job.stage("build"), kAssemblerPe, [&](par::Pe&) {
         built = std::make_unique<Bvh>(job.scene, job.options.bvh);
       });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;

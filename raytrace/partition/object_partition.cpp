@@ -69,16 +69,16 @@ class ObjectFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
-    // The pieces, their owners and the owner directory, on the assembler's PE alone: a serial
-    // part of the method, timed as such.
-    rt_.runPinned(job_.stage("split"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    // The pieces, their owners, the owner directory and the tiles' probe rays, on the
+    // assembler's PE alone: a serial part of the method, timed as such.
+    std::vector<Ray> probes;
+    rt_.runOnOnePe(job_.stage("split"), kAssemblerPe, [&](par::Pe&) {
       assignment_ = ObjectAssignment(
           job_.scene, {pes, maxPieceTriangles_, partitionMargin(job_.scene, job_.camera.position()), replicatedFraction_});
       directory_ = OwnerDirectory(assignment_);
+      if (wantsTileAffinity(job_, pes)) probes = affinityProbes(*integrator_, tiles);
     });
-    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
-    // A pre-pass program's tasks are not image tiles: its tasks get no preferred PE.
-    const std::vector<Ray> probes = job_.assembleImage && pes > 1 ? affinityProbes(*integrator_, tiles) : std::vector<Ray>{};
     std::vector<std::vector<float>> nearest(static_cast<size_t>(pes));  // per PE: its probe hits
     std::vector<float> shared;  // the replicated pieces' probe hits, on the controller's PE
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
@@ -98,8 +98,9 @@ class ObjectFrame {
     if (!probes.empty())
       nearest = par::gatherToRoot(rt_, job_.stage("affinity"), "affinity", par::MessageKind::Results, std::move(nearest),
                                   sizeof(float), kAssemblerPe);
-    const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx,
-                                           probes.empty() ? std::vector<int>{} : preferredPes(nearest, shared, tiles.size()));
+    std::vector<int> preferred;
+    if (!probes.empty()) preferred = preferredPes(nearestOwners(nearest, shared), tiles.size(), pes);
+    const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
 
     const auto total = int64_t(tiles.size());
     std::atomic<int64_t> done{0};

@@ -53,7 +53,7 @@ VoxelSplit makeSplit(const TraceJob& job, int voxels, int spp) {
     work = viewWork(job.scene, job.camera, job.width, job.height);
     for (WorkPoint& w : work) w.weight *= float(spp);
   }
-  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work, kBuildSamplesPerTriangle});
+  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work});
 }
 
 // A ray on its way to the owner of the next voxel along it: the message with its path state,
@@ -84,10 +84,14 @@ class ObjectSpaceFrame {
 
   TraceResult run() {
     const int pes = rt_.pes();
-    // The split, on the assembler's PE alone: a serial part of the method, timed as such.
-    rt_.runPinned(job_.stage("split"), par::TaskSet::uniform(1), {kAssemblerPe}, [&](par::Pe&, par::TaskId) {
+    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
+    // The split and the tiles' preferred PEs, on the assembler's PE alone: a serial part of the
+    // method, timed as such.
+    std::vector<int> preferred;
+    rt_.runOnOnePe(job_.stage("split"), kAssemblerPe, [&](par::Pe&) {
       split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp);
-      owners_ = assignVoxelOwners(split_, pes);
+      owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
+      if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
     });
     // Each owner builds one BVH over its voxels' triangles (a triangle straddling two of them
     // once): task t is PE t's.
@@ -101,10 +105,8 @@ class ObjectSpaceFrame {
       views_.build(pe.id(), held, integrator_->context().lights());
     });
 
-    const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     const auto total = int64_t(tiles.size());
-    const par::TaskSet tasks =
-        tileTaskSet(tiles, job_.options.tileSizePx, job_.assembleImage && pes > 1 ? firstOwners(tiles) : std::vector<int>{});
+    const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
     std::atomic<int64_t> done{0};
     par::BatchedChannel<TravellingRay> rays(rt_, "rays", par::MessageKind::Rays, size_t(job_.options.rayBatch),
                                             [this](par::Pe& pe, RayBatch&& batch) {
@@ -166,19 +168,19 @@ class ObjectSpaceFrame {
 
   // Per tile, the owner of the first voxel with content that most of its probe rays reach
   // (tile_affinity.h): a camera ray starting there is traced without being sent first. From
-  // the replicated kd tree and content boxes alone, on the controlling thread.
+  // the replicated kd tree and content boxes alone.
   std::vector<int> firstOwners(const std::vector<PixelRect>& tiles) const {
     const std::vector<Ray> probes = affinityProbes(*integrator_, tiles);
-    std::vector<std::vector<float>> first(size_t(rt_.pes()), std::vector<float>(probes.size(), kInfinity));
+    std::vector<int> owner(probes.size(), -1);
     for (size_t i = 0; i < probes.size(); ++i) {
       const RaySlabs slabs(probes[i]);
       split_.walk(probes[i], [&](const VoxelSpan& s) {
         if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
-        first[size_t(owners_[s.voxel])][i] = s.tEnter;
+        owner[i] = owners_[s.voxel];
         return false;
       });
     }
-    return preferredPes(first, {}, tiles.size());
+    return preferredPes(owner, tiles.size(), rt_.pes());
   }
 
   // On PE pe, inside a tile task or the "rays" handler: traces the ray through this PE's
@@ -209,11 +211,12 @@ class ObjectSpaceFrame {
         if (s.voxel != item.voxel) return true;
         reached = true;
       }
-      if (split_.triangles(s.voxel).empty()) return true;  // nothing to hit: no owner needs the ray
-      // Another owner's voxel the ray crosses through empty space holds no hit in its span: the
-      // walk goes on, and a run of this PE's voxels stays open across it.
-      if (owners_[s.voxel] != pe.id() && !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
-      if (owners_[s.voxel] == pe.id()) {
+      // A voxel of this PE's without triangles has nothing to hit; another owner's voxel the ray
+      // crosses through empty space (always so for one without triangles) holds no hit in its
+      // span: the walk goes on, and a run of this PE's voxels stays open across it.
+      const bool mine = owners_[s.voxel] == pe.id();
+      if (mine ? split_.triangles(s.voxel).empty() : !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+      if (mine) {
         if (!run) runEnter = s.tEnter;
         run = true;
         runExit = s.tExit;
@@ -249,14 +252,9 @@ class ObjectSpaceFrame {
         owners.push_back(s);
       return true;
     });
-    if (owners.empty()) {  // no voxel content on the ray: nothing can occlude it
-      Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
-      integrator_->miss(m, emit);
-      return;
-    }
     auto me = std::find_if(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == pe.id(); });
-    if (item.voxel == TravellingRay::kStartVoxel && me != owners.begin()) {
-      me = owners.begin();  // a new ray starts at the first owner on it (or has none)
+    if (item.voxel == TravellingRay::kStartVoxel && (owners.empty() || me != owners.begin())) {
+      me = owners.begin();  // a new ray starts at the first owner on it, or has none: unoccluded
     } else {
       PR_CHECK(me != owners.end(), "object-space: a shadow ray sent to a PE that owns no voxel on it");
       if (bvhs_[size_t(pe.id())].occluded(m.ray)) return;  // blocked

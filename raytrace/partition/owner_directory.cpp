@@ -4,7 +4,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 
 namespace pr::rt {
@@ -43,12 +42,7 @@ void OwnerDirectory::build(uint32_t node, uint32_t begin, uint32_t end) {
     centres.extend(leaves_[i].box.center());
   }
   Node& n = nodes_[node];
-  for (int a = 0; a < 3; ++a) {
-    n.lo[a] = box.min[a];
-    n.hi[a] = box.max[a];
-  }
-  n.lo[3] = -std::numeric_limits<float>::infinity();
-  n.hi[3] = std::numeric_limits<float>::infinity();
+  n.box = SlabBox::of(box);
   if (end - begin == 1) {
     n.leaf = true;
     n.first = begin;
@@ -83,7 +77,7 @@ void OwnerDirectory::NearestFirst::push(uint32_t node) {
   const Node& n = directory_.nodes_[node];
   if (n.leaf && directory_.leaves_[n.first].owner == except_) return;
   float entry;
-  if (!slabs_.entry(n.lo, n.hi, entry)) return;
+  if (!slabs_.entry(n.box, entry)) return;
   heap_.push_back({entry, node});
   std::push_heap(heap_.begin(), heap_.end(), later);
 }
@@ -113,7 +107,7 @@ void OwnerDirectory::ownersNearestFirst(const Ray& ray, int except, std::vector<
     const RaySlabs slabs(ray);
     for (const Node& n : nodes_) {
       float t;
-      if (n.leaf && leaves_[n.first].owner != except && slabs.entry(n.lo, n.hi, t)) out.push_back({t, leaves_[n.first].owner});
+      if (n.leaf && leaves_[n.first].owner != except && slabs.entry(n.box, t)) out.push_back({t, leaves_[n.first].owner});
     }
     std::sort(out.begin(), out.end(), [](const OwnerEntry& x, const OwnerEntry& y) { return x.t < y.t || (x.t == y.t && x.owner < y.owner); });
     return;

@@ -69,9 +69,7 @@ class OwnerDirectory {
 
  private:
   struct Node {
-    // The box as 4 lanes for the SSE slab test; lane 3 is (-inf, +inf), which never limits.
-    alignas(16) float lo[4];
-    alignas(16) float hi[4];
+    SlabBox box;
     uint32_t first = 0;  // a leaf: index into leaves_; else the first of two child nodes
     bool leaf = false;
   };

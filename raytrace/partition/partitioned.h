@@ -130,6 +130,10 @@ inline double tileCostEstimate(uint64_t raysTraced, const PixelRect& rect, int64
   return std::max(cost, 1.0);
 }
 
+// Whether the tiles get preferred PEs (tile_affinity.h): only with another PE to prefer, and
+// only for image tiles (a pre-pass program's tasks start no camera rays).
+inline bool wantsTileAffinity(const TraceJob& job, int pes) { return job.assembleImage && pes > 1; }
+
 // The tasks of the camera-ray tiles; preferred: per tile, the PE holding what its rays need
 // (tile_affinity.h), or empty when none is known.
 inline par::TaskSet tileTaskSet(const std::vector<PixelRect>& tiles, int tileSizePx, std::span<const int> preferred = {}) {

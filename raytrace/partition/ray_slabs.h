@@ -11,9 +11,28 @@
 
 #include <emmintrin.h>  // SSE2: part of every x86-64 target
 
+#include "common/scene/scene.h"
 #include "raytrace/core/ray.h"
 
 namespace pr::rt {
+
+// A box as 4 lanes for RaySlabs' SSE test; lane 3 is (-inf, +inf), which never limits.
+struct SlabBox {
+  alignas(16) float lo[4];
+  alignas(16) float hi[4];
+
+  // b grown by `grow` on every side.
+  static SlabBox of(const scene::Bounds& b, float grow = 0.0f) {
+    SlabBox box;
+    for (int a = 0; a < 3; ++a) {
+      box.lo[a] = b.min[a] - grow;
+      box.hi[a] = b.max[a] + grow;
+    }
+    box.lo[3] = -std::numeric_limits<float>::infinity();
+    box.hi[3] = std::numeric_limits<float>::infinity();
+    return box;
+  }
+};
 
 // The slab test of one ray against many boxes, three axes in one SSE register. Rounding of
 // (b - o) * (1 / d) is below gamma(3) relative (Ize 2013): the near distance is moved towards
@@ -39,26 +58,26 @@ class RaySlabs {
     parallel_ = _mm_castsi128_ps(_mm_load_si128(reinterpret_cast<const __m128i*>(parallel)));
   }
 
-  // lo, hi: 16-byte aligned (x, y, z, lane 3 = (-inf, +inf)). t: the entry when reached.
-  bool entry(const float* lo, const float* hi, float& t) const {
+  // t: the entry when reached.
+  bool entry(const SlabBox& box, float& t) const {
     float near, far;
-    interval(lo, hi, near, far);
+    interval(box, near, far);
     t = std::max(near, tMin_);
     return t <= std::min(far, tMax_);
   }
   // Whether the ray touches the box for some t in [t0, t1].
-  bool overlaps(const float* lo, const float* hi, float t0, float t1) const {
+  bool overlaps(const SlabBox& box, float t0, float t1) const {
     float near, far;
-    interval(lo, hi, near, far);
+    interval(box, near, far);
     return std::max(near, t0) <= std::min(far, t1);
   }
 
  private:
   // The ray's parameters in the box (widened): near > far when it misses.
-  void interval(const float* lo, const float* hi, float& near, float& far) const {
+  void interval(const SlabBox& box, float& near, float& far) const {
     constexpr float kUlp = 0x1p-24f;
     constexpr float kSlack = 2.0f * (3.0f * kUlp) / (1.0f - 3.0f * kUlp);
-    const __m128 l = _mm_load_ps(lo), h = _mm_load_ps(hi);
+    const __m128 l = _mm_load_ps(box.lo), h = _mm_load_ps(box.hi);
     const __m128 a = _mm_mul_ps(_mm_sub_ps(l, origin_), inverse_);
     const __m128 b = _mm_mul_ps(_mm_sub_ps(h, origin_), inverse_);
     const __m128 absMask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));

@@ -27,24 +27,31 @@ std::vector<Ray> affinityProbes(const Integrator& integrator, std::span<const Pi
   return probes;
 }
 
-std::vector<int> preferredPes(const std::vector<std::vector<float>>& nearest, std::span<const float> shared,
-                              std::size_t tiles) {
-  const std::size_t probes = tiles * kAffinityProbesPerTile;
-  for (const std::vector<float>& n : nearest) PR_CHECK(n.size() == probes, "preferredPes: one hit per probe per PE");
-  PR_CHECK(shared.empty() || shared.size() == probes, "preferredPes: one shared hit per probe");
+std::vector<int> nearestOwners(const std::vector<std::vector<float>>& nearest, std::span<const float> shared) {
+  const std::size_t probes = nearest.empty() ? shared.size() : nearest.front().size();
+  for (const std::vector<float>& n : nearest) PR_CHECK(n.size() == probes, "nearestOwners: one hit per probe per PE");
+  PR_CHECK(shared.empty() || shared.size() == probes, "nearestOwners: one shared hit per probe");
+  std::vector<int> owner(probes, -1);
+  for (std::size_t i = 0; i < probes; ++i) {
+    float best = shared.empty() ? kInfinity : shared[i];
+    for (std::size_t p = 0; p < nearest.size(); ++p)
+      if (nearest[p][i] < best) {
+        best = nearest[p][i];
+        owner[i] = int(p);
+      }
+  }
+  return owner;
+}
+
+std::vector<int> preferredPes(std::span<const int> probeOwner, std::size_t tiles, int pes) {
+  PR_CHECK(probeOwner.size() == tiles * kAffinityProbesPerTile, "preferredPes: kAffinityProbesPerTile probes per tile");
   std::vector<int> preferred(tiles, -1);
-  std::vector<int> votes(nearest.size());
+  std::vector<int> votes(static_cast<std::size_t>(pes));
   for (std::size_t t = 0; t < tiles; ++t) {
     std::fill(votes.begin(), votes.end(), 0);
     for (std::size_t i = t * kAffinityProbesPerTile; i < (t + 1) * kAffinityProbesPerTile; ++i) {
-      int first = -1;
-      float best = shared.empty() ? kInfinity : shared[i];
-      for (std::size_t p = 0; p < nearest.size(); ++p)
-        if (nearest[p][i] < best) {
-          best = nearest[p][i];
-          first = int(p);
-        }
-      if (first >= 0) ++votes[size_t(first)];
+      PR_CHECK(probeOwner[i] < pes, "preferredPes: a probe's owner outside [0, P)");
+      if (probeOwner[i] >= 0) ++votes[size_t(probeOwner[i])];
     }
     const auto most = std::max_element(votes.begin(), votes.end());  // the first of equals
     if (most != votes.end() && *most > 0) preferred[t] = int(most - votes.begin());

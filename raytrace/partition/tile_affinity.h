@@ -27,9 +27,12 @@ inline constexpr int kAffinityProbesPerTile = kAffinityProbesPerEdge * kAffinity
 std::vector<Ray> affinityProbes(const Integrator& integrator, std::span<const PixelRect> tiles);
 
 // nearest[p][i]: the nearest hit of probe i on PE p's own geometry (kInfinity: none); shared[i]
-// the same on geometry every PE holds (empty: none such). Per tile: the PE whose geometry most
-// of its probes hit first (ties: the lower PE), or -1 when no probe hits owned geometry first.
-std::vector<int> preferredPes(const std::vector<std::vector<float>>& nearest, std::span<const float> shared,
-                              std::size_t tiles);
+// the same on geometry every PE holds (empty: none such). Per probe: the PE whose geometry it
+// hits first (ties: the lower PE), or -1 when it hits none or the shared geometry first.
+std::vector<int> nearestOwners(const std::vector<std::vector<float>>& nearest, std::span<const float> shared);
+
+// probeOwner[i]: the PE that answers probe i first, or -1 (nearestOwners). Per tile: the PE
+// most of its probes name (ties: the lower PE), or -1 when none names one.
+std::vector<int> preferredPes(std::span<const int> probeOwner, std::size_t tiles, int pes);
 
 }  // namespace pr::rt

@@ -56,12 +56,11 @@ float workQuantile(std::span<const WorkPoint> work, const std::vector<uint32_t>&
 }  // namespace
 
 VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
-    : triangleWork_(options.triangleWork), margin_(options.margin) {
+    : margin_(options.margin) {
   if (options.voxels < 1 || options.voxels > kMaxVoxels)
     throw InputError("object-space partitioning: " + std::to_string(options.voxels) +
                      " voxels requested, expected 1 to " + std::to_string(kMaxVoxels));
   PR_CHECK(std::isfinite(margin_) && margin_ >= 0.0f, "VoxelSplit: margin must be finite and >= 0");
-  PR_CHECK(std::isfinite(triangleWork_) && triangleWork_ >= 0.0f, "VoxelSplit: triangle work must be finite and >= 0");
 
   Built b;
   b.bounds.resize(s.triangles.size());
@@ -125,17 +124,7 @@ void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
       for (size_t i = kContentBoxes; i < boxes.size(); ++i) boxes[kContentBoxes - 1].extend(boxes[i]);
       boxes.resize(kContentBoxes);
     }
-    for (const scene::Bounds& box : boxes) {
-      if (box.empty()) continue;
-      ContentBox c;
-      for (int a = 0; a < 3; ++a) {
-        c.lo[a] = box.min[a] - margin_;
-        c.hi[a] = box.max[a] + margin_;
-      }
-      c.lo[3] = -kInf;
-      c.hi[3] = kInf;
-      content_.push_back(c);
-    }
+    for (const scene::Bounds& box : boxes) content_.push_back(SlabBox::of(box, margin_));
     contentFirst_.push_back(static_cast<uint32_t>(content_.size()));
   }
 }
@@ -283,20 +272,19 @@ std::vector<VoxelSpan> VoxelSplit::spans(const Ray& ray) const {
   return out;
 }
 
-std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes) {
+std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes, float triangleWork) {
   PR_CHECK(pes >= 1, "assignVoxelOwners: at least one PE");
+  PR_CHECK(std::isfinite(triangleWork) && triangleWork >= 0.0f, "assignVoxelOwners: triangle work must be finite and >= 0");
   const int n = split.voxels();
   std::vector<int> owners(n, 0);
   if (n == pes) {
     std::iota(owners.begin(), owners.end(), 0);
     return owners;
   }
-  double totalWork = 0.0;
-  for (int v = 0; v < n; ++v) totalWork += split.work(v);
   // Without work points an empty voxel still costs its traversal: it counts as one triangle.
   auto cost = [&](int v) {
     const double triangles = double(split.triangles(v).size());
-    return totalWork > 0.0 ? split.work(v) + double(split.triangleWork()) * triangles : std::max(1.0, triangles);
+    return split.hasWork() ? split.work(v) + double(triangleWork) * triangles : std::max(1.0, triangles);
   };
   std::vector<int> order(n);
   std::iota(order.begin(), order.end(), 0);

@@ -29,10 +29,6 @@ struct VoxelSplitOptions {
   // cut puts on each side work in proportion to the voxels it will become, on the axis that
   // balances it best and duplicates the fewest triangles; else triangle counts are balanced.
   std::span<const WorkPoint> work{};
-  // The work of holding one triangle (its share of the owner's BVH build), in the work points'
-  // unit: added to a voxel's work when voxels are dealt to PEs (assignVoxelOwners), not when
-  // cutting, so a cluster of many triangles but little view work is not dealt to one PE whole.
-  float triangleWork = 0.0f;
 };
 
 // The part of a ray inside one voxel: t in [tEnter, tExit]. Consecutive spans of a walk share
@@ -66,10 +62,10 @@ class VoxelSplit {
   // The estimated work in the voxel: the weight of the work points inside its cell (0 for
   // every voxel of a split made without work points).
   double work(int voxel) const { return work_.empty() ? 0.0 : work_[size_t(voxel)]; }
-  float triangleWork() const { return triangleWork_; }
+  bool hasWork() const { return !work_.empty(); }
   // Bytes of the kd tree and the voxels' content boxes, which every PE keeps a copy of to
   // route rays.
-  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(ContentBox); }
+  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(SlabBox); }
 
   // What a voxel holds, as up to kContentBoxes boxes inside its cell: per scene object the
   // bounds of its triangles' parts in the cell, the largest (by surface area) kept apart and
@@ -80,7 +76,7 @@ class VoxelSplit {
   static constexpr int kContentBoxes = 6;
   bool reachesContent(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
     for (uint32_t i = contentFirst_[voxel]; i < contentFirst_[voxel + 1]; ++i)
-      if (slabs.overlaps(content_[i].lo, content_[i].hi, t0, t1)) return true;
+      if (slabs.overlaps(content_[i], t0, t1)) return true;
     return false;
   }
 
@@ -101,11 +97,6 @@ class VoxelSplit {
     uint32_t left = 0, right = 0;
   };
   struct Built;
-  // A box as 4 lanes for the SSE slab test; lane 3 is (-inf, +inf), which never limits.
-  struct ContentBox {
-    alignas(16) float lo[4];
-    alignas(16) float hi[4];
-  };
 
   uint32_t build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, std::vector<uint32_t> points, int leaves,
                  int depth);
@@ -114,18 +105,19 @@ class VoxelSplit {
   std::vector<Node> nodes_;
   std::vector<scene::Bounds> cells_;
   std::vector<std::vector<uint32_t>> triangles_;
-  std::vector<ContentBox> content_;      // voxel v's: [contentFirst_[v], contentFirst_[v + 1])
+  std::vector<SlabBox> content_;      // voxel v's: [contentFirst_[v], contentFirst_[v + 1])
   std::vector<uint32_t> contentFirst_;
   std::vector<double> work_;  // per voxel, when built with work points
-  float triangleWork_ = 0.0f;
   float margin_ = 0.0f;
 };
 
 // Owners of k·P voxels: longest processing time first by estimated work (the voxel's work plus
-// triangleWork per triangle it holds), or by triangle count for a split made without work
-// points (ties to the lower voxel, then the lower PE), so every PE gets about the same work (or
-// geometry); with as many voxels as PEs, voxel i goes to PE i.
-std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes);
+// triangleWork per triangle it holds: the work of holding one, its share of the owner's BVH
+// build, in the work points' unit, so a cluster of many triangles but little view work is not
+// dealt to one PE whole), or by triangle count for a split made without work points (ties to
+// the lower voxel, then the lower PE), so every PE gets about the same work (or geometry); with
+// as many voxels as PEs, voxel i goes to PE i.
+std::vector<int> assignVoxelOwners(const VoxelSplit& split, int pes, float triangleWork = 0.0f);
 
 template <class Visit>
 void VoxelSplit::walk(const Ray& ray, Visit&& visit) const {

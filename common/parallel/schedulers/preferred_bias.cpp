@@ -22,16 +22,15 @@ class PreferredBiasScheduler : public Scheduler {
     costs_.resize(tasks.size());
     for (std::size_t i = 0; i < tasks.size(); ++i) costs_[i] = tasks.tasks[i].costEstimate;
     regions_.assign(static_cast<std::size_t>(pes), Region{});
+    // The portions are contiguous and ascending, so each region's ids come in id order.
     const auto portions = balancedSplit(tasks.size(), pes);
-    std::vector<int> region(tasks.size());
     for (int p = 0; p < pes; ++p)
-      for (TaskId id : portions[p]) region[id] = p;
-    for (std::size_t id = 0; id < tasks.size(); ++id) {
-      const int preferred = tasks.tasks[id].preferredPe;
-      Region& r = regions_[preferred >= 0 && preferred < pes ? preferred : region[id]];
-      r.ids.push_back(static_cast<TaskId>(id));
-      r.costLeft += costs_[id];
-    }
+      for (TaskId id : portions[p]) {
+        const int preferred = tasks.tasks[id].preferredPe;
+        Region& r = regions_[preferred >= 0 && preferred < pes ? preferred : p];
+        r.ids.push_back(id);
+        r.costLeft += costs_[id];
+      }
     for (Region& r : regions_) r.back = r.ids.size();
   }
 

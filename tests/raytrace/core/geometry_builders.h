@@ -30,6 +30,19 @@ inline void addTriangle(scene::Scene& s, glm::vec3 a, glm::vec3 b, glm::vec3 c, 
   s.bounds.extend(c);
 }
 
+// Appends src's vertices and triangles to s (its indices moved past s's vertices), each
+// triangle with `material`.
+inline void appendTriangles(scene::Scene& s, const scene::Scene& src, uint32_t material = 0) {
+  const auto base = static_cast<uint32_t>(s.positions.size());
+  s.positions.insert(s.positions.end(), src.positions.begin(), src.positions.end());
+  for (scene::Triangle t : src.triangles) {
+    for (uint32_t& v : t.v) v += base;
+    t.material = material;
+    s.triangles.push_back(t);
+  }
+  s.bounds.extend(src.bounds);
+}
+
 // `count` random triangles with vertices in centre +- scale (edges up to ~0.3 scale).
 inline scene::Scene randomSoup(int count, float scale = 1.0f, glm::vec3 centre = glm::vec3(0.0f),
                                uint32_t seed = 1) {

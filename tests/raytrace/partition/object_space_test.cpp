@@ -119,13 +119,7 @@ TEST_CASE("ObjectSpace: axis-aligned city, rays parallel to the split planes, = 
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) {
       const scene::Scene box = test::closedBox(glm::vec3(i - 2, 0, j - 2), glm::vec3(i - 1, 1 + (i * 3 + j) % 4, j - 1), 1);
-      const auto base = uint32_t(s.positions.size());
-      s.positions.insert(s.positions.end(), box.positions.begin(), box.positions.end());
-      for (scene::Triangle t : box.triangles) {
-        for (uint32_t& v : t.v) v += base;
-        t.material = white;
-        s.triangles.push_back(t);
-      }
+      test::appendTriangles(s, box, white);
     }
   s.normals.clear();  // the boxes come without: geometric normals everywhere
   s.uvs.clear();

@@ -28,9 +28,9 @@ TEST_CASE("TileAffinity: a tile prefers the PE whose geometry most of its probes
       {1, 1, 1, 5, 1, 1, 5, 5, 3, 3, 3, 3, kInf, kInf, kInf, kInf},
       {2, 2, 2, 2, 2, 2, 1, 1, 4, 4, 4, 4, kInf, kInf, kInf, kInf}};
   const std::vector<float> shared = {9, 9, 9, 9, 9, 9, 9, 9, 1, 1, 1, 1, kInf, kInf, kInf, kInf};
-  CHECK(rt::preferredPes(nearest, shared, 4) == std::vector<int>{0, 0, -1, -1});
+  CHECK(rt::preferredPes(rt::nearestOwners(nearest, shared), 4, 2) == std::vector<int>{0, 0, -1, -1});
   // Without shared geometry tile 2's probes hit PE 0 first.
-  CHECK(rt::preferredPes(nearest, {}, 4) == std::vector<int>{0, 0, 0, -1});
+  CHECK(rt::preferredPes(rt::nearestOwners(nearest, {}), 4, 2) == std::vector<int>{0, 0, 0, -1});
 }
 
 TEST_CASE("TileAffinity: probes are camera rays through each tile's quarters") {
@@ -57,10 +57,10 @@ TEST_CASE("TileAffinity: the partitioned tracers' tiles prefer the owner of the 
   const image::Image reference = test::renderSequential(s, cam, 32, 16, opt);
   rt::ObjectPartition object;
   rt::ObjectSpacePartition objectSpace(1);
-  for (int which = 0; which < 2; ++which) {
-    CAPTURE(which);
-    const test::PartitionedRun run = which == 0 ? test::renderPartitioned(object, s, cam, 32, 16, opt, 2, "preferred-bias")
-                                                : test::renderPartitioned(objectSpace, s, cam, 32, 16, opt, 2, "preferred-bias");
+  for (rt::Partition* tracer : std::initializer_list<rt::Partition*>{&object, &objectSpace}) {
+    const bool isObject = tracer == &object;
+    CAPTURE(isObject);
+    const test::PartitionedRun run = test::renderPartitioned(*tracer, s, cam, 32, 16, opt, 2, "preferred-bias");
     CHECK(run.image.pixels == reference.pixels);
     const par::StageRecord& trace = test::traceStage(run.record);
     REQUIRE(trace.tasks.size() == 2);
@@ -68,7 +68,7 @@ TEST_CASE("TileAffinity: the partitioned tracers' tiles prefer the owner of the 
     // assignment's (object partitioning) or voxel 0's, PE 0, below the split plane x = 0
     // (object-space, one voxel per PE).
     int leftOwner = 0;
-    if (which == 0) {
+    if (isObject) {
       const rt::ObjectAssignment assignment(s, {2, 0, rt::partitionMargin(s, cam.position()), 0.0});
       for (const rt::ObjectPiece& piece : assignment.pieces())
         if (piece.triangles.front() == 0) leftOwner = piece.owner;
@@ -76,8 +76,7 @@ TEST_CASE("TileAffinity: the partitioned tracers' tiles prefer the owner of the 
     CHECK(trace.tasks[0].preferredPe == leftOwner);
     CHECK(trace.tasks[1].preferredPe == 1 - leftOwner);
     // At P = 1 there is no one else to prefer.
-    const test::PartitionedRun one = which == 0 ? test::renderPartitioned(object, s, cam, 32, 16, opt, 1, "preferred-bias")
-                                                : test::renderPartitioned(objectSpace, s, cam, 32, 16, opt, 1, "preferred-bias");
+    const test::PartitionedRun one = test::renderPartitioned(*tracer, s, cam, 32, 16, opt, 1, "preferred-bias");
     for (const par::TaskInfo& t : test::traceStage(one.record).tasks) CHECK(t.preferredPe == -1);
   }
 }

@@ -52,6 +52,23 @@ Hit voxelByVoxel(const VoxelSplit& split, const std::vector<Bvh>& bvhs, const Ra
   return result;
 }
 
+// Test ray i: an even one from the eye towards a random point of the plane z = 0, an odd one
+// from a random point in a random direction (u's draws, scaled per axis, taken in order).
+Ray eyeOrRandomRay(int i, glm::vec3 eye, std::mt19937& rng, std::uniform_real_distribution<float>& u,
+                   glm::vec3 originScale = glm::vec3(1.0f), glm::vec2 targetScale = glm::vec2(1.0f)) {
+  Ray ray;
+  if (i % 2 == 0) {
+    const float x = u(rng), y = u(rng);
+    ray.origin = eye;
+    ray.direction = glm::normalize(glm::vec3(x * targetScale.x, y * targetScale.y, 0.0f) - eye);
+  } else {
+    const float x = u(rng), y = u(rng), z = u(rng);
+    ray.origin = glm::vec3(x, y, z) * originScale;
+    ray.direction = pr::test::randomDirection(rng);
+  }
+  return ray;
+}
+
 std::vector<Bvh> voxelBvhs(const pr::scene::Scene& s, const VoxelSplit& split) {
   std::vector<Bvh> bvhs;
   for (int v = 0; v < split.voxels(); ++v) bvhs.emplace_back(s.positions, s.triangles, split.triangles(v));
@@ -168,9 +185,7 @@ TEST_CASE("VoxelSplit: voxel by voxel first hits equal the full BVH bit for bit"
   std::uniform_real_distribution<float> u(-1.2f, 1.2f);
   int hits = 0;
   for (int i = 0; i < 600; ++i) {
-    Ray ray;
-    ray.origin = i % 2 == 0 ? eye : glm::vec3(u(rng), u(rng), u(rng));
-    ray.direction = i % 2 == 0 ? glm::normalize(glm::vec3(u(rng), u(rng), 0.0f) - eye) : pr::test::randomDirection(rng);
+    const Ray ray = eyeOrRandomRay(i, eye, rng, u);
     Hit expected;
     const bool hit = full.intersect(ray, expected);
     const Hit got = voxelByVoxel(split, bvhs, ray);
@@ -190,13 +205,7 @@ TEST_CASE("VoxelSplit: a voxel's content boxes are reached wherever it has a hit
   // would skip the owner of the hit); a ray through the gap between two far clusters reaches
   // neither's content although it crosses their voxels.
   pr::scene::Scene s = pr::test::randomSoup(400, 0.5f, glm::vec3(-3.0f, 0.0f, 0.0f), 5);
-  const pr::scene::Scene right = pr::test::randomSoup(400, 0.5f, glm::vec3(3.0f, 0.0f, 0.0f), 6);
-  const uint32_t base = uint32_t(s.positions.size());
-  s.positions.insert(s.positions.end(), right.positions.begin(), right.positions.end());
-  for (pr::scene::Triangle t : right.triangles) {
-    for (uint32_t& v : t.v) v += base;
-    s.triangles.push_back(t);
-  }
+  pr::test::appendTriangles(s, pr::test::randomSoup(400, 0.5f, glm::vec3(3.0f, 0.0f, 0.0f), 6));
   const glm::vec3 eye(0.0f, 0.5f, 6.0f);
   const VoxelSplit split(s, {8, pr::rt::partitionMargin(s, eye)});
   const std::vector<Bvh> bvhs = voxelBvhs(s, split);
@@ -204,9 +213,7 @@ TEST_CASE("VoxelSplit: a voxel's content boxes are reached wherever it has a hit
   std::uniform_real_distribution<float> u(-4.0f, 4.0f);
   int hitSpans = 0;
   for (int i = 0; i < 800; ++i) {
-    Ray ray;
-    ray.origin = i % 2 == 0 ? eye : glm::vec3(u(rng), u(rng) * 0.3f, u(rng) * 0.3f);
-    ray.direction = i % 2 == 0 ? glm::normalize(glm::vec3(u(rng), u(rng) * 0.2f, 0.0f) - eye) : pr::test::randomDirection(rng);
+    const Ray ray = eyeOrRandomRay(i, eye, rng, u, glm::vec3(1.0f, 0.3f, 0.3f), glm::vec2(1.0f, 0.2f));
     const pr::rt::RaySlabs slabs(ray);
     split.walk(ray, [&](const VoxelSpan& span) {
       Ray clipped = ray;
@@ -244,9 +251,9 @@ TEST_CASE("VoxelSplit: with work points the cuts balance work, and dealing count
   std::vector<pr::rt::WorkPoint> work;
   for (int i = 0; i < 90; ++i) work.push_back({glm::vec3(3.0f, -1.9f + 0.04f * float(i), 0.5f * float(i % 7) - 1.5f), 1.0f});
   for (int i = 0; i < 10; ++i) work.push_back({glm::vec3(-3.0f + 0.01f * float(i), 0.05f * float(i), 0.0f), 1.0f});
+  const VoxelSplit split(s, {4, 0.0f, work});
   for (float triangleWork : {0.0f, 1.0f}) {
     CAPTURE(triangleWork);
-    const VoxelSplit split(s, {4, 0.0f, work, triangleWork});
     // Equal work per voxel: the cluster's 600 triangles fall in two of them, the wall's two
     // triangles in the other two.
     for (int v = 0; v < 4; ++v) CHECK(split.work(v) == doctest::Approx(25.0));
@@ -257,7 +264,7 @@ TEST_CASE("VoxelSplit: with work points the cuts balance work, and dealing count
     // Longest first: by work alone the four are equal and dealt in turn (0, 1, 0, 1); with a
     // triangle's work the cluster's voxels go first, one to each PE, and the wall's two voxels
     // to the lighter PE (PE 1, holding 321 triangles against 361).
-    const std::vector<int> owners = pr::rt::assignVoxelOwners(split, 2);
+    const std::vector<int> owners = pr::rt::assignVoxelOwners(split, 2, triangleWork);
     CHECK(owners == (triangleWork == 0.0f ? std::vector<int>{0, 1, 0, 1} : std::vector<int>{1, 0, 1, 1}));
   }
 }
