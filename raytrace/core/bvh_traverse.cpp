@@ -5,7 +5,7 @@
 // 4-lane SSE tests elsewhere; bvh_traverse_lanes.inc), whose near and far planes are picked
 // once per ray by the sign of the direction; leaves test four triangles at once
 // (triangle4.h); hit children are visited nearest first, and subtrees that start beyond the
-// best hit so far are pruned.
+// best hit so far are pruned; a child left on the stack is prefetched as it is pushed.
 #include <algorithm>
 #include <cmath>
 #include <limits>
