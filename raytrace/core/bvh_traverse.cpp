@@ -4,8 +4,9 @@
 // Each 8-wide node is one slab test of all its children (AVX2 where the processor has it, two
 // 4-lane SSE tests elsewhere; bvh_traverse_lanes.inc), whose near and far planes are picked
 // once per ray by the sign of the direction; leaves test four triangles at once
-// (triangle4.h); hit children are visited nearest first, and subtrees that start beyond the
-// best hit so far are pruned; a child left on the stack is prefetched as it is pushed.
+// (triangle4.h); a closest-hit query visits hit children nearest first and prunes subtrees that
+// start beyond the best hit so far, an any-hit query visits them farthest first; a child left
+// on the stack is prefetched as it is pushed.
 #include <algorithm>
 #include <cmath>
 #include <limits>
