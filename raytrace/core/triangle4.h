@@ -16,9 +16,12 @@ namespace pr::rt {
 
 // Hits of the first `count` triangles of a leaf block (1 <= count <= 4) for t in [tMin, tMax]:
 // bit i of the result is set when triangle i is hit, and then t[i], u[i], v[i] hold what
-// intersectTriangle gives for it.
+// intersectTriangle gives for it. Always inlined: called out of line from the AVX2 traversal
+// (bvh_traverse_lanes.inc), each call cleared the upper vector state and made the caller keep
+// its ray constants in memory across it; inlined there it runs as VEX code (no FMA: the
+// same operations, the same bits) with the traversal's registers intact.
 template <int Kz>
-inline int intersectLeaf(const RayShear& s, const BvhLeafBlock& block, uint32_t count, float tMin, float tMax,
+__attribute__((always_inline)) inline int intersectLeaf(const RayShear& s, const BvhLeafBlock& block, uint32_t count, float tMin, float tMax,
                          float (&t)[kLeafLanes], float (&u)[kLeafLanes], float (&v)[kLeafLanes]) {
   constexpr int Kx = (Kz + 1) % 3, Ky = (Kx + 1) % 3;
   // Rows x, y, z of p0, p1 and p2 over the lanes.
