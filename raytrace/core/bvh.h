@@ -22,7 +22,8 @@ namespace pr::rt {
 // Children per node: one AVX2 slab test of eight lanes, or two SSE tests of four where the
 // processor has no AVX2 (bvh_traverse_lanes.inc). Measured on the 1M-triangle terrain
 // (bench_rays, leaves in blocks of four): against 4-wide nodes, 25-45% more rays per second
-// with either test, for 59 instead of 56 bytes per triangle (54 since the least-cost collapse).
+// with either test, for 59 instead of 56 bytes per triangle (both with the earlier greedy
+// collapse; the least-cost one below takes 8-wide nodes to 54).
 inline constexpr int kBvhWidth = 8;
 
 // Leaf triangles tested at once (triangle4.h): one SSE lane each. The SAH counts a leaf's cost
@@ -34,8 +35,9 @@ inline constexpr uint32_t leafBlocks(uint32_t triangles) { return (triangles + k
 // SIMD lane each (bounds[0..2] = min x, y, z; bounds[3..5] = max x, y, z), and the children's
 // references (see BvhRef). The binned-SAH build makes a binary tree first and collapses it
 // into the wide nodes of least SAH cost (bvh_build.cpp; Ylitie et al. 2017), 5.9 children per
-// node on the 1M-triangle terrain; one wide slab test then replaces up to three binary levels,
-// and a ray's chain of dependent node loads gets that much shorter.
+// node on the 1M-triangle terrain; one wide slab test then replaces about three levels of a
+// balanced binary tree (up to seven of an unbalanced one), and a ray's chain of dependent node
+// loads gets that much shorter.
 struct alignas(64) BvhNode {
   float bounds[6][kBvhWidth];
   uint32_t child[kBvhWidth];

@@ -239,46 +239,50 @@ class Builder {
 // kBvhWidth slots; in j + 1 slots of its parent, cost[n][j] also considers spreading n's two
 // children over them without a node for n. Opening the child with the largest area until a
 // node is full (the greedy rule) left the wide nodes of the 1M-triangle terrain half empty
-// (4.4 children on average), so rays visited more of them on their way down.
+// (4.4 children on average), so rays visited more of them on their way down. Where ways cost
+// the same (subtrees of zero area, coincident degenerate triangles, or of areas past the float
+// range), the one with fewer wide nodes wins, so such nodes fill up too.
 class WideCollapse {
  public:
-  WideCollapse(const std::vector<BinaryNode>& binary, const BvhBuildOptions& options)
-      : binary_(binary), slots_(binary.size()) {
+  WideCollapse(const std::vector<BinaryNode>& binary, const BvhBuildOptions& options) : binary_(binary) {
+    reserveHugePages(slots_, binary.size());  // written once, back to front
+    slots_.resize(binary.size());
     // Children follow their parents (Builder::build), so a reverse sweep sees children first.
     for (size_t i = binary.size(); i-- > 0;) {
       const BinaryNode& node = binary[i];
       Slots& s = slots_[i];
-      const float area = node.box.halfArea();
+      // Half the surface area, in double and then at most the largest float: no infinity, so
+      // no 0 * inf among the costs below.
+      const glm::dvec3 d = glm::dvec3(node.box.upper()) - glm::dvec3(node.box.lower());
+      const float area = float(std::min(d.x * d.y + d.y * d.z + d.z * d.x, double(std::numeric_limits<float>::max())));
       if (node.count > 0) {
-        s.cost.fill(options.intersectionCost * area * float(leafBlocks(node.count)));
+        s.way.fill(Way{options.intersectionCost * area * float(leafBlocks(node.count)), 0});
         continue;  // a leaf is always one child: split stays 0
       }
       const Slots& left = slots_[i + 1];
       const Slots& right = slots_[node.second];
       // Spread over j + 1 >= 2 slots: k + 1 of them to the left child, the rest to the right.
-      std::array<float, kBvhWidth> spread{};
+      // The first way stands unless another is better, so a NaN cost still gives a valid one.
+      std::array<Way, kBvhWidth> spread{};
       std::array<uint8_t, kBvhWidth> spreadSplit{};
       for (int j = 1; j < kBvhWidth; ++j) {
-        // The first way is taken whatever it costs: an area that overflows to infinity (or a
-        // NaN) then still gives a valid spread.
-        spread[j] = left.cost[0] + right.cost[j - 1];
-        spreadSplit[j] = 1;
-        for (int k = 1; k < j; ++k) {
-          const float c = left.cost[k] + right.cost[j - 1 - k];
-          if (c < spread[j]) {
-            spread[j] = c;
+        for (int k = 0; k < j; ++k) {
+          const Way w = left.way[k] + right.way[j - 1 - k];
+          if (k == 0 || w.better(spread[j])) {
+            spread[j] = w;
             spreadSplit[j] = uint8_t(k + 1);
           }
         }
       }
-      s.cost[0] = options.traversalCost * area + spread[kBvhWidth - 1];  // a wide node of its own
+      const Way& inside = spread[kBvhWidth - 1];
+      s.way[0] = Way{options.traversalCost * area + inside.cost, inside.nodes + 1};  // a wide node of its own
       s.nodeSplit = spreadSplit[kBvhWidth - 1];
       for (int j = 1; j < kBvhWidth; ++j) {
         // At most j + 1 slots: the best of fewer slots, or its children spread over all of them.
-        s.cost[j] = s.cost[j - 1];
+        s.way[j] = s.way[j - 1];
         s.split[j] = s.split[j - 1];
-        if (spread[j] < s.cost[j]) {
-          s.cost[j] = spread[j];
+        if (!s.way[j].better(spread[j])) {
+          s.way[j] = spread[j];
           s.split[j] = spreadSplit[j];
         }
       }
@@ -295,8 +299,16 @@ class WideCollapse {
   }
 
  private:
+  // A way to represent a subtree: its SAH cost, and its wide nodes, which decide between ways
+  // of equal cost (fewer nodes: fuller ones).
+  struct Way {
+    float cost = 0.0f;
+    uint32_t nodes = 0;
+    bool better(const Way& o) const { return cost < o.cost || (cost == o.cost && nodes < o.nodes); }
+    Way operator+(const Way& o) const { return {cost + o.cost, nodes + o.nodes}; }
+  };
   struct Slots {
-    std::array<float, kBvhWidth> cost{};  // [j]: in at most j + 1 slots
+    std::array<Way, kBvhWidth> way{};  // [j]: the best in at most j + 1 slots
     // [j]: 0 when n is one child in j + 1 slots, else the slots its left child takes.
     std::array<uint8_t, kBvhWidth> split{};
     uint8_t nodeSplit = 0;  // slots the left child takes in n's own wide node

@@ -84,6 +84,8 @@ bool usable(const Ray& ray) {
 
 struct StackEntry {
   uint32_t ref;
+  // The child's entry distance, which closestHit's pruning reads; anyHit, which orders farthest
+  // first, keeps it negated and never reads it.
   float tEntry;
 };
 
