@@ -51,6 +51,13 @@ struct Box {
     const glm::vec3 d = h - l;
     return d.x * d.y + d.y * d.z + d.z * d.x;
   }
+  // The same in double, at most the largest float: finite for any box of float corners.
+  float cappedHalfArea() const {
+    const glm::vec3 l = lower(), h = upper();
+    if (l.x > h.x) return 0.0f;
+    const glm::dvec3 d = glm::dvec3(h) - glm::dvec3(l);
+    return float(std::min(d.x * d.y + d.y * d.z + d.z * d.x, double(std::numeric_limits<float>::max())));
+  }
   static glm::vec3 toVec3(__m128 v) {
     alignas(16) float f[4];
     _mm_store_ps(f, v);
@@ -251,10 +258,7 @@ class WideCollapse {
     for (size_t i = binary.size(); i-- > 0;) {
       const BinaryNode& node = binary[i];
       Slots& s = slots_[i];
-      // Half the surface area, in double and then at most the largest float: no infinity, so
-      // no 0 * inf among the costs below.
-      const glm::dvec3 d = glm::dvec3(node.box.upper()) - glm::dvec3(node.box.lower());
-      const float area = float(std::min(d.x * d.y + d.y * d.z + d.z * d.x, double(std::numeric_limits<float>::max())));
+      const float area = node.box.cappedHalfArea();  // no infinity: no 0 * inf among the costs
       if (node.count > 0) {
         s.way.fill(Way{options.intersectionCost * area * float(leafBlocks(node.count)), 0});
         continue;  // a leaf is always one child: split stays 0

@@ -21,8 +21,9 @@ namespace pr::rt {
 // its ray constants in memory across it; inlined there it runs as VEX code (no FMA: the
 // same operations, the same bits) with the traversal's registers intact.
 template <int Kz>
-__attribute__((always_inline)) inline int intersectLeaf(const RayShear& s, const BvhLeafBlock& block, uint32_t count, float tMin, float tMax,
-                         float (&t)[kLeafLanes], float (&u)[kLeafLanes], float (&v)[kLeafLanes]) {
+__attribute__((always_inline)) inline int intersectLeaf(const RayShear& s, const BvhLeafBlock& block, uint32_t count,
+                                                        float tMin, float tMax, float (&t)[kLeafLanes],
+                                                        float (&u)[kLeafLanes], float (&v)[kLeafLanes]) {
   constexpr int Kx = (Kz + 1) % 3, Ky = (Kx + 1) % 3;
   // Rows x, y, z of p0, p1 and p2 over the lanes.
   __m128 p[3][3];
