@@ -3,6 +3,8 @@
 // Not part of the scene API: only the loader's own .cpp files include it.
 #pragma once
 
+#include <cmath>
+#include <limits>
 #include <set>
 #include <string>
 
@@ -42,6 +44,18 @@ struct Context {
     pr::warn(file + ": " + what);
   }
 };
+
+// An integer that an extension holds as a raw JSON value (a light or material index, a
+// TEXCOORD set): its value when it is a whole number within int's range, otherwise an input
+// error naming `what`. tinygltf's GetNumberAsInt converts any real, which is undefined
+// behaviour for one outside int's range (1e30 in a fuzzed file).
+inline int wholeNumber(const Context& ctx, const tinygltf::Value& v, const std::string& what) {
+  if (v.IsInt()) return v.GetNumberAsInt();
+  const double d = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");
+  constexpr double lo = std::numeric_limits<int>::min(), hi = std::numeric_limits<int>::max();
+  if (!(d >= lo && d <= hi) || d != std::floor(d)) ctx.fail(what + " is not a whole number within int's range");
+  return int(d);
+}
 
 // "mesh 2 'Box'" (the name only when the file gives one), for messages.
 inline std::string describe(const char* kind, int index, const std::string& name) {

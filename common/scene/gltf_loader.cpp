@@ -328,7 +328,8 @@ class Flattener {
     if (node.mesh >= 0) addMesh(index, node, world);
     if (node.camera >= 0) addCamera(index, node, world);
     if (auto it = node.extensions.find("KHR_lights_punctual"); it != node.extensions.end() && it->second.Has("light")) {
-      addLight(index, node, it->second.Get("light").GetNumberAsInt(), world);
+      const std::string what = describe("node", index, node.name) + ": KHR_lights_punctual light";
+      addLight(index, node, wholeNumber(ctx_, it->second.Get("light"), what), world);
     }
     for (int child : node.children) visit(child, world, depth + 1);
     onPath_[size_t(index)] = false;
@@ -426,8 +427,8 @@ class Flattener {
       if (!m.Has("variants") || !m.Get("variants").IsArray() || !m.Has("material") || !m.Get("material").IsNumber()) continue;
       const tinygltf::Value& vs = m.Get("variants");
       for (size_t k = 0; k < vs.ArrayLen(); ++k) {
-        if (!vs.Get(int(k)).IsNumber() || vs.Get(int(k)).GetNumberAsInt() != ctx_.variant) continue;
-        const int material = m.Get("material").GetNumberAsInt();
+        if (wholeNumber(ctx_, vs.Get(int(k)), where + ": KHR_materials_variants variant") != ctx_.variant) continue;
+        const int material = wholeNumber(ctx_, m.Get("material"), where + ": KHR_materials_variants material");
         if (material < 0 || size_t(material) + 1 >= ctx_.scene.materials.size()) {
           ctx_.fail(where + ": KHR_materials_variants maps to material " + std::to_string(material) +
                     ", which is out of range (the file has " + std::to_string(ctx_.scene.materials.size() - 1) +

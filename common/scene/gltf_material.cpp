@@ -103,7 +103,7 @@ TextureRef textureRef(Context& ctx, const tinygltf::TextureInfo& info, const std
     glm::vec2 offset = numbers<2>(*t, "offset", glm::vec2(0.0f));
     float rotation = number(*t, "rotation", 0.0f);
     glm::vec2 scale = numbers<2>(*t, "scale", glm::vec2(1.0f));
-    if (t->Has("texCoord") && t->Get("texCoord").IsNumber()) ref.texCoord = t->Get("texCoord").GetNumberAsInt();
+    if (t->Has("texCoord")) ref.texCoord = wholeNumber(ctx, t->Get("texCoord"), where + ": KHR_texture_transform texCoord");
     // uv' = T * R * S * (u, v, 1) with R rotating UVs counter-clockwise in the texture's
     // (u right, v down) frame: u' = cos*u + sin*v, v' = -sin*u + cos*v (extension spec).
     float c = std::cos(rotation), s = std::sin(rotation);
@@ -122,9 +122,9 @@ TextureRef textureRef(Context& ctx, const tinygltf::Value& ext, const char* key,
   tinygltf::TextureInfo info;
   if (!ext.Has(key) || !ext.Get(key).IsObject()) return {};
   const tinygltf::Value& v = ext.Get(key);
-  if (!v.Has("index") || !v.Get("index").IsNumber()) return {};
-  info.index = v.Get("index").GetNumberAsInt();
-  if (v.Has("texCoord") && v.Get("texCoord").IsNumber()) info.texCoord = v.Get("texCoord").GetNumberAsInt();
+  if (!v.Has("index")) return {};
+  info.index = wholeNumber(ctx, v.Get("index"), where + ": " + key + " index");
+  if (v.Has("texCoord")) info.texCoord = wholeNumber(ctx, v.Get("texCoord"), where + ": " + key + " texCoord");
   if (v.Has("extensions") && v.Get("extensions").IsObject()) {
     const tinygltf::Value& exts = v.Get("extensions");
     for (const std::string& name : exts.Keys()) info.extensions[name] = exts.Get(name);

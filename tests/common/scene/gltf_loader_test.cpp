@@ -363,6 +363,28 @@ TEST_CASE("GltfLoader: lights and cameras are placed by their nodes") {
   CHECK(glm::length(glm::vec3(s.cameras[0].cameraToWorld[0])) == doctest::Approx(1.0f));
 }
 
+TEST_CASE("GltfLoader: an extension's index must be a whole number within int's range") {
+  auto dir = pr::test::scratchDir("gltf_extension_index");
+  for (const double light : {1e30, -1e30, 0.5}) {
+    pr::test::GltfWriter w = pr::test::oneTriangle();
+    w.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+    w.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}}};
+    w.addNode({{"extensions", {{"KHR_lights_punctual", {{"light", light}}}}}});
+    w.doc["scenes"][0]["nodes"] = {0, 1};
+    INFO("light index " << light);
+    CHECK_THROWS_WITH_AS(loadQuiet(w.write(dir, "light_index.gltf")),
+                         doctest::Contains("KHR_lights_punctual light is not a whole number within int's range"),
+                         pr::InputError);
+  }
+  // A whole number written as a real (0.0) is still the index 0.
+  pr::test::GltfWriter w = pr::test::oneTriangle();
+  w.doc["extensionsUsed"] = {"KHR_lights_punctual"};
+  w.doc["extensions"]["KHR_lights_punctual"]["lights"] = {{{"type", "point"}}};
+  w.addNode({{"extensions", {{"KHR_lights_punctual", {{"light", 0.0}}}}}});
+  w.doc["scenes"][0]["nodes"] = {0, 1};
+  CHECK(loadQuiet(w.write(dir, "light_real_zero.gltf")).lights.size() == 1);
+}
+
 TEST_CASE("GltfLoader: emissive triangles become area lights with their world area") {
   auto dir = pr::test::scratchDir("gltf_emissive");
   pr::test::GltfWriter w = pr::test::oneTriangle();
