@@ -21,7 +21,7 @@ namespace {
 // Below this depth the SAH decides; deeper, object-median splits halve the count each level,
 // so the tree stays within the traversal stack (bvh_traverse.cpp) for any input.
 constexpr int kSahDepthLimit = 32;
-constexpr int kMaxBins = 32;
+constexpr int kMaxBins = 64;
 
 // An axis-aligned box as two SSE vectors (x, y, z, unused), so growing one is two instructions.
 // Each lane computes what glm::min(lo, p) and glm::max(hi, p) do, NaN included: the new value
