@@ -245,12 +245,15 @@ class ObjectSpaceFrame {
     std::vector<VoxelSpan>& owners = st.shadowOwners;
     owners.clear();
     const RaySlabs slabs(m.ray);
+    // An owner already listed needs no content test (the costly part of the walk), and once
+    // every PE is listed the rest of the walk can add none.
+    const auto pes = size_t(rt_.pes());
     split_.walk(m.ray, [&](const VoxelSpan& s) {
-      if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;  // empty, or crossed through empty space
       const int owner = owners_[s.voxel];
-      if (std::none_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; }))
-        owners.push_back(s);
-      return true;
+      if (std::any_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; })) return true;
+      if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;  // empty, or crossed through empty space
+      owners.push_back(s);
+      return owners.size() < pes;
     });
     auto me = std::find_if(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == pe.id(); });
     if (item.voxel == TravellingRay::kStartVoxel && (owners.empty() || me != owners.begin())) {
