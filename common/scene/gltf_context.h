@@ -48,7 +48,9 @@ struct Context {
 // An integer that an extension holds as a raw JSON value (a light or material index, a
 // TEXCOORD set): its value when it is a whole number within int's range, otherwise an input
 // error naming `what`. tinygltf's GetNumberAsInt converts any real, which is undefined
-// behaviour for one outside int's range (1e30 in a fuzzed file).
+// behaviour for one outside int's range (1e30 in a fuzzed file). A JSON integer beyond int's
+// range cannot be caught here: tinygltf's parser has already wrapped it to an int (defined,
+// modulo 2^32), so such an index reads as another one (4294967296 as 0).
 inline int wholeNumber(const Context& ctx, const tinygltf::Value& v, const std::string& what) {
   if (v.IsInt()) return v.GetNumberAsInt();
   const double d = v.IsNumber() ? v.GetNumberAsDouble() : std::nan("");

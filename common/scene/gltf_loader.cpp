@@ -424,7 +424,7 @@ class Flattener {
     const tinygltf::Value& mappings = it->second.Get("mappings");
     for (size_t i = 0; i < mappings.ArrayLen(); ++i) {
       const tinygltf::Value& m = mappings.Get(int(i));
-      if (!m.Has("variants") || !m.Get("variants").IsArray() || !m.Has("material") || !m.Get("material").IsNumber()) continue;
+      if (!m.Has("variants") || !m.Get("variants").IsArray() || !m.Has("material")) continue;
       const tinygltf::Value& vs = m.Get("variants");
       for (size_t k = 0; k < vs.ArrayLen(); ++k) {
         if (wholeNumber(ctx_, vs.Get(int(k)), where + ": KHR_materials_variants variant") != ctx_.variant) continue;

@@ -123,8 +123,8 @@ TextureRef textureRef(Context& ctx, const tinygltf::Value& ext, const char* key,
   if (!ext.Has(key) || !ext.Get(key).IsObject()) return {};
   const tinygltf::Value& v = ext.Get(key);
   if (!v.Has("index")) return {};
-  info.index = wholeNumber(ctx, v.Get("index"), where + ": " + key + " index");
-  if (v.Has("texCoord")) info.texCoord = wholeNumber(ctx, v.Get("texCoord"), where + ": " + key + " texCoord");
+  info.index = wholeNumber(ctx, v.Get("index"), where + " index");
+  if (v.Has("texCoord")) info.texCoord = wholeNumber(ctx, v.Get("texCoord"), where + " texCoord");
   if (v.Has("extensions") && v.Get("extensions").IsObject()) {
     const tinygltf::Value& exts = v.Get("extensions");
     for (const std::string& name : exts.Keys()) info.extensions[name] = exts.Get(name);

@@ -28,8 +28,9 @@ constexpr int kStackSize = (kBvhWidth - 1) * 60 + kBvhWidth;
 // Robust slab test (Ize 2013, "Robust BVH ray traversal"; pbrt-v4): the far distances are
 // scaled by 1 + 2 gamma(3), gamma(n) = n u / (1 - n u) with u = 2^-24, which bounds the
 // rounding of (b - o) * (1/d), so a box the ray touches is never missed. The scale is folded
-// into a far reciprocal, (1/d) * scale, computed once per ray: one more rounding, four in all,
-// which 1 + 6u still covers ((1 - u)^-4 < 1 + 4.1u), and one multiply less per node.
+// into a far reciprocal, (1/d) * scale, computed once per ray: four roundings, as with the
+// scale applied last, which 1 + 6u still covers ((1 - u)^-4 < 1 + 4.1u), and one multiply less
+// per node.
 constexpr float kUlp = 0x1p-24f;
 constexpr float kSlabScale = 1.0f + 2.0f * (3.0f * kUlp) / (1.0f - 3.0f * kUlp);
 

@@ -99,6 +99,28 @@ TEST_CASE("MaterialFeatures: KHR_materials_variants picks the mapped material, a
   }
 }
 
+TEST_CASE("MaterialFeatures: an extension's texture index or variant material that is not a whole number is an input error") {
+  const auto dir = test::scratchDir("material_features_whole_numbers");
+  // A clearcoat texture whose index is a fraction.
+  test::GltfWriter coat = quad(false, {{"extensions", {{"KHR_materials_clearcoat", {{"clearcoatFactor", 1.0}, {"clearcoatTexture", {{"index", 0.5}}}}}}}});
+  coat.doc["extensionsUsed"] = {"KHR_materials_clearcoat"};
+  addTexture(coat, {255, 255, 255, 255});
+  CHECK_THROWS_WITH_AS(load(coat.write(dir, "coat_index.gltf")),
+                       doctest::Contains("clearcoatTexture index is not a whole number within int's range"), InputError);
+  // A variant mapped to material 1e30, and one mapped to a string.
+  for (const nlohmann::json& material : {nlohmann::json(1e30), nlohmann::json("one")}) {
+    test::GltfWriter w = quad(false, {{"pbrMetallicRoughness", {{"baseColorFactor", {1, 0, 0, 1}}}}});
+    w.doc["extensionsUsed"] = {"KHR_materials_variants"};
+    w.doc["extensions"]["KHR_materials_variants"]["variants"] = {{{"name", "red"}}};
+    w.doc["meshes"][0]["primitives"][0]["extensions"]["KHR_materials_variants"]["mappings"] = {
+        {{"material", material}, {"variants", {0}}}};
+    CAPTURE(material.dump());
+    CHECK_THROWS_WITH_AS(load(w.write(dir, "variant_material.gltf"), "red"),
+                         doctest::Contains("KHR_materials_variants material is not a whole number within int's range"),
+                         InputError);
+  }
+}
+
 TEST_CASE("MaterialFeatures: generated tangents follow +u, with w = -1 for mirrored UVs") {
   const auto dir = test::scratchDir("material_features_tangents");
   for (bool mirrored : {false, true}) {
