@@ -21,7 +21,6 @@ namespace {
 // Below this depth the SAH decides; deeper, object-median splits halve the count each level,
 // so the tree stays within the traversal stack (bvh_traverse.cpp) for any input.
 constexpr int kSahDepthLimit = 32;
-constexpr int kMaxBins = 64;
 
 // An axis-aligned box as two SSE vectors (x, y, z, unused), so growing one is two instructions.
 // Each lane computes what glm::min(lo, p) and glm::max(hi, p) do, NaN included: the new value
@@ -94,7 +93,7 @@ class Builder {
           const std::vector<BvhTriangle>& prepared, std::vector<BinaryNode>& nodes,
           std::vector<BvhTriangle>& leafTris, BvhStats& stats)
       : options_(options), refs_(refs), prepared_(prepared), nodes_(nodes), leafTris_(leafTris),
-        stats_(stats), bins_(std::clamp(options.bins, 2, kMaxBins)) {}
+        stats_(stats), bins_(std::clamp(options.bins, 2, kMaxSahBins)) {}
 
   // Builds the subtree over refs_[begin, end) and returns its node index. Nodes are emitted in
   // depth-first order: the first child directly follows its parent.
@@ -164,12 +163,15 @@ class Builder {
   // n < bins_ triangles gets n bins: the sweep over the bins then costs what binning its
   // triangles does, where 32 bins for a handful of triangles made the sweeps most of the build.
   Split findSahSplit(uint32_t begin, uint32_t end, const Box& bounds, const glm::vec3& centreLo,
-                     const glm::vec3& centreHi) const {
+                     const glm::vec3& centreHi) {
     Split best;
     const float nodeArea = bounds.halfArea();
     if (!(nodeArea > 0.0f)) return best;  // flat or point node: the median split handles it
     const int nodeBins = std::min(bins_, int(end - begin));
-    std::array<std::array<Bin, kMaxBins>, 3> bins{};  // only [0, nodeBins) of each axis is used
+    // Only [0, nodeBins) of each axis is used and reset: a fresh table per call cleared all
+    // 3 x 64 bins (9 KiB) for every node, most of them nodes of a few triangles.
+    auto& bins = binScratch_;
+    for (auto& axis : bins) std::fill_n(axis.begin(), nodeBins, Bin{});
     glm::vec3 scale(0.0f);
     for (int a = 0; a < 3; ++a) {
       const float extent = centreHi[a] - centreLo[a];
@@ -194,8 +196,8 @@ class Builder {
         bin.box.extend(r.box);
       }
     }
-    std::array<float, kMaxBins> rightArea{};
-    std::array<uint32_t, kMaxBins> rightCount{};
+    std::array<float, kMaxSahBins> rightArea{};
+    std::array<uint32_t, kMaxSahBins> rightCount{};
     for (int a = 0; a < 3; ++a) {
       if (scale[a] == 0.0f) continue;
       Box acc;
@@ -236,6 +238,7 @@ class Builder {
   std::vector<BvhTriangle>& leafTris_;
   BvhStats& stats_;
   int bins_;
+  std::array<std::array<Bin, kMaxSahBins>, 3> binScratch_;  // findSahSplit's, per axis
 };
 
 // Which binary subtrees become the wide nodes' children: the choice of least SAH cost (Ylitie

@@ -251,7 +251,7 @@ int main(int argc, char** argv) {
   app.add_option("--grid", grid, "terrain grid (2 grid^2 triangles)")->check(CLI::Range(2, 4096))->capture_default_str();
   app.add_option("--repeat", repeat, "passes over each ray set, the best reported")->check(CLI::Range(1, 100))->capture_default_str();
   app.add_option("--leaf", options.maxLeafSize, "largest leaf, triangles")->check(CLI::Range(1, 16))->capture_default_str();
-  app.add_option("--bins", options.bins, "SAH bins per axis")->check(CLI::Range(2, 64))->capture_default_str();
+  app.add_option("--bins", options.bins, "SAH bins per axis")->check(CLI::Range(2, pr::rt::kMaxSahBins))->capture_default_str();
   app.add_option("--traversal-cost", traversalPercent, "SAH cost of a node visit, percent of one triangle test")
       ->check(CLI::Range(1, 1000))->capture_default_str();
   CLI11_PARSE(app, argc, argv);
