@@ -42,8 +42,8 @@ struct SlabBox {
 // not (its reciprocal is never used there, so no lane computes 0 * inf).
 class RaySlabs {
  public:
-  // Built in registers: eight scalar stores read back as two vectors could not be forwarded
-  // from the store buffer, and that stall was the largest cost of object-space's voxel walk.
+  // Built in registers: eight scalar stores read back as two vectors cannot be forwarded from
+  // the store buffer, and that stall stood out in every object-space walk's profile.
   explicit RaySlabs(const Ray& ray) : tMin_(ray.tMin), tMax_(ray.tMax) {
     const glm::vec3 d = ray.direction;
     auto reciprocal = [](float x) { return x == 0.0f ? 0.0f : 1.0f / x; };
