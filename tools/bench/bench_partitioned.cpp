@@ -92,7 +92,8 @@ std::pair<Run, std::vector<Run>> measureP1P2(const scene::Scene& s, const scene:
   return {p1, p2};
 }
 
-int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& opt, int repeats, const std::vector<int>& batches) {
+int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& opt, int repeats, const std::vector<int>& batches,
+               const std::vector<std::string>& methods) {
   const scene::Scene s = scene::loadGltf(file);
   const scene::Camera cam = scene::selectCamera(s, "", float(w) / float(h));
   par::Runtime sequential(1, "demand");
@@ -103,7 +104,7 @@ int benchScene(const std::string& file, int w, int h, const rt::TraceOptions& op
   // Demand-driven tiles, and preferred-bias, whose regions are the tiles' preferred PEs (the
   // owner of what their probe rays reach first, tile_affinity.h).
   const std::vector<std::string> schedules = {"demand", "preferred-bias"};
-  for (const std::string method : {"object-space", "object"}) {
+  for (const std::string& method : methods) {
     const auto [p1, p2s] = measureP1P2(s, cam, w, h, opt, method, repeats, reference, schedules);
     Run unbatched;
     measureOnce(unbatched, s, cam, w, h, opt, method, 2, 1, reference);
@@ -269,15 +270,24 @@ int main(int argc, char** argv) {
   app.add_option("--latency-us", latencyUs, "image-space-cached: simulated one-way latencies of the latency-hiding runs, microseconds")
       ->check(CLI::Range(0.0, 1e6));
   app.add_option("--cache-mb", cacheMb, "image-space-cached: cache sizes of the sweep at P = 2, MiB")->check(CLI::Range(0.0, 1048576.0));
+  std::vector<std::string> methods = {"object-space", "object", "image-space-cached"};
+  app.add_option("--methods", methods, "the methods to measure")
+      ->check(CLI::IsMember({"object-space", "object", "image-space-cached"}))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   try {
     rt::TraceOptions opt;
     opt.integrator.kind = integrator == "whitted" ? rt::IntegratorKind::Whitted : rt::IntegratorKind::Path;
     opt.integrator.spp = spp;
     std::printf("bench_partitioned on %u hardware threads\n", std::thread::hardware_concurrency());
+    std::vector<std::string> partitioned;
+    for (const std::string& m : methods)
+      if (m != "image-space-cached") partitioned.push_back(m);
     int failures = 0;
-    for (const std::string& f : scenes) failures += benchScene(f, width, height, opt, repeats, batches);
-    for (const std::string& f : scenes) failures += benchCached(f, width, height, opt, repeats, cacheMb, latencyUs);
+    if (!partitioned.empty())
+      for (const std::string& f : scenes) failures += benchScene(f, width, height, opt, repeats, batches, partitioned);
+    if (partitioned.size() < methods.size())
+      for (const std::string& f : scenes) failures += benchCached(f, width, height, opt, repeats, cacheMb, latencyUs);
     return failures == 0 ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "bench_partitioned: %s\n", e.what());
