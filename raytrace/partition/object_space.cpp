@@ -8,7 +8,8 @@
 // the first run that reports a hit reports the ray's closest hit, the same one (bit for bit)
 // as the BVH over the whole scene. A shadow ray is blocked by any occluder on it, found in
 // any order: it visits each owner on its way once, in the order of the owners' first voxels
-// along it, and stops at the first that reports one. Shading and spawning happen on the PE
+// with content along it, each testing the rest of the ray from there, and stops at the first
+// that reports one; the owners visited travel with it. Shading and spawning happen on the PE
 // that found the hit; new rays start from there. The stage ends when no tile, ray or message
 // is left (termination.h). A ray passes another owner's voxel without visiting it when it
 // misses the voxel's content boxes (voxel_split.h) there: through empty space. The voxels are
@@ -18,6 +19,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,6 +65,10 @@ struct TravellingRay {
   RayMessage message;
   float tEnter = 0.0f;
   uint32_t voxel = kStartVoxel;  // kStartVoxel: a new ray, traced from its first voxel
+  // A shadow ray's owners that have tested the rest of it, bit p for PE p. Owners from 64 up
+  // are not remembered: such an owner may get the ray again at a later voxel of its own and
+  // test from there again, which is only redundant.
+  uint64_t visited = 0;
   static constexpr uint32_t kStartVoxel = ~0u;
 };
 using RayBatch = std::vector<TravellingRay>;
@@ -161,7 +167,6 @@ class ObjectSpaceFrame {
   struct alignas(64) PeState {
     std::vector<TravellingRay> work;  // rays to trace here, depth first
     std::vector<RayMessage> spawned;
-    std::vector<VoxelSpan> shadowOwners;  // a shadow ray's owners, each at its first voxel
     TraceStats stats;
     uint64_t raysSent = 0;
   };
@@ -201,16 +206,11 @@ class ObjectSpaceFrame {
     const RayMessage& m = item.message;
     if (m.kind == RayKind::Shadow) return advanceShadow(pe, st, item);
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
-    bool reached = item.voxel == TravellingRay::kStartVoxel;  // at the voxel the walk resumes in
     bool finished = false;  // hit or sent on
     bool run = false;       // a run of this PE's voxels is open, over [runEnter, runExit]
     float runEnter = 0.0f, runExit = 0.0f;
     const RaySlabs slabs(m.ray);
-    auto visit = [&](const VoxelSpan& s) {
-      if (!reached) {
-        if (s.voxel != item.voxel) return true;
-        reached = true;
-      }
+    walkOn(item, [&](const VoxelSpan& s) {
       // A voxel of this PE's without triangles has nothing to hit; another owner's voxel the ray
       // crosses through empty space (always so for one without triangles) holds no hit in its
       // span: the walk goes on, and a run of this PE's voxels stays open across it.
@@ -225,50 +225,63 @@ class ObjectSpaceFrame {
       finished = (run && traceRun(pe, st, m, runEnter, runExit, emit)) || sendOn(pe, st, m, s);
       run = false;
       return !finished;
-    };
-    // The walk from tEnter gives the same spans from the voxel on as the walk from the origin,
-    // unless the voxel's span has zero length at a corner the shorter walk steps past: then
-    // the whole walk finds it.
-    Ray resume = m.ray;
-    resume.tMin = item.tEnter;
-    split_.walk(resume, visit);
-    if (!reached) split_.walk(m.ray, visit);
-    PR_CHECK(reached, "object-space: a ray sent to a voxel its walk does not pass");
+    });
     if (!finished && run) finished = traceRun(pe, st, m, runEnter, runExit, emit);
     if (!finished) integrator_->miss(m, emit);  // left the scene
   }
 
-  // A shadow ray: this PE tests the whole ray against its triangles once, then hands it to the
-  // owner whose first voxel along the ray comes next; a new ray goes to the first owner.
+  // A shadow ray, blocked by any occluder on it, found in any order: each owner on its way, in
+  // the order of its first voxel with content along it, tests the rest of the ray from there
+  // (a hit before lies in an earlier owner's voxel, tested there) and, when that finds none,
+  // walks on to the next owner not yet visited. A new ray goes to the first owner.
   void advanceShadow(par::Pe& pe, PeState& st, const TravellingRay& item) {
     const RayMessage& m = item.message;
-    std::vector<VoxelSpan>& owners = st.shadowOwners;
-    owners.clear();
+    uint64_t visited = item.visited;
+    const int pes = rt_.pes();
+    bool tested = false;  // by this PE, in this call
+    bool finished = false;  // blocked or sent on
     const RaySlabs slabs(m.ray);
-    // An owner already listed needs no content test (the costly part of the walk), and once
-    // every PE is listed the rest of the walk can add none.
-    const auto pes = size_t(rt_.pes());
-    split_.walk(m.ray, [&](const VoxelSpan& s) {
+    walkOn(item, [&](const VoxelSpan& s) {
       const int owner = owners_[s.voxel];
-      if (std::any_of(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == owner; })) return true;
-      if (!split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;  // empty, or crossed through empty space
-      owners.push_back(s);
-      return owners.size() < pes;
+      const bool done = owner == pe.id() ? tested : owner < 64 && (visited >> owner & 1u) != 0;
+      // Content tests are the costly part of the walk: none for an owner that has tested.
+      if (done || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+      if (owner != pe.id()) {
+        finished = sendOn(pe, st, m, s, visited);
+        return false;
+      }
+      Ray rest = m.ray;
+      rest.tMin = std::max(m.ray.tMin, s.tEnter);
+      finished = bvhs_[size_t(pe.id())].occluded(rest);
+      tested = true;
+      if (owner < 64) visited |= uint64_t{1} << owner;
+      // Once every PE has tested, the rest of the walk can find no owner to visit.
+      return !finished && !(pes <= 64 && std::popcount(visited) == pes);
     });
-    auto me = std::find_if(owners.begin(), owners.end(), [&](const VoxelSpan& o) { return owners_[o.voxel] == pe.id(); });
-    if (item.voxel == TravellingRay::kStartVoxel && (owners.empty() || me != owners.begin())) {
-      me = owners.begin();  // a new ray starts at the first owner on it, or has none: unoccluded
-    } else {
-      PR_CHECK(me != owners.end(), "object-space: a shadow ray sent to a PE that owns no voxel on it");
-      if (bvhs_[size_t(pe.id())].occluded(m.ray)) return;  // blocked
-      ++me;
-    }
-    if (me != owners.end()) {
-      sendOn(pe, st, m, *me);
-      return;
-    }
+    if (finished) return;
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     integrator_->miss(m, emit);  // no owner holds an occluder: unoccluded
+  }
+
+  // Walks the ray's voxels from the one where it entered this PE's (all of them for a new ray),
+  // calling visit(const VoxelSpan&) until it returns false. The walk from tEnter gives the
+  // same spans from that voxel on as the walk from the origin, unless the voxel's span has zero
+  // length at a corner the shorter walk steps past: then the whole walk finds it.
+  template <class Visit>
+  void walkOn(const TravellingRay& item, Visit&& visit) const {
+    bool reached = item.voxel == TravellingRay::kStartVoxel;
+    auto fromVoxel = [&](const VoxelSpan& s) {
+      if (!reached) {
+        if (s.voxel != item.voxel) return true;
+        reached = true;
+      }
+      return visit(s);
+    };
+    Ray resume = item.message.ray;
+    resume.tMin = std::max(resume.tMin, item.tEnter);
+    split_.walk(resume, fromVoxel);
+    if (!reached) split_.walk(item.message.ray, fromVoxel);
+    PR_CHECK(reached, "object-space: a ray sent to a voxel its walk does not pass");
   }
 
   // The ray in a run of this PE's voxels over [runEnter, runExit]: true when it hits there.
@@ -292,8 +305,8 @@ class ObjectSpaceFrame {
   }
 
   // Sends the ray to the owner of the voxel of span s, where its walk resumes. Always true.
-  bool sendOn(par::Pe& pe, PeState& st, const RayMessage& m, const VoxelSpan& s) {
-    rays_->send(pe, owners_[s.voxel], TravellingRay{m, s.tEnter, s.voxel});
+  bool sendOn(par::Pe& pe, PeState& st, const RayMessage& m, const VoxelSpan& s, uint64_t visited = 0) {
+    rays_->send(pe, owners_[s.voxel], TravellingRay{m, s.tEnter, s.voxel, visited});
     ++st.raysSent;
     return true;
   }
