@@ -124,7 +124,7 @@ void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
       for (size_t i = kContentBoxes; i < boxes.size(); ++i) boxes[kContentBoxes - 1].extend(boxes[i]);
       boxes.resize(kContentBoxes);
     }
-    for (const scene::Bounds& box : boxes) content_.push_back(SlabBox::of(box, margin_));
+    for (size_t i = 0; i < boxes.size(); i += 4) content_.push_back(SlabBoxes4::of(&boxes[i], boxes.size() - i, margin_));
     contentFirst_.push_back(static_cast<uint32_t>(content_.size()));
   }
 }

@@ -65,18 +65,18 @@ class VoxelSplit {
   bool hasWork() const { return !work_.empty(); }
   // Bytes of the kd tree and the voxels' content boxes, which every PE keeps a copy of to
   // route rays.
-  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(SlabBox); }
+  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(SlabBoxes4); }
 
   // What a voxel holds, as up to kContentBoxes boxes inside its cell: per scene object the
   // bounds of its triangles' parts in the cell, the largest (by surface area) kept apart and
-  // the rest merged, all grown by the margin. False when the ray (slabs) touches none of them
-  // for t in [t0, t1] (always for a voxel without triangles, which has none): then no triangle
-  // of the voxel has a hit in that span, and a ray that crosses the voxel through empty space
-  // need not visit its owner. Conservative.
-  static constexpr int kContentBoxes = 6;
+  // the rest merged, all grown by the margin, in groups of four tested together. False when
+  // the ray (slabs) touches none of them for t in [t0, t1] (always for a voxel without
+  // triangles, which has none): then no triangle of the voxel has a hit in that span, and a
+  // ray that crosses the voxel through empty space need not visit its owner. Conservative.
+  static constexpr int kContentBoxes = 8;
   bool reachesContent(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
     for (uint32_t i = contentFirst_[voxel]; i < contentFirst_[voxel + 1]; ++i)
-      if (slabs.overlaps(content_[i], t0, t1)) return true;
+      if (slabs.overlapsAny(content_[i], t0, t1)) return true;
     return false;
   }
 
@@ -105,7 +105,7 @@ class VoxelSplit {
   std::vector<Node> nodes_;
   std::vector<scene::Bounds> cells_;
   std::vector<std::vector<uint32_t>> triangles_;
-  std::vector<SlabBox> content_;      // voxel v's: [contentFirst_[v], contentFirst_[v + 1])
+  std::vector<SlabBoxes4> content_;   // voxel v's groups: [contentFirst_[v], contentFirst_[v + 1])
   std::vector<uint32_t> contentFirst_;
   std::vector<double> work_;  // per voxel, when built with work points
   float margin_ = 0.0f;
