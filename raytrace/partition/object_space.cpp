@@ -7,9 +7,10 @@
 // ray is one query of the owner's BVH, which accepts only a hit up to the end of the run, so
 // the first run that reports a hit reports the ray's closest hit, the same one (bit for bit)
 // as the BVH over the whole scene. A shadow ray is blocked by any occluder on it, found in
-// any order: it visits each owner on its way once, in the order of the owners' first voxels
-// with content along it, each testing the rest of the ray from there, and stops at the first
-// that reports one; the owners visited travel with it. Shading and spawning happen on the PE
+// any order: the PE that spawned it tests it whole (every BVH also holds the replicated
+// emitters), then it visits each other owner with triangles of its own on the way once, in the
+// order of their first such voxels, each testing the rest of the ray from there, and stops at
+// the first that reports one; the owners visited travel with it. Shading and spawning happen on the PE
 // that found the hit; new rays start from there. The stage ends when no tile, ray or message
 // is left (termination.h). A ray passes another owner's voxel without visiting it when it
 // misses the voxel's content boxes (voxel_split.h) there: through empty space. The voxels are
@@ -20,7 +21,9 @@
 #include <algorithm>
 #include <atomic>
 #include <bit>
+#include <iterator>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -49,13 +52,13 @@ constexpr float kBuildSamplesPerTriangle = 0.28f;
 // rays land (view_work.h, in samples: pixels times spp), dealt to PEs by that work plus their
 // BVH builds; a pre-pass program's rays do not start at the camera, so its split balances
 // triangles.
-VoxelSplit makeSplit(const TraceJob& job, int voxels, int spp) {
+VoxelSplit makeSplit(const TraceJob& job, int voxels, int spp, std::span<const uint32_t> emitters) {
   std::vector<WorkPoint> work;
   if (job.assembleImage && voxels > 1) {
     work = viewWork(job.scene, job.camera, job.width, job.height);
     for (WorkPoint& w : work) w.weight *= float(spp);
   }
-  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work});
+  return VoxelSplit(job.scene, {voxels, partitionMargin(job.scene, job.camera.position()), work, emitters});
 }
 
 // A ray on its way to the owner of the next voxel along it: the message with its path state,
@@ -95,7 +98,7 @@ class ObjectSpaceFrame {
     // method, timed as such.
     std::vector<int> preferred;
     rt_.runOnOnePe(job_.stage("split"), kAssemblerPe, [&](par::Pe&) {
-      split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp);
+      split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp, integrator_->context().lights().emitters());
       owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
       if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
     });
@@ -107,7 +110,15 @@ class ObjectSpaceFrame {
         if (owners_[v] == pe.id()) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
       std::sort(held.begin(), held.end());
       held.erase(std::unique(held.begin(), held.end()), held.end());
-      if (!held.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, held, job_.options.bvh);
+      // The BVH also holds the PE's copy of the emitters (replicated for light sampling), so
+      // that the PE spawning a shadow ray tests it against every emitter. A closest hit on one
+      // outside this PE's voxels lies outside its runs, which are the only spans it traces.
+      std::vector<uint32_t> emitters = integrator_->context().lights().emitters();
+      std::sort(emitters.begin(), emitters.end());
+      std::vector<uint32_t> traced;
+      traced.reserve(held.size() + emitters.size());
+      std::set_union(held.begin(), held.end(), emitters.begin(), emitters.end(), std::back_inserter(traced));
+      if (!traced.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, traced, job_.options.bvh);
       views_.build(pe.id(), held, integrator_->context().lights());
     });
 
@@ -230,34 +241,45 @@ class ObjectSpaceFrame {
     if (!finished) integrator_->miss(m, emit);  // left the scene
   }
 
-  // A shadow ray, blocked by any occluder on it, found in any order: each owner on its way, in
-  // the order of its first voxel with content along it, tests the rest of the ray from there
-  // (a hit before lies in an earlier owner's voxel, tested there) and, when that finds none,
-  // walks on to the next owner not yet visited. A new ray goes to the first owner.
+  // A shadow ray, blocked by any occluder on it, found in any order. The PE that spawned it
+  // tests the whole ray first: its BVH holds every emitter (replicated on every PE) besides its
+  // voxels' triangles. Then each other owner on its way, in the order of its first voxel with
+  // triangles only it holds along the ray, tests the rest of the ray from there (a hit before
+  // lies in an earlier owner's voxel, tested there) and, when that finds none, walks on to the
+  // next owner not yet visited. So a ray towards an area light is not sent to the light's owner
+  // for the end of its way, where only the light is.
   void advanceShadow(par::Pe& pe, PeState& st, const TravellingRay& item) {
     const RayMessage& m = item.message;
-    uint64_t visited = item.visited;
+    const Bvh& bvh = bvhs_[size_t(pe.id())];
     const int pes = rt_.pes();
-    bool tested = false;  // by this PE, in this call
+    uint64_t visited = item.visited;
+    bool tested = false;    // by this PE, in this call
     bool finished = false;  // blocked or sent on
-    const RaySlabs slabs(m.ray);
-    walkOn(item, [&](const VoxelSpan& s) {
-      const int owner = owners_[s.voxel];
-      const bool done = owner == pe.id() ? tested : owner < 64 && (visited >> owner & 1u) != 0;
-      // Content tests are the costly part of the walk: none for an owner that has tested.
-      if (done || !split_.reachesContent(s.voxel, slabs, s.tEnter, s.tExit)) return true;
-      if (owner != pe.id()) {
-        finished = sendOn(pe, st, m, s, visited);
-        return false;
-      }
+    // Once every PE has tested, the rest of the walk can find no owner to visit.
+    auto allVisited = [&] { return pes <= 64 && std::popcount(visited) == pes; };
+    auto test = [&](float tEnter) {
       Ray rest = m.ray;
-      rest.tMin = std::max(m.ray.tMin, s.tEnter);
-      finished = bvhs_[size_t(pe.id())].occluded(rest);
+      rest.tMin = std::max(m.ray.tMin, tEnter);
+      finished = bvh.occluded(rest);
       tested = true;
-      if (owner < 64) visited |= uint64_t{1} << owner;
-      // Once every PE has tested, the rest of the walk can find no owner to visit.
-      return !finished && !(pes <= 64 && std::popcount(visited) == pes);
-    });
+      if (pe.id() < 64) visited |= uint64_t{1} << pe.id();
+    };
+    if (item.voxel == TravellingRay::kStartVoxel) test(m.ray.tMin);
+    if (!finished && !allVisited()) {
+      const RaySlabs slabs(m.ray);
+      walkOn(item, [&](const VoxelSpan& s) {
+        const int owner = owners_[s.voxel];
+        const bool done = owner == pe.id() ? tested : owner < 64 && (visited >> owner & 1u) != 0;
+        // Content tests are the costly part of the walk: none for an owner that has tested.
+        if (done || !split_.reachesHeldOnly(s.voxel, slabs, s.tEnter, s.tExit)) return true;
+        if (owner != pe.id()) {
+          finished = sendOn(pe, st, m, s, visited);
+          return false;
+        }
+        test(s.tEnter);
+        return !finished && !allVisited();
+      });
+    }
     if (finished) return;
     Emit emit(*films_[size_t(pe.id())], st.spawned, st.stats, pe.id());
     integrator_->miss(m, emit);  // no owner holds an occluder: unoccluded
@@ -318,7 +340,7 @@ class ObjectSpaceFrame {
   VoxelSplit split_;  // and owners_: made in the "split" stage
   std::vector<int> owners_;
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
-  std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles
+  std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles and the emitters
   std::vector<std::vector<uint32_t>> held_;  // per PE: those triangles, ascending
   SceneViews views_;
   std::vector<PeState> state_;

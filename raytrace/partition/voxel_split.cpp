@@ -28,6 +28,7 @@ struct VoxelSplit::Built {
   std::vector<scene::Bounds> bounds;  // per scene triangle
   scene::Bounds scene;                // of every finite triangle
   std::span<const WorkPoint> work;    // the options' work points
+  std::vector<uint32_t> replicated;   // the options', ascending
 };
 
 namespace {
@@ -63,6 +64,8 @@ VoxelSplit::VoxelSplit(const scene::Scene& s, const VoxelSplitOptions& options)
   PR_CHECK(std::isfinite(margin_) && margin_ >= 0.0f, "VoxelSplit: margin must be finite and >= 0");
 
   Built b;
+  b.replicated.assign(options.replicated.begin(), options.replicated.end());
+  std::sort(b.replicated.begin(), b.replicated.end());
   b.bounds.resize(s.triangles.size());
   std::vector<uint32_t> all;
   all.reserve(s.triangles.size());
@@ -101,14 +104,15 @@ void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
     for (uint32_t t = s.objects[o].firstTriangle; t < s.objects[o].firstTriangle + s.objects[o].triangleCount; ++t)
       objectOf[t] = static_cast<uint32_t>(o);
   const glm::vec3 grow(2.0f * margin_);  // the cell as its triangles were chosen, and more
-  contentFirst_.assign(1, 0);
   std::vector<scene::Bounds> boxes;
-  for (size_t v = 0; v < cells_.size(); ++v) {
+  // One set of boxes over the voxel's triangles for which keep(t) holds.
+  auto addBoxes = [&](size_t v, auto keep, std::vector<SlabBoxes4>& content, std::vector<uint32_t>& first) {
     const scene::Bounds cell{cells_[v].min - grow, cells_[v].max + grow};
     // A voxel's triangles ascend, and an object's are one range: one box per run of an object.
     boxes.clear();
     uint32_t object = ~0u;
     for (uint32_t t : triangles_[v]) {
+      if (!keep(t)) continue;
       const scene::Bounds part{glm::max(b.bounds[t].min, cell.min), glm::min(b.bounds[t].max, cell.max)};
       if (part.min.x > part.max.x || part.min.y > part.max.y || part.min.z > part.max.z) continue;
       if (boxes.empty() || objectOf[t] != object) boxes.emplace_back();
@@ -124,8 +128,15 @@ void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
       for (size_t i = kContentBoxes; i < boxes.size(); ++i) boxes[kContentBoxes - 1].extend(boxes[i]);
       boxes.resize(kContentBoxes);
     }
-    for (size_t i = 0; i < boxes.size(); i += 4) content_.push_back(SlabBoxes4::of(&boxes[i], boxes.size() - i, margin_));
-    contentFirst_.push_back(static_cast<uint32_t>(content_.size()));
+    for (size_t i = 0; i < boxes.size(); i += 4) content.push_back(SlabBoxes4::of(&boxes[i], boxes.size() - i, margin_));
+    first.push_back(static_cast<uint32_t>(content.size()));
+  };
+  contentFirst_.assign(1, 0);
+  heldOnlyFirst_.assign(1, 0);
+  for (size_t v = 0; v < cells_.size(); ++v) {
+    addBoxes(v, [](uint32_t) { return true; }, content_, contentFirst_);
+    addBoxes(v, [&](uint32_t t) { return !std::binary_search(b.replicated.begin(), b.replicated.end(), t); }, heldOnly_,
+             heldOnlyFirst_);
   }
 }
 

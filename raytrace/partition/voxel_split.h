@@ -29,6 +29,9 @@ struct VoxelSplitOptions {
   // cut puts on each side work in proportion to the voxels it will become, on the axis that
   // balances it best and duplicates the fewest triangles; else triangle counts are balanced.
   std::span<const WorkPoint> work{};
+  // Triangles every PE holds a copy of (scene indices): left out of the held-only content
+  // boxes (reachesHeldOnly).
+  std::span<const uint32_t> replicated{};
 };
 
 // The part of a ray inside one voxel: t in [tEnter, tExit]. Consecutive spans of a walk share
@@ -65,7 +68,7 @@ class VoxelSplit {
   bool hasWork() const { return !work_.empty(); }
   // Bytes of the kd tree and the voxels' content boxes, which every PE keeps a copy of to
   // route rays.
-  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + content_.size() * sizeof(SlabBoxes4); }
+  size_t treeBytes() const { return nodes_.size() * sizeof(Node) + (content_.size() + heldOnly_.size()) * sizeof(SlabBoxes4); }
 
   // What a voxel holds, as up to kContentBoxes boxes inside its cell: per scene object the
   // bounds of its triangles' parts in the cell, the largest (by surface area) kept apart and
@@ -75,9 +78,12 @@ class VoxelSplit {
   // ray that crosses the voxel through empty space need not visit its owner. Conservative.
   static constexpr int kContentBoxes = 8;
   bool reachesContent(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
-    for (uint32_t i = contentFirst_[voxel]; i < contentFirst_[voxel + 1]; ++i)
-      if (slabs.overlapsAny(content_[i], t0, t1)) return true;
-    return false;
+    return reaches(content_, contentFirst_, voxel, slabs, t0, t1);
+  }
+  // The same for the voxel's triangles other than the options' replicated ones, which only
+  // its owner holds: false when no such triangle has a hit in [t0, t1].
+  bool reachesHeldOnly(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
+    return reaches(heldOnly_, heldOnlyFirst_, voxel, slabs, t0, t1);
   }
 
   // Calls visit(const VoxelSpan&) for each voxel the ray passes through for t in
@@ -101,12 +107,20 @@ class VoxelSplit {
   uint32_t build(Built& b, const scene::Bounds& cell, std::vector<uint32_t> tris, std::vector<uint32_t> points, int leaves,
                  int depth);
   void buildContent(const scene::Scene& scene, const Built& b);
+  static bool reaches(const std::vector<SlabBoxes4>& boxes, const std::vector<uint32_t>& first, uint32_t voxel,
+                      const RaySlabs& slabs, float t0, float t1) {
+    for (uint32_t i = first[voxel]; i < first[voxel + 1]; ++i)
+      if (slabs.overlapsAny(boxes[i], t0, t1)) return true;
+    return false;
+  }
 
   std::vector<Node> nodes_;
   std::vector<scene::Bounds> cells_;
   std::vector<std::vector<uint32_t>> triangles_;
   std::vector<SlabBoxes4> content_;   // voxel v's groups: [contentFirst_[v], contentFirst_[v + 1])
   std::vector<uint32_t> contentFirst_;
+  std::vector<SlabBoxes4> heldOnly_;  // the same without the replicated triangles
+  std::vector<uint32_t> heldOnlyFirst_;
   std::vector<double> work_;  // per voxel, when built with work points
   float margin_ = 0.0f;
 };

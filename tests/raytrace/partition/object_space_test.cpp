@@ -169,6 +169,39 @@ TEST_CASE("ObjectSpace: two walls, one tile: exactly one ray message") {
   }
 }
 
+TEST_CASE("ObjectSpace: a shadow ray is not sent to an owner whose voxel holds only an emitter on its way") {
+  // The two walls of the test above, and a two-sided area light at x = -2.5 in voxel 0, out of
+  // the two pixels' view. Pixel 1's ray hits the right wall (PE 1's voxel); its shadow ray to
+  // the light crosses into voxel 0 but reaches none of the left wall there, only the light,
+  // which every PE holds a copy of: PE 1 tests it whole and sends it nowhere. So the one
+  // message is still the camera ray sent to the other PE; the image is the sequential one.
+  scene::Scene s = test::twoWalls();
+  scene::Material lamp;
+  lamp.emissiveFactor = glm::vec3(4.0f);
+  const uint32_t light = test::addMaterial(s, lamp);
+  const glm::vec3 a(-2.5f, 4.0f, -6.0f), b(-2.5f, 6.0f, -6.0f), c(-2.5f, 5.0f, -4.0f);
+  scene::Object obj;
+  obj.firstTriangle = uint32_t(s.triangles.size());
+  obj.triangleCount = 2;
+  test::addTriangle(s, a, b, c, light);
+  test::addTriangle(s, a, c, b, light);
+  s.objects.push_back(obj);
+  test::addAreaLights(s, light);
+  const scene::Camera cam = test::perspectiveAt(glm::vec3(0.0f), 1.2f);
+  const rt::TraceOptions opt = test::partitionedOptions(rt::IntegratorKind::Whitted, 1);
+  const image::Image reference = test::renderSequential(s, cam, 2, 1, opt);
+  CHECK(reference.pixels[1].x > 0.0f);  // the right wall sees the light: its shadow ray was traced, unoccluded
+  for (int p : {1, 2}) {
+    CAPTURE(p);
+    rt::ObjectSpacePartition partition(1);
+    const test::PartitionedRun run = test::renderPartitioned(partition, s, cam, 2, 1, opt, p);
+    test::checkTraffic(run, p);
+    CHECK(run.image.pixels == reference.pixels);
+    CHECK(run.result.rays.shadowRays >= 1);
+    CHECK(run.figures.raysSent == (p == 1 ? 0u : 1u));
+  }
+}
+
 TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);

@@ -242,6 +242,26 @@ TEST_CASE("VoxelSplit: a voxel's content boxes are reached wherever it has a hit
   CHECK(crossed > 0);
 }
 
+TEST_CASE("VoxelSplit: held-only content leaves out the replicated triangles") {
+  // Two clusters; the triangles of the one at x = +3 are replicated. A ray through that cluster
+  // reaches its voxel's content, but not the part only the owner holds.
+  pr::scene::Scene s = pr::test::randomSoup(200, 0.5f, glm::vec3(-3.0f, 0.0f, 0.0f), 5);
+  const auto firstReplicated = uint32_t(s.triangles.size());
+  pr::test::appendTriangles(s, pr::test::randomSoup(200, 0.5f, glm::vec3(3.0f, 0.0f, 0.0f), 6));
+  std::vector<uint32_t> replicated;
+  for (auto t = firstReplicated; t < s.triangles.size(); ++t) replicated.push_back(t);
+  const VoxelSplit split(s, {2, 0.0f, {}, replicated});
+  for (float x : {-3.0f, 3.0f}) {
+    Ray ray;
+    ray.origin = glm::vec3(x, 5.0f, 0.0f);
+    ray.direction = glm::vec3(0.0f, -1.0f, 0.0f);
+    const pr::rt::RaySlabs slabs(ray);
+    const uint32_t voxel = uint32_t(split.voxelAt(glm::vec3(x, 0.0f, 0.0f)));
+    CHECK(split.reachesContent(voxel, slabs, ray.tMin, ray.tMax));
+    CHECK(split.reachesHeldOnly(voxel, slabs, ray.tMin, ray.tMax) == (x < 0.0f));
+  }
+}
+
 TEST_CASE("VoxelSplit: with work points the cuts balance work, and dealing counts the triangles held too") {
   // A cluster of 600 triangles around x = -3 with a tenth of the work, and a wall of two
   // triangles at x = +3 with the rest, spread over its face.
