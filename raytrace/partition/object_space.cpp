@@ -8,10 +8,10 @@
 // the first run that reports a hit reports the ray's closest hit, the same one (bit for bit)
 // as the BVH over the whole scene. A shadow ray is blocked by any occluder on it, found in
 // any order: the PE that spawned it tests it whole (every BVH also holds the replicated
-// emitters), then it visits each other owner with triangles of its own on the way once, in the
-// order of their first such voxels, each testing the rest of the ray from there, and stops at
-// the first that reports one; the owners visited travel with it. Shading and spawning happen on the PE
-// that found the hit; new rays start from there. The stage ends when no tile, ray or message
+// emitters), then it visits each other owner with triangles of its own on the way once, in
+// the order of their first such voxels, each testing the rest of the ray from there, and stops
+// at the first that reports one; the owners visited travel with it. Shading and spawning happen
+// on the PE that found the hit; new rays start from there. The stage ends when no tile, ray or message
 // is left (termination.h). A ray passes another owner's voxel without visiting it when it
 // misses the voxel's content boxes (voxel_split.h) there: through empty space. The voxels are
 // cut at equal work where the camera rays land (view_work.h), and each tile names as its

@@ -85,14 +85,9 @@ class RaySlabs {
     t = std::max(near, tMin_);
     return t <= std::min(far, tMax_);
   }
-  // Whether the ray touches the box for some t in [t0, t1].
-  bool overlaps(const SlabBox& box, float t0, float t1) const {
-    float near, far;
-    interval(box, near, far);
-    return std::max(near, t0) <= std::min(far, t1);
-  }
-  // Whether the ray touches any of the four boxes for some t in [t0, t1]: the test of
-  // overlaps() with the boxes in the lanes, so a voxel's content costs one pass per four boxes.
+  // Whether the ray touches any of the four boxes for some t in [t0, t1]: entry()'s test of
+  // the ray clipped to [t0, t1], with the boxes in the lanes, so a voxel's content costs one
+  // pass per four boxes.
   // An axis whose reciprocal overflows (|d| below 2^-128) limits nothing here: conservative.
   bool overlapsAny(const SlabBoxes4& boxes, float t0, float t1) const {
     const __m128 inf = _mm_set1_ps(std::numeric_limits<float>::infinity());

@@ -132,12 +132,12 @@ void VoxelSplit::buildContent(const scene::Scene& s, const Built& b) {
     first.push_back(static_cast<uint32_t>(content.size()));
   };
   contentFirst_.assign(1, 0);
+  for (size_t v = 0; v < cells_.size(); ++v) addBoxes(v, [](uint32_t) { return true; }, content_, contentFirst_);
+  if (b.replicated.empty()) return;  // the held-only boxes are the content boxes
   heldOnlyFirst_.assign(1, 0);
-  for (size_t v = 0; v < cells_.size(); ++v) {
-    addBoxes(v, [](uint32_t) { return true; }, content_, contentFirst_);
+  for (size_t v = 0; v < cells_.size(); ++v)
     addBoxes(v, [&](uint32_t t) { return !std::binary_search(b.replicated.begin(), b.replicated.end(), t); }, heldOnly_,
              heldOnlyFirst_);
-  }
 }
 
 // Splits `cell` (holding `tris`: the triangles overlapping it grown by the margin) into

@@ -83,7 +83,7 @@ class VoxelSplit {
   // The same for the voxel's triangles other than the options' replicated ones, which only
   // its owner holds: false when no such triangle has a hit in [t0, t1].
   bool reachesHeldOnly(uint32_t voxel, const RaySlabs& slabs, float t0, float t1) const {
-    return reaches(heldOnly_, heldOnlyFirst_, voxel, slabs, t0, t1);
+    return heldOnlyFirst_.empty() ? reachesContent(voxel, slabs, t0, t1) : reaches(heldOnly_, heldOnlyFirst_, voxel, slabs, t0, t1);
   }
 
   // Calls visit(const VoxelSpan&) for each voxel the ray passes through for t in
@@ -119,8 +119,8 @@ class VoxelSplit {
   std::vector<std::vector<uint32_t>> triangles_;
   std::vector<SlabBoxes4> content_;   // voxel v's groups: [contentFirst_[v], contentFirst_[v + 1])
   std::vector<uint32_t> contentFirst_;
-  std::vector<SlabBoxes4> heldOnly_;  // the same without the replicated triangles
-  std::vector<uint32_t> heldOnlyFirst_;
+  std::vector<SlabBoxes4> heldOnly_;  // the same without the replicated triangles; both
+  std::vector<uint32_t> heldOnlyFirst_;  // empty when nothing is replicated
   std::vector<double> work_;  // per voxel, when built with work points
   float margin_ = 0.0f;
 };

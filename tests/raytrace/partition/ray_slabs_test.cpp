@@ -55,8 +55,14 @@ TEST_CASE("RaySlabs: four boxes at once give the answer of testing each box") {
     const float t0 = std::uniform_int_distribution<int>(0, 1)(rng) ? ray.tMin : 1.0f;
     const float t1 = std::uniform_int_distribution<int>(0, 1)(rng) ? ray.tMax : 3.0f;
     const float grow = i % 2 == 0 ? 0.0f : 0.01f;  // ungrown, origins lie on faces
+    // The one-box test: entry() of the same ray clipped to [t0, t1].
+    Ray clipped = ray;
+    clipped.tMin = t0;
+    clipped.tMax = t1;
+    const RaySlabs one(clipped);
     bool any = false;
-    for (int k = 0; k < n; ++k) any = any || slabs.overlaps(SlabBox::of(boxes[size_t(k)], grow), t0, t1);
+    float t = 0.0f;
+    for (int k = 0; k < n; ++k) any = any || one.entry(SlabBox::of(boxes[size_t(k)], grow), t);
     const bool all4 = slabs.overlapsAny(SlabBoxes4::of(boxes.data(), size_t(n), grow), t0, t1);
     CAPTURE(i);
     CHECK(all4 == any);
