@@ -63,8 +63,10 @@ struct StageRecord {
   std::vector<int> owners;      // owner-pinned stages: the PE of each task; empty otherwise
 };
 
-// One task (or, with task = kMessageSpan, one message handler) on one PE.
+// One task on one PE, or with task = kMessageSpan one message handler, with task = kSetupSpan
+// the PE's set-up at the start of a stage (Runtime::runStage with a SetupFn).
 inline constexpr TaskId kMessageSpan = -1;
+inline constexpr TaskId kSetupSpan = -2;
 struct TaskSpan {
   int pe = 0;
   int stage = 0;  // index into RunRecord::stages

@@ -306,7 +306,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
                   numberAs<double>(jt[4], spanWhat + " end"),       numberAs<std::uint32_t>(jt[5], spanWhat + " messagesSent"),
                   numberAs<std::uint64_t>(jt[6], spanWhat + " bytesSent")};
     if (span.stage < 0 || span.stage >= static_cast<int>(record.stages.size()) || span.pe < 0 ||
-        span.pe >= record.pes || span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
+        span.pe >= record.pes || span.task < kSetupSpan ||
+        span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
       throw InputError(origin + ": \"timeline\" span names a PE, stage or task the record does not have");
     record.timeline.push_back(span);
   }
@@ -340,7 +341,8 @@ std::string toChromeTraceText(const RunRecord& record) {
                       {"args", {{"name", "PE " + std::to_string(p)}}}});
   for (const TaskSpan& t : record.timeline) {
     const std::string stage = t.stage < static_cast<int>(record.stages.size()) ? record.stages[t.stage].name : "?";
-    events.push_back({{"name", t.task == kMessageSpan ? "message" : "task " + std::to_string(t.task)},
+    const std::string name = t.task == kMessageSpan ? "message" : t.task == kSetupSpan ? "set-up" : "task " + std::to_string(t.task);
+    events.push_back({{"name", name},
                       {"cat", stage},
                       {"ph", "X"},
                       {"pid", 0},

@@ -76,7 +76,7 @@ void Runtime::workerMain(int p) {
       seen = generation_;
       job = job_;
     }
-    peLoop(p, *job.scheduler, *job.work, job.stage, *job.name);
+    peLoop(p, job);
     {
       std::lock_guard lock(stageMutex_);
       if (--running_ == 0) stageDone_.notify_one();
@@ -88,9 +88,13 @@ void Runtime::runStage(std::string_view name, const TaskSet& tasks, const TaskFn
   runStage(name, tasks, *schedule_, work);
 }
 
+void Runtime::runStage(std::string_view name, const TaskSet& tasks, const SetupFn& setup, const TaskFn& work) {
+  runStage(name, tasks, *schedule_, &setup, work, {});
+}
+
 void Runtime::runPinned(std::string_view name, const TaskSet& tasks, std::vector<int> owner, const TaskFn& work) {
   const std::unique_ptr<Scheduler> pinned = makeOwnerPinnedScheduler(owner);
-  runStage(name, tasks, *pinned, work, std::move(owner));
+  runStage(name, tasks, *pinned, nullptr, work, std::move(owner));
 }
 
 void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work) {
@@ -189,7 +193,10 @@ void Runtime::fail(int p, const std::string& stage, TaskId task, std::exception_
       } catch (...) {
       }
       record_.error = "stage '" + stage + "', PE " + std::to_string(p) +
-                      (task == kMessageSpan ? ", message handler" : ", task " + std::to_string(task)) + ": " + what;
+                      (task == kMessageSpan ? ", message handler"
+                       : task == kSetupSpan ? ", set-up"
+                                            : ", task " + std::to_string(task)) +
+                      ": " + what;
     }
   }
   abort_.store(true, std::memory_order_release);
@@ -243,16 +250,39 @@ bool Runtime::handleMessages(Pe& pe, std::vector<TaskSpan>& spans) {
   return any;
 }
 
-// The loop of one PE for one stage: messages first (they unblock other PEs), then the next
-// task(s) from the scheduler, then wait until a message arrives or the stage's work is done.
-void Runtime::peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name) {
+// The PE's set-up, timed like a task. Messages that arrive meanwhile wait in their channels.
+void Runtime::runSetup(Pe& pe, const SetupFn& setup, std::vector<TaskSpan>& spans) {
+  PeCounters& c = pe.counters();
+  const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
+  const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
+  const double t0 = now();
+  const double w0 = c.inTaskWaitSeconds;
+  setup(pe);
+  const double t1 = now();
+  c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
+  c.lastWorkEnd = t1;
+  if (options_.recordTimeline)
+    spans.push_back({pe.id(), pe.stage(), kSetupSpan, t0, t1,
+                     static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
+                     c.bytesSent.load(std::memory_order_relaxed) - b0});
+}
+
+// The loop of one PE for one stage: its set-up if the stage has one; then messages first (they
+// unblock other PEs), then the next task(s) from the scheduler, then wait until a message
+// arrives or the stage's work is done.
+void Runtime::peLoop(int p, const StageJob& job) {
+  Scheduler& scheduler = *job.scheduler;
+  const TaskFn& work = *job.work;
+  const int stage = job.stage;
+  const std::string& name = *job.name;
   PeCounters& c = counters_[p];
   Pe pe(*this, p, options_.pes, stage, name, c);
   std::vector<TaskSpan>& spans = spans_[p];
   Grab grab;
   bool tasksLeft = true;
-  TaskId current = kMessageSpan;
+  TaskId current = kSetupSpan;
   try {
+    if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) runSetup(pe, *job.setup, spans);
     while (!abort_.load(std::memory_order_acquire)) {
       current = kMessageSpan;
       if (handleMessages(pe, spans)) continue;
@@ -301,11 +331,11 @@ void Runtime::peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage,
 }
 
 void Runtime::runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work) {
-  runStage(name, tasks, scheduler, work, {});
+  runStage(name, tasks, scheduler, nullptr, work, {});
 }
 
-void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work,
-                       std::vector<int> owners) {
+void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const SetupFn* setup,
+                       const TaskFn& work, std::vector<int> owners) {
   PR_CHECK(!inStage_, "runStage is called by the controlling thread, not from inside a stage");
   const int pes = options_.pes;
   const std::string name(nameView);
@@ -334,7 +364,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   for (PeCounters& c : counters_) c.lastWorkEnd = start;
   {
     std::unique_lock lock(stageMutex_);
-    job_ = StageJob{&scheduler, &work, stage, &name};
+    job_ = StageJob{&scheduler, &work, setup, stage, &name};
     running_ = pes;
     ++generation_;
   }

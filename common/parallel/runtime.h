@@ -97,6 +97,7 @@ class ChannelBase {
 class Runtime {
  public:
   using TaskFn = std::function<void(Pe&, TaskId)>;
+  using SetupFn = std::function<void(Pe&)>;
 
   // Throws pr::InputError for pes outside [1, 4096] or an unknown schedule.
   explicit Runtime(RuntimeOptions options);
@@ -114,6 +115,12 @@ class Runtime {
   // runtime's schedule (options().schedule).
   void runStage(std::string_view name, const TaskSet& tasks, const TaskFn& work);
   void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work);
+  // The same, with each PE first running setup(pe): owner-local preparation that this PE's tasks
+  // and message handlers need (build my BVH), done inside the stage so that a PE that is ready
+  // starts on tasks while another still prepares, instead of every PE waiting at a barrier for
+  // the slowest set-up. Messages sent to a PE in its set-up wait until it is done. Recorded as
+  // a span with task = kSetupSpan; the simulator replays it before the PE's first task.
+  void runStage(std::string_view name, const TaskSet& tasks, const SetupFn& setup, const TaskFn& work);
   // Task t runs on PE owner[t] (owner-pinned: a region, voxel or buffer runs where its data is),
   // whatever the runtime's schedule; the record names the stage's schedule "owner-pinned" and
   // keeps the owners, so the simulator can say how the method would pin them at another P.
@@ -158,16 +165,18 @@ class Runtime {
   struct StageJob {
     Scheduler* scheduler = nullptr;
     const TaskFn* work = nullptr;
+    const SetupFn* setup = nullptr;  // none: the PEs start on tasks at once
     int stage = 0;
     const std::string* name = nullptr;
   };
 
   // owners: the PE of each task of an owner-pinned stage (kept in the record), else empty.
-  void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const TaskFn& work,
-                std::vector<int> owners);
+  void runStage(std::string_view name, const TaskSet& tasks, Scheduler& scheduler, const SetupFn* setup,
+                const TaskFn& work, std::vector<int> owners);
   void startWorkers();
   void workerMain(int p);
-  void peLoop(int p, Scheduler& scheduler, const TaskFn& work, int stage, const std::string& name);
+  void peLoop(int p, const StageJob& job);
+  void runSetup(Pe& pe, const SetupFn& setup, std::vector<TaskSpan>& spans);
   bool handleMessages(Pe& pe, std::vector<TaskSpan>& spans);
   void waitForWork(int p);
   static void confirmWait(PeCounters& c);

@@ -74,6 +74,16 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     std::size_t seenCount = 0;
     for (const TaskSpan& span : record.timeline) {
       if (span.stage != static_cast<int>(s)) continue;
+      if (span.task == kSetupSpan) {
+        if (span.pe < 0 || span.pe >= record.pes)
+          throw InputError(origin + ": stage '" + sr.name + "' has a set-up span on PE " + std::to_string(span.pe));
+        if (stage.setups.empty()) stage.setups.resize(static_cast<std::size_t>(record.pes));
+        SetupLoad& load = stage.setups[static_cast<std::size_t>(span.pe)];
+        load.seconds += span.end - span.start;
+        load.messagesSent += span.messagesSent;
+        load.bytesSent += span.bytesSent;
+        continue;
+      }
       if (span.task == kMessageSpan) {
         if (span.pe < 0 || span.pe >= record.pes)
           throw InputError(origin + ": stage '" + sr.name + "' has a message span on PE " + std::to_string(span.pe));
@@ -246,7 +256,7 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       t += due;
     };
 
-    // Each PE starts when its copy of the stage's broadcast data has arrived.
+    // Each PE starts when its copy of the stage's broadcast data has arrived, with its set-up.
     std::vector<double> lastEnd(pes, stageStart);
     std::vector<Event> initial(pes);
     for (int p = 0; p < pes; ++p) {
@@ -255,8 +265,22 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       r.broadcastsReceived = stage.broadcasts;
       r.broadcastBytesReceived = stage.broadcastBytes;
       r.messageWaitSeconds += arrival;
-      lastEnd[p] = stageStart + arrival;
-      initial[p] = {stageStart + arrival, p};
+      double t = stageStart + arrival;
+      const SetupLoad& setup = plan.setups[p];
+      if (setup.seconds > 0.0 || setup.messagesSent > 0) {
+        const double send = net.seconds(setup.messagesSent, setup.bytesSent);
+        const double d = setup.seconds + send;
+        if (options.recordTimeline)
+          record.timeline.push_back({p, stageIndex, kSetupSpan, t, t + d, static_cast<std::uint32_t>(setup.messagesSent),
+                                     setup.bytesSent});
+        r.busySeconds += d;
+        r.sendReceiveSeconds += send;
+        r.messagesSent += setup.messagesSent;
+        r.bytesSent += setup.bytesSent;
+        t += d;
+      }
+      lastEnd[p] = t;
+      initial[p] = {t, p};
     }
     std::priority_queue<Event, std::vector<Event>, std::greater<Event>> ready(std::greater<Event>(), std::move(initial));
     while (!ready.empty()) {

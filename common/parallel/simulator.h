@@ -55,6 +55,13 @@ struct HandlerLoad {
   std::uint64_t messagesSent = 0, bytesSent = 0;
 };
 
+// The set-up of one PE at the start of one stage, as recorded (the span with task ==
+// kSetupSpan, Runtime::runStage with a SetupFn): its seconds and the data messages it sent.
+struct SetupLoad {
+  double seconds = 0.0;
+  std::uint64_t messagesSent = 0, bytesSent = 0;
+};
+
 // One stage's work. tasks is what the scheduler sees (estimates, positions); costs are the
 // seconds each task really takes; messages/bytes the data messages each task sends (empty:
 // none). A sender pays latency + bytes/bandwidth for its messages inside the task. The fields
@@ -70,6 +77,7 @@ struct SimStage {
   bool runtimeSchedule = true;  // it ran under the run's own schedule, which --schedule replaces
   std::vector<int> owners;      // owner-pinned stages: the PE of each task in the recorded run
   std::vector<HandlerLoad> handlers;  // one per recorded PE; empty: no message handled
+  std::vector<SetupLoad> setups;      // one per recorded PE; empty: the stage has no set-up
   // Replicated read-only data each PE received before the stage (messages and bytes per PE).
   std::uint64_t broadcasts = 0, broadcastBytes = 0;
   // The controlling thread's time between the previous stage's end (or the first stage's
@@ -121,7 +129,7 @@ std::string formatStageNotes(const std::vector<StageNote>& notes);
 // empty: each stage's recorded one. Stages that ran with another strategy keep theirs, and
 // owner-pinned stages follow the rules of stage_replay.h. Within a stage: PEs ask for work in
 // order of virtual time, ties by lower PE id; a PE starts only when its copy of the stage's
-// broadcast data has arrived (NetworkModel::broadcastArrival); a PE waiting for a task packet
+// broadcast data has arrived (NetworkModel::broadcastArrival) and its set-up is done; a PE waiting for a task packet
 // is idle for the request and packet latencies plus the packet's bytes over the bandwidth
 // (refills ahead of need are counted as traffic but not waited for); data messages sent by a
 // task or handler are charged to the sender; message-handler work is charged alongside the

@@ -51,6 +51,22 @@ std::vector<HandlerLoad> handlersAt(const std::vector<HandlerLoad>& recorded, in
   return out;
 }
 
+// The recorded set-ups at P', by the same rule as the handlers.
+std::vector<SetupLoad> setupsAt(const std::vector<SetupLoad>& recorded, int recordedPes, int pes) {
+  std::vector<SetupLoad> out(static_cast<std::size_t>(pes));
+  if (recorded.empty()) return out;
+  if (static_cast<int>(recorded.size()) == pes && recordedPes == pes) return recorded;
+  SetupLoad total;
+  for (const SetupLoad& s : recorded) {
+    total.seconds += s.seconds;
+    total.messagesSent += s.messagesSent;
+    total.bytesSent += s.bytesSent;
+  }
+  for (int p = 0; p < pes; ++p)
+    out[p] = {total.seconds / pes, evenShare(total.messagesSent, pes, p), evenShare(total.bytesSent, pes, p)};
+  return out;
+}
+
 bool isEachPe(const std::vector<int>& owners, int recordedPes) {
   if (static_cast<int>(owners.size()) != recordedPes) return false;
   for (std::size_t t = 0; t < owners.size(); ++t)
@@ -79,6 +95,7 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
   StageReplay r;
   r.stage = stage;
   r.handlers = handlersAt(stage.handlers, recordedPes, pes);
+  r.setups = setupsAt(stage.setups, recordedPes, pes);
   const bool pinned = stage.schedule == kOwnerPinnedSchedule;
   if (!pinned) {
     r.rule = ReplayRule::Scheduled;
@@ -179,6 +196,10 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
   for (HandlerLoad& h : r.handlers) {
     dropped += std::exchange(h.messagesSent, 0u);
     h.bytesSent = 0;
+  }
+  for (SetupLoad& s : r.setups) {
+    dropped += std::exchange(s.messagesSent, 0u);
+    s.bytesSent = 0;
   }
   if (dropped > 0) r.note += "; its " + std::to_string(dropped) + " data messages are to itself on one PE, not charged";
   return r;

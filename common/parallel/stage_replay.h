@@ -24,7 +24,9 @@
 //
 // Message handlers: at the recorded P each PE keeps its recorded handler work; at another P'
 // the stage's total (seconds, messages handled, messages and bytes sent) is divided evenly over
-// the P' PEs, i.e. the messages go to owners that hold equal shares of the data. Data messages
+// the P' PEs, i.e. the messages go to owners that hold equal shares of the data. Set-ups (the
+// PEs' owner-local preparation at the start of a stage) follow the same rule: as recorded at
+// P, else the total over P' (the each-PE rule's assumption: the data divides evenly). Data messages
 // (sent by tasks or handlers) are the recorded ones, except at P' = 1, where every message
 // would go to the PE itself and none is charged. A P = 1 record has none, so it predicts no
 // data traffic at P' > 1; a record at P predicts its own message count at every P' > 1,
@@ -50,6 +52,7 @@ struct StageReplay {
   std::string note;      // the rule's assumption, or why the stage is excluded
   SimStage stage;        // the stage at P': tasks, costs, messages; owners for pinned rules
   std::vector<HandlerLoad> handlers;  // P' entries, zero when the stage handled no messages
+  std::vector<SetupLoad> setups;      // P' entries, zero when the stage has no set-up
 };
 
 // Called by simulate() for each stage. recordedPes = 0 for a cost table. schedule: the strategy

@@ -1,6 +1,8 @@
 // The object-space tracer. Stage "split": the assembler's PE cuts the scene into voxels and deals
-// them to the PEs. Stage "build": each owner builds one BVH over the triangles its
-// voxels hold. Stage "trace": image tiles are tasks that make camera rays; a ray is traced on
+// them to the PEs. Stage "trace": each owner first builds one BVH over the triangles its voxels
+// hold (the stage's set-up, so that an owner with less to build starts tracing while another
+// still builds, as the dealing of voxels by build and trace work intends); then image tiles
+// are tasks that make camera rays; a ray is traced on
 // the PE owning the voxel it is in, and sent (a TravellingRay in a batch on the "rays"
 // BatchedChannel) to the owner of the next voxel along it when it leaves without a hit; the
 // owner resumes the walk at that voxel. Each run of consecutive voxels of one owner along the
@@ -102,25 +104,6 @@ class ObjectSpaceFrame {
       owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
       if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
     });
-    // Each owner builds one BVH over its voxels' triangles (a triangle straddling two of them
-    // once): task t is PE t's.
-    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
-      std::vector<uint32_t>& held = held_[size_t(pe.id())];
-      for (int v = 0; v < split_.voxels(); ++v)
-        if (owners_[v] == pe.id()) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
-      std::sort(held.begin(), held.end());
-      held.erase(std::unique(held.begin(), held.end()), held.end());
-      // The BVH also holds the PE's copy of the emitters (replicated for light sampling), so
-      // that the PE spawning a shadow ray tests it against every emitter. A closest hit on one
-      // outside this PE's voxels lies outside its runs, which are the only spans it traces.
-      std::vector<uint32_t> emitters = integrator_->context().lights().emitters();
-      std::sort(emitters.begin(), emitters.end());
-      std::vector<uint32_t> traced;
-      traced.reserve(held.size() + emitters.size());
-      std::set_union(held.begin(), held.end(), emitters.begin(), emitters.end(), std::back_inserter(traced));
-      if (!traced.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, traced, job_.options.bvh);
-      views_.build(pe.id(), held, integrator_->context().lights());
-    });
 
     const auto total = int64_t(tiles.size());
     const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
@@ -134,7 +117,7 @@ class ObjectSpaceFrame {
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
     if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
-    rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
+    rt_.runStage(job_.stage("trace"), tasks, [this](par::Pe& pe) { buildOwnBvh(pe); }, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
       integrator_->cameraRays(tiles[size_t(id)], camera);
@@ -181,6 +164,26 @@ class ObjectSpaceFrame {
     TraceStats stats;
     uint64_t raysSent = 0;
   };
+
+  // On PE pe, before it traces anything: one BVH over its voxels' triangles (a triangle
+  // straddling two of them once) and its view of the scene.
+  void buildOwnBvh(par::Pe& pe) {
+    std::vector<uint32_t>& held = held_[size_t(pe.id())];
+    for (int v = 0; v < split_.voxels(); ++v)
+      if (owners_[v] == pe.id()) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
+    std::sort(held.begin(), held.end());
+    held.erase(std::unique(held.begin(), held.end()), held.end());
+    // The BVH also holds the PE's copy of the emitters (replicated for light sampling), so
+    // that the PE spawning a shadow ray tests it against every emitter. A closest hit on one
+    // outside this PE's voxels lies outside its runs, which are the only spans it traces.
+    std::vector<uint32_t> emitters = integrator_->context().lights().emitters();
+    std::sort(emitters.begin(), emitters.end());
+    std::vector<uint32_t> traced;
+    traced.reserve(held.size() + emitters.size());
+    std::set_union(held.begin(), held.end(), emitters.begin(), emitters.end(), std::back_inserter(traced));
+    if (!traced.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, traced, job_.options.bvh);
+    views_.build(pe.id(), held, integrator_->context().lights());
+  }
 
   // Per tile, the owner of the first voxel with content that most of its probe rays reach
   // (tile_affinity.h): a camera ray starting there is traced without being sent first. From

@@ -84,7 +84,7 @@ inline void countStartRays(TraceStats& stats, std::span<const RayMessage> rays) 
 class SceneViews {
  public:
   explicit SceneViews(const TraceJob& job, int pes) : job_(job), views_(job.options.poisonForeignGeometry ? pes : 0) {}
-  // On PE p, in the build stage: its view, from the triangles it holds.
+  // On PE p, in its build (a stage, or the trace stage's set-up): its view, from the triangles it holds.
   void build(int p, std::span<const uint32_t> held, const LightSampler& lights) {
     if (!views_.empty()) views_[size_t(p)] = scene::poisonedView(job_.scene, held, lights.emitters());
   }

@@ -291,8 +291,10 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     nlohmann::json spans = nlohmann::json::array();
     for (const par::TaskSpan& s : timeline) {
       if (spans.size() >= kMaxTimelineSpans) break;
+      const std::string& stage = chosen->record.stages[std::size_t(s.stage)].name;
       const std::string what = s.task == par::kMessageSpan ? std::string("message handler")
-                                                            : chosen->record.stages[std::size_t(s.stage)].name;
+                               : s.task == par::kSetupSpan ? stage + " set-up"
+                                                           : stage;
       spans.push_back({{"pe", s.pe}, {"start", s.start}, {"end", s.end}, {"what", what}, {"task", s.task},
                        {"messagesSent", s.messagesSent}});
     }

@@ -124,6 +124,9 @@ TEST_CASE("RunRecord: a number the field's type cannot hold is an input error, a
   CHECK_THROWS_AS(runRecordFromJsonText(record("1", "1e20", goodSpan), "m.json"), pr::InputError);
   CHECK_THROWS_AS(runRecordFromJsonText(record("1", "5", "[0, 0, 0, 0.0, 1.0, 5e9, 3]"), "m.json"), pr::InputError);
   CHECK_THROWS_AS(runRecordFromJsonText(record("1", "5", "[0, 0, 0, 0.0, 1.0, 2, -3]"), "m.json"), pr::InputError);
+  // Task -1 is a message handler, -2 a set-up; nothing below.
+  CHECK(runRecordFromJsonText(record("1", "5", "[0, 0, -2, 0.0, 1.0, 0, 0]"), "m.json").timeline[0].task == kSetupSpan);
+  CHECK_THROWS_AS(runRecordFromJsonText(record("1", "5", "[0, 0, -3, 0.0, 1.0, 0, 0]"), "m.json"), pr::InputError);
 }
 
 TEST_CASE("RunRecord: named per-PE counters add up, survive JSON and appear in the summary") {

@@ -152,3 +152,60 @@ TEST_CASE("Runtime: a PE blocked on an empty mailbox books message waiting, not 
   CHECK(s.pes[0].sendReceiveSeconds > 0.0);
   CHECK(s.pes[0].sendReceiveSeconds < s.pes[0].busySeconds);
 }
+
+TEST_CASE("Runtime: a stage's set-up runs once on each PE before its tasks and handlers there, without a barrier") {
+  // PE 1's set-up takes 100 ms, PE 0's none; every task sends the other PE a message, so PE 1
+  // gets messages while it still sets up. Nothing may run on a PE before its set-up is done.
+  Runtime rt(2, "demand");
+  std::atomic<bool> ready[2] = {false, false};
+  std::atomic<int> setups{0}, early{0}, handled{0};
+  Channel<int> ch(rt, "m", MessageKind::Data, [&](Pe& pe, int&&) {
+    if (!ready[pe.id()]) early++;
+    handled++;
+  });
+  rt.runStage(
+      "s", TaskSet::uniform(8),
+      [&](Pe& pe) {
+        if (pe.id() == 1) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        ready[pe.id()] = true;
+        setups++;
+      },
+      [&](Pe& pe, TaskId) {
+        if (!ready[pe.id()]) early++;
+        ch.send(pe, 1 - pe.id(), 0);
+      });
+  CHECK(setups == 2);
+  CHECK(early == 0);
+  CHECK(handled == 8);
+  const RunRecord& r = rt.record();
+  double setupEnd[2] = {0.0, 0.0}, firstTask[2] = {1e30, 1e30};
+  int setupSpans = 0;
+  for (const TaskSpan& span : r.timeline) {
+    if (span.task == kSetupSpan) {
+      ++setupSpans;
+      setupEnd[span.pe] = span.end;
+    } else if (span.task >= 0) {
+      firstTask[span.pe] = std::min(firstTask[span.pe], span.start);
+    }
+  }
+  CHECK(setupSpans == 2);
+  CHECK(r.stages[0].pes[0].tasks + r.stages[0].pes[1].tasks == 8);
+  // PE 0 took tasks while PE 1 was still setting up; the set-up counts as PE 1's busy time.
+  CHECK(firstTask[0] < setupEnd[1]);
+  CHECK(r.stages[0].pes[1].busySeconds >= 0.09);
+  CHECK(r.stages[0].pes[1].tasks == 0);
+}
+
+TEST_CASE("Runtime: an exception in a set-up ends the stage and names the set-up") {
+  Runtime rt(2, "demand");
+  std::atomic<int> ran{0};
+  CHECK_THROWS_WITH_AS(rt.runStage(
+                           "s", TaskSet::uniform(4),
+                           [](Pe& pe) {
+                             if (pe.id() == 1) throw std::runtime_error("no memory for the BVH");
+                           },
+                           [&](Pe&, TaskId) { ran++; }),
+                       "no memory for the BVH", std::runtime_error);
+  CHECK(rt.record().error == "stage 's', PE 1, set-up: no memory for the BVH");
+  CHECK(ran <= 4);
+}

@@ -128,6 +128,45 @@ TEST_CASE("Simulator: message-handler time is charged on its PE with its sends")
   CHECK(handlerBusy == doctest::Approx(2.0 + 0.25 + 1.0));
 }
 
+TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at the recorded P, evenly at another") {
+  // Recorded at P = 2 under demand: PE 0 set up for 1 s, PE 1 for 3 s (sending one 1000-byte
+  // message), then four tasks of 1 s.
+  RunRecord rec;
+  rec.pes = 2;
+  rec.schedule = "demand";
+  StageRecord s;
+  s.name = "trace";
+  s.schedule = "demand";
+  s.tasks = TaskSet::uniform(4).tasks;
+  s.pes.resize(2);
+  s.wallSeconds = 4.0;
+  rec.stages.push_back(s);
+  rec.timeline = {{0, 0, kSetupSpan, 0.0, 1.0},       {1, 0, kSetupSpan, 0.0, 3.0, 1, 1000}, {0, 0, 0, 1.0, 2.0},
+                  {0, 0, 1, 2.0, 3.0},                {0, 0, 2, 3.0, 4.0},                   {1, 0, 3, 3.0, 4.0}};
+  rec.wallSeconds = 4.0;
+  const Workload w = workloadFromRecord(rec, "hand-made");
+  REQUIRE(w.stages[0].setups.size() == 2);
+  CHECK(w.stages[0].setups[1].seconds == doctest::Approx(3.0));
+  CHECK(w.stages[0].setups[1].bytesSent == 1000);
+  SimOptions options;
+  options.pes = 2;
+  options.network = networkByName("zero");
+  options.recordTimeline = true;
+  // PE 0 runs tasks from 1 s while PE 1 still sets up: 4 s, where a barrier after the
+  // set-ups would give 3 + 2 = 5 s.
+  const RunRecord two = simulate(w, "", options);
+  CHECK(two.wallSeconds == doctest::Approx(4.0));
+  CHECK(two.stages[0].pes[0].tasks == 3);
+  CHECK(two.stages[0].pes[1].busySeconds == doctest::Approx(4.0));
+  CHECK(two.stages[0].pes[1].messagesSent == 1);
+  CHECK(std::count_if(two.timeline.begin(), two.timeline.end(), [](const TaskSpan& t) { return t.task == kSetupSpan; }) == 2);
+  // At P = 4 the 4 s of set-up are 1 s on each PE; at P = 1 all of it comes first.
+  options.pes = 4;
+  CHECK(simulate(w, "", options).wallSeconds == doctest::Approx(2.0));
+  options.pes = 1;
+  CHECK(simulate(w, "", options).wallSeconds == doctest::Approx(8.0));
+}
+
 TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arrived") {
   // 1 MB of scene to each of 4 PEs at 1 ms + 1e6 / 12.5e6 s = 81 ms per copy, sent one after
   // another: PE p has it at (p + 1) x 81 ms. PE 3 then waits for its task packet

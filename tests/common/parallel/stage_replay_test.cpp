@@ -172,6 +172,28 @@ TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split
   CHECK(planReplay(SimStage{}, 2, 3, "demand").handlers.size() == 3);  // none recorded: zero on every PE
 }
 
+TEST_CASE("StageReplay: set-ups stay per PE at the recorded P and are split evenly at another") {
+  SimStage s;
+  s.setups = {{3.0, 4, 400}, {1.0, 0, 0}};
+  s.schedule = "demand";
+  const StageReplay same = planReplay(s, 2, 2, "");
+  REQUIRE(same.setups.size() == 2);
+  CHECK(same.setups[0].seconds == 3.0);
+  CHECK(same.setups[1].seconds == 1.0);
+  const StageReplay four = planReplay(s, 2, 4, "");
+  REQUIRE(four.setups.size() == 4);
+  for (const SetupLoad& load : four.setups) {
+    CHECK(load.seconds == doctest::Approx(1.0));
+    CHECK(load.messagesSent == 1);
+    CHECK(load.bytesSent == 100);
+  }
+  const StageReplay one = planReplay(s, 2, 1, "");
+  REQUIRE(one.setups.size() == 1);
+  CHECK(one.setups[0].seconds == doctest::Approx(4.0));
+  CHECK(one.setups[0].messagesSent == 0);  // to itself on one PE
+  CHECK(planReplay(SimStage{}, 2, 3, "demand").setups.size() == 3);  // none recorded: zero on every PE
+}
+
 TEST_CASE("StageReplay: on one PE no data message is charged, the work stays") {
   SimStage s;
   s.name = "trace";

@@ -223,6 +223,38 @@ TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   CHECK(run.figures.raysSent > 0);
 }
 
+TEST_CASE("ObjectSpace: each owner builds its BVH as the trace stage's set-up, before it traces anything") {
+  const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
+  const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
+  rt::ObjectSpacePartition partition;
+  const test::PartitionedRun run =
+      test::renderPartitioned(partition, s, cam, 16, 16, test::partitionedOptions(rt::IntegratorKind::Path, 1), 3);
+  CHECK(std::none_of(run.record.stages.begin(), run.record.stages.end(),
+                     [](const par::StageRecord& st) { return st.name == "build"; }));
+  int trace = -1;
+  for (size_t i = 0; i < run.record.stages.size(); ++i)
+    if (run.record.stages[i].name == "trace") trace = int(i);
+  REQUIRE(trace >= 0);
+  // Per PE: one set-up span in the trace stage, and every task or handler span there after it.
+  for (int p = 0; p < 3; ++p) {
+    CAPTURE(p);
+    int setups = 0;
+    double setupEnd = 0.0, firstWork = 1e30;
+    for (const par::TaskSpan& span : run.record.timeline) {
+      if (span.pe != p || span.stage != trace) continue;
+      if (span.task == par::kSetupSpan) {
+        ++setups;
+        setupEnd = span.end;
+      } else {
+        firstWork = std::min(firstWork, span.start);
+      }
+    }
+    CHECK(setups == 1);
+    CHECK(setupEnd <= firstWork);
+    CHECK(run.figures.triangles[p] > 0);
+  }
+}
+
 TEST_CASE("ObjectSpace: renders terminate (timeout guard)") {
   // Deep glass and mirror paths at P = 8 with spp 2: if termination detection failed, the
   // stage would never end; the guard turns a hang into a failure.
