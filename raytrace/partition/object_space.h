@@ -16,8 +16,11 @@ namespace pr::rt {
 class ObjectSpacePartition final : public Partition {
  public:
   // voxelsPerPe: k of the k·P voxels (1..64); more voxels than PEs let the owners' work be
-  // dealt evenly (4 is fastest on the hot-spot scene at P = 2 among 2, 4 and 8).
-  explicit ObjectSpacePartition(int voxelsPerPe = 4);
+  // dealt evenly, fewer mean shorter walks and fewer rays between owners. 2 is fastest on the
+  // hot-spot scene at P = 2 among 1 to 4, and as fast as 4 on the landscape, since the owners
+  // build their BVHs as the trace stage's set-up (with a build stage of its own, whose
+  // barrier waited for the owner with the most triangles, 4 was).
+  explicit ObjectSpacePartition(int voxelsPerPe = 2);
   std::string_view name() const override { return "object-space"; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
 

@@ -205,14 +205,15 @@ TEST_CASE("ObjectSpace: a shadow ray is not sent to an owner whose voxel holds o
 TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
-  rt::ObjectSpacePartition partition;
+  rt::ObjectSpacePartition partition(4);  // 16 voxels
   const test::PartitionedRun run =
       test::renderPartitioned(partition, s, cam, 8, 8, test::partitionedOptions(rt::IntegratorKind::Whitted, 1), 4);
   uint64_t triangles = 0;
   for (int p = 0; p < 4; ++p) {
     CHECK(run.figures.triangles[p] > 0);
     // Not the world: the cluster of spheres, most of the triangles but little of the view's
-    // work, is cut in two and the rest of the voxels hold parts of the walls.
+    // work, is cut in two and the rest of the voxels hold parts of the walls (with fewer
+    // voxels the cluster may be one voxel, whose owner then holds nearly every triangle).
     CHECK(run.figures.triangles[p] < s.triangles.size() * 7 / 10);
     CHECK(run.figures.geometryBytes[p] > run.figures.triangles[p] * rt::kTriangleVertexBytes);
     triangles += run.figures.triangles[p];
