@@ -96,11 +96,12 @@ void runSimulate(const SimulateArgs& args) {
   par::ScheduleParams params = args.schedule.params;
   if (!args.scheduleGiven && fromRecord) params.grain = workload.grain;
   std::size_t tasks = 0;
-  double work = 0.0, handlerWork = 0.0, gaps = 0.0;
+  double work = 0.0, handlerWork = 0.0, setupWork = 0.0, gaps = 0.0;
   for (const par::SimStage& s : workload.stages) {
     tasks += s.costs.size();
     for (double c : s.costs) work += c;
     for (const par::HandlerLoad& h : s.handlers) handlerWork += h.seconds;
+    for (const par::SetupLoad& load : s.setups) setupWork += load.seconds;
     gaps += s.gapBeforeSeconds;
   }
   if (fromRecord)
@@ -112,6 +113,8 @@ void runSimulate(const SimulateArgs& args) {
   if (handlerWork > 0.0)
     std::printf("message handlers: %.6f s of recorded handler work, charged on the PEs alongside the tasks\n",
                 handlerWork);
+  if (setupWork > 0.0)
+    std::printf("set-ups: %.6f s of the PEs' recorded set-up work, each PE's before its first task\n", setupWork);
   if (gaps > 0.0) std::printf("controlling thread between stages: %.6f s, replayed serially\n", gaps);
   std::printf("schedule %s, grain %d; network %s (%s)\n",
               schedule.empty() ? ("as recorded per stage (run: " + workload.schedule + ")").c_str() : schedule.c_str(),

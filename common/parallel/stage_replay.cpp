@@ -187,6 +187,13 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
 
 StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
   StageReplay r = planRule(stage, recordedPes, pes, schedule);
+  if (!stage.setups.empty() && r.rule != ReplayRule::Excluded) {
+    double total = 0.0;
+    for (const SetupLoad& load : stage.setups) total += load.seconds;
+    r.note += pes == recordedPes ? "; set-ups as recorded"
+                                 : "; set-ups: " + seconds(total) + " split evenly over " + std::to_string(pes) +
+                                       " PEs (assumes the data divides evenly)";
+  }
   if (pes != 1 || recordedPes <= 1) return r;  // a cost table (0) says what its tasks send
   // On one PE every message would be to itself, which is no transfer (Runtime::countMessage):
   // the work stays, the data traffic goes.

@@ -180,7 +180,9 @@ TEST_CASE("StageReplay: set-ups stay per PE at the recorded P and are split even
   REQUIRE(same.setups.size() == 2);
   CHECK(same.setups[0].seconds == 3.0);
   CHECK(same.setups[1].seconds == 1.0);
+  CHECK(same.note.find("set-ups as recorded") != std::string::npos);
   const StageReplay four = planReplay(s, 2, 4, "");
+  CHECK(four.note.find("set-ups: 4 s split evenly over 4 PEs") != std::string::npos);
   REQUIRE(four.setups.size() == 4);
   for (const SetupLoad& load : four.setups) {
     CHECK(load.seconds == doctest::Approx(1.0));
