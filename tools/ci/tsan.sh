@@ -16,8 +16,9 @@ jobs="${JOBS:-2}"
 # (raster/sort): PEs waiting on each other's messages inside a task, and the abort;
 # GatherToRoot and PhotonPass (photonmap): per-PE results written during a pre-pass program
 # in every tracer and merged on PE 0; TileAffinity (raytrace/partition): probe hits sent to PE 0
-# in the build stage.
-runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*"
+# in the build stage; ObjectSpace (raytrace/partition): owners building their BVHs as the trace
+# stage's set-up while the other PEs already trace and send them rays.
+runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*,ObjectSpace*"
 
 cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests
