@@ -282,7 +282,10 @@ void Runtime::peLoop(int p, const StageJob& job) {
   bool tasksLeft = true;
   TaskId current = kSetupSpan;
   try {
-    if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) runSetup(pe, *job.setup, spans);
+    if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) {
+      runSetup(pe, *job.setup, spans);
+      if (outstanding_.done()) ringAll();
+    }
     while (!abort_.load(std::memory_order_acquire)) {
       current = kMessageSpan;
       if (handleMessages(pe, spans)) continue;
@@ -355,7 +358,8 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   for (auto& s : spans_) s.clear();
   abort_.store(false);
   error_ = nullptr;
-  outstanding_.reset(static_cast<std::int64_t>(tasks.size()));
+  // Every task and every PE's set-up is outstanding work until it returns (termination.h).
+  outstanding_.reset(static_cast<std::int64_t>(tasks.size()) + (setup && *setup ? pes : 0));
   scheduler.reset(tasks, pes, options_.params);
 
   if (workers_.empty()) startWorkers();

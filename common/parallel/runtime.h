@@ -9,7 +9,7 @@
 // function called as work(pe, taskId) on the PE the schedule chose. PEs talk only through
 // Channels; a Channel constructed with a handler makes the stage message-driven: the stage
 // ends when every task has run and every message (and the messages its handler sent) has been
-// handled (termination.h). The runtime, not the algorithm, times tasks and handlers.
+// handled (termination.h). The runtime, not the algorithm, times tasks, handlers and set-ups.
 //
 //   par::Runtime rt(8, "spiral", scheduleOptions.params);   // or from --schedule/--grain
 //   par::Channel<RayBatch> rays(rt, "rays", par::MessageKind::Rays, [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
@@ -23,8 +23,8 @@
 // and task packets are counted as scheduling traffic), and the renderer's controlling thread
 // collates results between stages (Channel::drain), after runStage's barrier.
 //
-// An exception thrown by a task or handler stops every PE at its next task boundary and is
-// rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
+// An exception thrown by a task, handler or set-up stops every PE at its next task boundary (a
+// set-up already running is not interrupted: the stage ends when it returns) and is rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
 // P may exceed the core count: idle PEs block on a condition variable, they do not spin.
 // The PE threads live for the runtime's lifetime (started by the first stage): a stage costs a
 // wake-up and a barrier, not P thread creations (bench_runtime section 6).
@@ -57,7 +57,7 @@ struct RuntimeOptions {
   int pes = 1;
   std::string schedule = "demand";  // registry name (schedulers/registry.cpp)
   ScheduleParams params;
-  bool recordTimeline = true;       // keep one TaskSpan per task and handled message
+  bool recordTimeline = true;       // keep one TaskSpan per task, handled message and set-up
 };
 
 // What a message carries, for the traffic-by-kind figures of the run record: primitives
@@ -118,8 +118,10 @@ class Runtime {
   // The same, with each PE first running setup(pe): owner-local preparation that this PE's tasks
   // and message handlers need (build my BVH), done inside the stage so that a PE that is ready
   // starts on tasks while another still prepares, instead of every PE waiting at a barrier for
-  // the slowest set-up. Messages sent to a PE in its set-up wait until it is done. Recorded as
-  // a span with task = kSetupSpan; the simulator replays it before the PE's first task.
+  // the slowest set-up. Messages sent to a PE in its set-up wait until it is done (unless the
+  // set-up itself waits for a reply, await_reply.h, which handles them). A set-up may send; it
+  // counts as outstanding work (termination.h) until it returns. Recorded as a span with task =
+  // kSetupSpan; the simulator replays it before the PE's first task.
   void runStage(std::string_view name, const TaskSet& tasks, const SetupFn& setup, const TaskFn& work);
   // Task t runs on PE owner[t] (owner-pinned: a region, voxel or buffer runs where its data is),
   // whatever the runtime's schedule; the record names the stage's schedule "owner-pinned" and

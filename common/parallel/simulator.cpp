@@ -74,25 +74,18 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     std::size_t seenCount = 0;
     for (const TaskSpan& span : record.timeline) {
       if (span.stage != static_cast<int>(s)) continue;
-      if (span.task == kSetupSpan) {
+      if (span.task == kMessageSpan || span.task == kSetupSpan) {
+        const bool setup = span.task == kSetupSpan;
         if (span.pe < 0 || span.pe >= record.pes)
-          throw InputError(origin + ": stage '" + sr.name + "' has a set-up span on PE " + std::to_string(span.pe));
-        if (stage.setups.empty()) stage.setups.resize(static_cast<std::size_t>(record.pes));
-        SetupLoad& load = stage.setups[static_cast<std::size_t>(span.pe)];
+          throw InputError(origin + ": stage '" + sr.name + "' has a " + (setup ? "set-up" : "message") + " span on PE " +
+                           std::to_string(span.pe));
+        std::vector<PeLoad>& loads = setup ? stage.setups : stage.handlers;
+        if (loads.empty()) loads.resize(static_cast<std::size_t>(record.pes));
+        PeLoad& load = loads[static_cast<std::size_t>(span.pe)];
         load.seconds += span.end - span.start;
+        load.spans += 1;
         load.messagesSent += span.messagesSent;
         load.bytesSent += span.bytesSent;
-        continue;
-      }
-      if (span.task == kMessageSpan) {
-        if (span.pe < 0 || span.pe >= record.pes)
-          throw InputError(origin + ": stage '" + sr.name + "' has a message span on PE " + std::to_string(span.pe));
-        if (stage.handlers.empty()) stage.handlers.resize(static_cast<std::size_t>(record.pes));
-        HandlerLoad& h = stage.handlers[static_cast<std::size_t>(span.pe)];
-        h.seconds += span.end - span.start;
-        h.handled += 1;
-        h.messagesSent += span.messagesSent;
-        h.bytesSent += span.bytesSent;
         continue;
       }
       if (span.task < 0 || static_cast<std::size_t>(span.task) >= n)
@@ -242,7 +235,7 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       const double send = net.seconds(h.messagesSent, h.bytesSent);
       handlerSeconds[p] = h.seconds + send;
       PeStageRecord& r = sr.pes[p];
-      r.messagesHandled = h.handled;
+      r.messagesHandled = h.spans;
       r.messagesSent += h.messagesSent;
       r.bytesSent += h.bytesSent;
       r.sendReceiveSeconds += send;

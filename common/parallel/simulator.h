@@ -47,20 +47,17 @@ const std::vector<NetworkModel>& networks();
 const NetworkModel& networkByName(std::string_view name);
 std::string describeNetworks();
 
-// Message handlers of one PE in one stage, as recorded (the spans with task == kMessageSpan):
-// their summed seconds, the messages they handled, and the data messages they sent.
-struct HandlerLoad {
+// Work of one PE in one stage besides its tasks, as recorded: its message handlers (the spans
+// with task == kMessageSpan) or its set-up (task == kSetupSpan, Runtime::runStage with a
+// SetupFn): their summed seconds, how many spans (messages handled; one set-up), and the data
+// messages they sent.
+struct PeLoad {
   double seconds = 0.0;
-  std::uint64_t handled = 0;
+  std::uint64_t spans = 0;
   std::uint64_t messagesSent = 0, bytesSent = 0;
 };
-
-// The set-up of one PE at the start of one stage, as recorded (the span with task ==
-// kSetupSpan, Runtime::runStage with a SetupFn): its seconds and the data messages it sent.
-struct SetupLoad {
-  double seconds = 0.0;
-  std::uint64_t messagesSent = 0, bytesSent = 0;
-};
+using HandlerLoad = PeLoad;
+using SetupLoad = PeLoad;
 
 // One stage's work. tasks is what the scheduler sees (estimates, positions); costs are the
 // seconds each task really takes; messages/bytes the data messages each task sends (empty:

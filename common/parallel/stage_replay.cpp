@@ -1,5 +1,5 @@
-// The replay rules of stage_replay.h: for each recorded stage, the strategy, tasks, owners and
-// handler work the simulator runs at P'. Pure functions of the recorded stage and P'.
+// The replay rules of stage_replay.h: for each recorded stage, the strategy, tasks, owners,
+// handler work and set-ups the simulator runs at P'. Pure functions of the recorded stage and P'.
 #include "common/parallel/stage_replay.h"
 
 #include <algorithm>
@@ -32,38 +32,22 @@ std::uint64_t evenShare(std::uint64_t n, int parts, int i) {
   return n / parts + (static_cast<std::uint64_t>(i) < n % parts ? 1 : 0);
 }
 
-// The recorded handler work at P': per PE as recorded at the recorded P, else the total split
-// evenly over the P' PEs.
-std::vector<HandlerLoad> handlersAt(const std::vector<HandlerLoad>& recorded, int recordedPes, int pes) {
-  std::vector<HandlerLoad> out(static_cast<std::size_t>(pes));
+// Recorded per-PE work besides the tasks (handlers, set-ups) at P': per PE as recorded at the
+// recorded P, else the total split evenly over the P' PEs.
+std::vector<PeLoad> perPeAt(const std::vector<PeLoad>& recorded, int recordedPes, int pes) {
+  std::vector<PeLoad> out(static_cast<std::size_t>(pes));
   if (recorded.empty()) return out;
   if (static_cast<int>(recorded.size()) == pes && recordedPes == pes) return recorded;
-  HandlerLoad total;
-  for (const HandlerLoad& h : recorded) {
+  PeLoad total;
+  for (const PeLoad& h : recorded) {
     total.seconds += h.seconds;
-    total.handled += h.handled;
+    total.spans += h.spans;
     total.messagesSent += h.messagesSent;
     total.bytesSent += h.bytesSent;
   }
   for (int p = 0; p < pes; ++p)
-    out[p] = {total.seconds / pes, evenShare(total.handled, pes, p), evenShare(total.messagesSent, pes, p),
+    out[p] = {total.seconds / pes, evenShare(total.spans, pes, p), evenShare(total.messagesSent, pes, p),
               evenShare(total.bytesSent, pes, p)};
-  return out;
-}
-
-// The recorded set-ups at P', by the same rule as the handlers.
-std::vector<SetupLoad> setupsAt(const std::vector<SetupLoad>& recorded, int recordedPes, int pes) {
-  std::vector<SetupLoad> out(static_cast<std::size_t>(pes));
-  if (recorded.empty()) return out;
-  if (static_cast<int>(recorded.size()) == pes && recordedPes == pes) return recorded;
-  SetupLoad total;
-  for (const SetupLoad& s : recorded) {
-    total.seconds += s.seconds;
-    total.messagesSent += s.messagesSent;
-    total.bytesSent += s.bytesSent;
-  }
-  for (int p = 0; p < pes; ++p)
-    out[p] = {total.seconds / pes, evenShare(total.messagesSent, pes, p), evenShare(total.bytesSent, pes, p)};
   return out;
 }
 
@@ -94,8 +78,8 @@ namespace {
 StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::string_view schedule) {
   StageReplay r;
   r.stage = stage;
-  r.handlers = handlersAt(stage.handlers, recordedPes, pes);
-  r.setups = setupsAt(stage.setups, recordedPes, pes);
+  r.handlers = perPeAt(stage.handlers, recordedPes, pes);
+  r.setups = perPeAt(stage.setups, recordedPes, pes);
   const bool pinned = stage.schedule == kOwnerPinnedSchedule;
   if (!pinned) {
     r.rule = ReplayRule::Scheduled;
@@ -190,7 +174,7 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
   if (!stage.setups.empty() && r.rule != ReplayRule::Excluded) {
     double total = 0.0;
     for (const SetupLoad& load : stage.setups) total += load.seconds;
-    r.note += pes == recordedPes ? "; set-ups as recorded"
+    r.note += pes == recordedPes && static_cast<int>(stage.setups.size()) == pes ? "; set-ups as recorded"
                                  : "; set-ups: " + seconds(total) + " split evenly over " + std::to_string(pes) +
                                        " PEs (assumes the data divides evenly)";
   }
@@ -200,14 +184,11 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
   std::uint64_t dropped = 0;
   for (std::uint32_t& m : r.stage.messages) dropped += std::exchange(m, 0u);
   for (std::uint64_t& b : r.stage.bytes) b = 0;
-  for (HandlerLoad& h : r.handlers) {
-    dropped += std::exchange(h.messagesSent, 0u);
-    h.bytesSent = 0;
-  }
-  for (SetupLoad& s : r.setups) {
-    dropped += std::exchange(s.messagesSent, 0u);
-    s.bytesSent = 0;
-  }
+  for (std::vector<PeLoad>* loads : {&r.handlers, &r.setups})
+    for (PeLoad& load : *loads) {
+      dropped += std::exchange(load.messagesSent, 0u);
+      load.bytesSent = 0;
+    }
   if (dropped > 0) r.note += "; its " + std::to_string(dropped) + " data messages are to itself on one PE, not charged";
   return r;
 }

@@ -1,6 +1,6 @@
 // StageReplay: how the simulator (simulator.cpp) replays one recorded stage at P' PEs — which
 // strategy hands out its tasks, which tasks there are and on which PE they are pinned, and how
-// much message-handler work each PE does — or why it cannot say, so the stage is left out of
+// much message-handler and set-up work each PE does — or why it cannot say, so the stage is left out of
 // the prediction. The rules for owner-pinned stages (Runtime::runPinned, runOnEachPe) say how
 // the method would split its data at P', from what the record holds:
 //

@@ -1,16 +1,17 @@
 // Termination detection for message-driven phases (work that creates messages that create
-// work: rays, photons). One counter of outstanding work: the stage's tasks not yet finished
-// plus messages sent to a handled Channel and not yet handled. The runtime ends the phase when
+// work: rays, photons). One counter of outstanding work: the stage's tasks and PE set-ups not
+// yet finished plus messages sent to a handled Channel and not yet handled. The runtime ends the phase when
 // it reaches zero.
 //
 // Why this is correct under any interleaving:
-//  - a task is counted from the start of the stage; a message is counted by its sender
+//  - a task or set-up is counted from the start of the stage; a message is counted by its sender
 //    *before* it is enqueued (add happens-before the receiver can pop it);
-//  - the count is decremented only *after* the task or handler has returned, i.e. after every
-//    message it sent has already been added;
-//  - so at every instant count >= (queued messages + running tasks and handlers + tasks not yet
-//    started), each term >= 0. count == 0 therefore means no work exists anywhere, and since
-//    only tasks and handlers create messages, none can appear later: zero is final (stable).
+//  - the count is decremented only *after* the task, set-up or handler has returned, i.e. after
+//    every message it sent has already been added;
+//  - so at every instant count >= (queued messages + running tasks, set-ups and handlers +
+//    tasks and set-ups not yet started), each term >= 0. count == 0 therefore means no work
+//    exists anywhere, and since only tasks, set-ups and handlers create messages, none can
+//    appear later: zero is final (stable).
 //  - the decrement that reaches zero is acq_rel, so the PE that observes it also observes
 //    every effect of the work counted before it.
 #pragma once

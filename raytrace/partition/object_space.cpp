@@ -46,8 +46,9 @@ constexpr int kMaxVoxels = 4096;  // VoxelSplit's limit
 int voxelCount(int voxelsPerPe, int pes) { return pes * std::max(1, std::min(voxelsPerPe, kMaxVoxels / pes)); }
 
 // An owner's BVH build per triangle, in the time of one camera path sample's tracing: 0.27-0.28
-// on both the hot-spot scene and the landscape in bench_partitioned at P = 1 (build stage per
-// triangle over trace stage per sample, path tracer).
+// on both the hot-spot scene and the landscape in bench_partitioned at P = 1 (build per
+// triangle over tracing per sample, path tracer; measured when the build was a stage of its
+// own, before it became the trace stage's set-up).
 constexpr float kBuildSamplesPerTriangle = 0.28f;
 
 // The kd split of the job's scene into `voxels` voxels of about equal work where the camera

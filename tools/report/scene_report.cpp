@@ -301,7 +301,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     const nlohmann::json peAxis = {{"field", "pe"}, {"type", "ordinal"}, {"title", "PE"}};
     html += "<h3>Per-PE time and timeline: " + escape(chosen->what.label()) + "</h3><p>Busy, communicating (inside "
             "channel calls or waiting on an empty mailbox), waiting at the end-of-stage synchronisation and otherwise idle, "
-            "per PE; then every task and message handler on its PE. The run's record: " +
+            "per PE; then every task, message handler and set-up on its PE. The run's record: " +
             link(relDir + "/timeline_metrics.json", "timeline_metrics.json") +
             "; its Chrome trace (Perfetto, chrome://tracing): " + link(relDir + "/timeline.trace.json", "timeline.trace.json") +
             ".</p>\n";

@@ -154,58 +154,86 @@ TEST_CASE("Runtime: a PE blocked on an empty mailbox books message waiting, not 
 }
 
 TEST_CASE("Runtime: a stage's set-up runs once on each PE before its tasks and handlers there, without a barrier") {
-  // PE 1's set-up takes 100 ms, PE 0's none; every task sends the other PE a message, so PE 1
-  // gets messages while it still sets up. Nothing may run on a PE before its set-up is done.
+  // PE 1's set-up lasts until PE 0 has run all 8 tasks (and at least 100 ms); every task sends
+  // PE 1 a message, which waits until PE 1 is set up. Nothing may run on a PE before its set-up.
   Runtime rt(2, "demand");
   std::atomic<bool> ready[2] = {false, false};
-  std::atomic<int> setups{0}, early{0}, handled{0};
+  std::atomic<int> setups{0}, early{0}, handled{0}, tasksRun{0};
   Channel<int> ch(rt, "m", MessageKind::Data, [&](Pe& pe, int&&) {
     if (!ready[pe.id()]) early++;
     handled++;
   });
-  rt.runStage(
-      "s", TaskSet::uniform(8),
-      [&](Pe& pe) {
-        if (pe.id() == 1) std::this_thread::sleep_for(std::chrono::milliseconds(100));
-        ready[pe.id()] = true;
-        setups++;
+  pr::test::runWithTimeout(
+      [&] {
+        rt.runStage(
+            "s", TaskSet::uniform(8),
+            [&](Pe& pe) {
+              if (pe.id() == 1) {
+                const auto start = std::chrono::steady_clock::now();
+                while (tasksRun < 8 || std::chrono::steady_clock::now() - start < std::chrono::milliseconds(100))
+                  std::this_thread::sleep_for(std::chrono::milliseconds(1));
+              }
+              ready[pe.id()] = true;
+              setups++;
+            },
+            [&](Pe& pe, TaskId) {
+              if (!ready[pe.id()]) early++;
+              ch.send(pe, 1, 0);
+              tasksRun++;
+            });
       },
-      [&](Pe& pe, TaskId) {
-        if (!ready[pe.id()]) early++;
-        ch.send(pe, 1 - pe.id(), 0);
-      });
+      30.0, "a stage with a set-up");
   CHECK(setups == 2);
   CHECK(early == 0);
   CHECK(handled == 8);
   const RunRecord& r = rt.record();
-  double setupEnd[2] = {0.0, 0.0}, firstTask[2] = {1e30, 1e30};
   int setupSpans = 0;
-  for (const TaskSpan& span : r.timeline) {
-    if (span.task == kSetupSpan) {
-      ++setupSpans;
-      setupEnd[span.pe] = span.end;
-    } else if (span.task >= 0) {
-      firstTask[span.pe] = std::min(firstTask[span.pe], span.start);
-    }
-  }
+  for (const TaskSpan& span : r.timeline) setupSpans += span.task == kSetupSpan ? 1 : 0;
   CHECK(setupSpans == 2);
-  CHECK(r.stages[0].pes[0].tasks + r.stages[0].pes[1].tasks == 8);
-  // PE 0 took tasks while PE 1 was still setting up; the set-up counts as PE 1's busy time.
-  CHECK(firstTask[0] < setupEnd[1]);
-  CHECK(r.stages[0].pes[1].busySeconds >= 0.09);
+  // PE 0 ran every task while PE 1 was still setting up; the set-up is PE 1's busy time.
+  CHECK(r.stages[0].pes[0].tasks == 8);
   CHECK(r.stages[0].pes[1].tasks == 0);
+  CHECK(r.stages[0].pes[1].messagesHandled == 8);
+  CHECK(r.stages[0].pes[1].busySeconds >= 0.09);
+}
+
+TEST_CASE("Runtime: a message a set-up sends after the other PEs are done is still handled") {
+  // No tasks at all: PE 0 is done at once, PE 1's set-up then sends it a message. The stage
+  // must not end before PE 0 has handled it, nor hang.
+  Runtime rt(2, "demand");
+  std::atomic<int> handled{0};
+  Channel<int> ch(rt, "late", MessageKind::Data, [&](Pe& pe, int&&) {
+    CHECK(pe.id() == 0);
+    handled++;
+  });
+  pr::test::runWithTimeout(
+      [&] {
+        rt.runStage(
+            "s", TaskSet::uniform(0),
+            [&](Pe& pe) {
+              if (pe.id() != 1) return;
+              std::this_thread::sleep_for(std::chrono::milliseconds(30));
+              ch.send(pe, 0, 1);
+            },
+            [](Pe&, TaskId) {});
+      },
+      30.0, "a set-up that sends");
+  CHECK(handled == 1);
+  CHECK(rt.record().stages[0].pes[0].messagesHandled == 1);
 }
 
 TEST_CASE("Runtime: an exception in a set-up ends the stage and names the set-up") {
   Runtime rt(2, "demand");
-  std::atomic<int> ran{0};
   CHECK_THROWS_WITH_AS(rt.runStage(
                            "s", TaskSet::uniform(4),
                            [](Pe& pe) {
                              if (pe.id() == 1) throw std::runtime_error("no memory for the BVH");
                            },
-                           [&](Pe&, TaskId) { ran++; }),
+                           [](Pe&, TaskId) {}),
                        "no memory for the BVH", std::runtime_error);
-  CHECK(rt.record().error == "stage 's', PE 1, set-up: no memory for the BVH");
-  CHECK(ran <= 4);
+  const RunRecord& r = rt.record();
+  CHECK(r.error == "stage 's', PE 1, set-up: no memory for the BVH");
+  // The failed PE ran no task and its set-up left no span.
+  CHECK(r.stages[0].pes[1].tasks == 0);
+  for (const TaskSpan& span : r.timeline) CHECK(!(span.pe == 1 && span.task == kSetupSpan));
 }

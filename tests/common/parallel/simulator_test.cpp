@@ -100,7 +100,7 @@ TEST_CASE("Simulator: message-handler time is charged on its PE with its sends")
   const Workload w = workloadFromRecord(handlerRecord(), "hand-made");
   REQUIRE(w.stages[0].handlers.size() == 2);
   CHECK(w.stages[0].handlers[0].seconds == doctest::Approx(2.0));
-  CHECK(w.stages[0].handlers[0].handled == 1);
+  CHECK(w.stages[0].handlers[0].spans == 1);
   CHECK(w.stages[0].handlers[0].bytesSent == 1000);
   CHECK(w.stages[0].handlers[1].seconds == 0.0);
   SimOptions options;
@@ -148,6 +148,7 @@ TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at
   REQUIRE(w.stages[0].setups.size() == 2);
   CHECK(w.stages[0].setups[1].seconds == doctest::Approx(3.0));
   CHECK(w.stages[0].setups[1].bytesSent == 1000);
+  CHECK(w.stages[0].setups[1].spans == 1);
   SimOptions options;
   options.pes = 2;
   options.network = networkByName("zero");

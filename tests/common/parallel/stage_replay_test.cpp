@@ -160,12 +160,12 @@ TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split
   s.schedule = "demand";
   const StageReplay same = planReplay(s, 2, 2, "");
   CHECK(same.handlers[0].seconds == 3.0);
-  CHECK(same.handlers[1].handled == 2);
+  CHECK(same.handlers[1].spans == 2);
   const StageReplay four = planReplay(s, 2, 4, "");
   REQUIRE(four.handlers.size() == 4);
   for (const HandlerLoad& h : four.handlers) {
     CHECK(h.seconds == doctest::Approx(1.0));
-    CHECK(h.handled == 2);
+    CHECK(h.spans == 2);
     CHECK(h.messagesSent == 1);
     CHECK(h.bytesSent == 100);
   }
@@ -174,7 +174,7 @@ TEST_CASE("StageReplay: handler work stays per PE at the recorded P and is split
 
 TEST_CASE("StageReplay: set-ups stay per PE at the recorded P and are split evenly at another") {
   SimStage s;
-  s.setups = {{3.0, 4, 400}, {1.0, 0, 0}};
+  s.setups = {{3.0, 1, 4, 400}, {1.0, 1, 0, 0}};
   s.schedule = "demand";
   const StageReplay same = planReplay(s, 2, 2, "");
   REQUIRE(same.setups.size() == 2);
