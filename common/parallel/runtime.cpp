@@ -223,48 +223,41 @@ void Runtime::confirmWait(PeCounters& c) {
   c.pendingWaitSeconds = 0.0;
 }
 
+// Runs work() as one timed piece of the PE's work (a task, a message handler or its set-up):
+// busy time less any wait for a reply inside it, and a span with the data messages it sent.
+// work returns false when it did nothing (no message after all): nothing is booked then.
+// Returns the piece's seconds, or nothing when it did nothing.
+template <class Work>
+std::optional<double> Runtime::timed(Pe& pe, TaskId task, std::vector<TaskSpan>& spans, Work&& work) {
+  PeCounters& c = pe.counters();
+  const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
+  const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
+  const double t0 = now();
+  confirmWait(c);
+  const double w0 = c.inTaskWaitSeconds;
+  if (!work()) return std::nullopt;
+  const double t1 = now();
+  c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
+  c.lastWorkEnd = t1;
+  if (options_.recordTimeline)
+    spans.push_back({pe.id(), pe.stage(), task, t0, t1,
+                     static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
+                     c.bytesSent.load(std::memory_order_relaxed) - b0});
+  return t1 - t0;
+}
+
 // Handles every message waiting for pe in the handled channels; true when it handled any.
 bool Runtime::handleMessages(Pe& pe, std::vector<TaskSpan>& spans) {
   bool any = false;
-  PeCounters& c = pe.counters();
   for (ChannelBase* channel : channels_) {
     while (channel->pending(pe.id()) && !abort_.load(std::memory_order_relaxed)) {
-      const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
-      const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
-      const double t0 = now();
-      confirmWait(c);
-      const double w0 = c.inTaskWaitSeconds;
-      if (!channel->handleOne(pe)) break;
-      const double t1 = now();
-      c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
-      c.lastWorkEnd = t1;
-      c.messagesHandled.fetch_add(1, std::memory_order_relaxed);
-      if (options_.recordTimeline)
-        spans.push_back({pe.id(), pe.stage(), kMessageSpan, t0, t1,
-                         static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
-                         c.bytesSent.load(std::memory_order_relaxed) - b0});
+      if (!timed(pe, kMessageSpan, spans, [&] { return channel->handleOne(pe); })) break;
+      pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
       any = true;
       if (outstanding_.done()) ringAll();
     }
   }
   return any;
-}
-
-// The PE's set-up, timed like a task. Messages that arrive meanwhile wait in their channels.
-void Runtime::runSetup(Pe& pe, const SetupFn& setup, std::vector<TaskSpan>& spans) {
-  PeCounters& c = pe.counters();
-  const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
-  const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
-  const double t0 = now();
-  const double w0 = c.inTaskWaitSeconds;
-  setup(pe);
-  const double t1 = now();
-  c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
-  c.lastWorkEnd = t1;
-  if (options_.recordTimeline)
-    spans.push_back({pe.id(), pe.stage(), kSetupSpan, t0, t1,
-                     static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
-                     c.bytesSent.load(std::memory_order_relaxed) - b0});
 }
 
 // The loop of one PE for one stage: its set-up if the stage has one; then messages first (they
@@ -283,7 +276,11 @@ void Runtime::peLoop(int p, const StageJob& job) {
   TaskId current = kSetupSpan;
   try {
     if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) {
-      runSetup(pe, *job.setup, spans);
+      // Messages that arrive meanwhile wait in their channels.
+      timed(pe, kSetupSpan, spans, [&] {
+        (*job.setup)(pe);
+        return true;
+      });
       if (outstanding_.done()) ringAll();
     }
     while (!abort_.load(std::memory_order_acquire)) {
@@ -304,21 +301,12 @@ void Runtime::peLoop(int p, const StageJob& job) {
         for (TaskId id : grab.tasks) {
           if (abort_.load(std::memory_order_relaxed)) break;
           current = id;
-          const std::uint64_t m0 = c.messagesSent.load(std::memory_order_relaxed);
-          const std::uint64_t b0 = c.bytesSent.load(std::memory_order_relaxed);
-          const double t0 = now();
-          confirmWait(c);
-          const double w0 = c.inTaskWaitSeconds;
-          work(pe, id);
-          const double t1 = now();
-          c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
-          c.lastWorkEnd = t1;
+          const double seconds = *timed(pe, id, spans, [&] {
+            work(pe, id);
+            return true;
+          });
           c.tasks.fetch_add(1, std::memory_order_relaxed);
-          if (options_.recordTimeline)
-            spans.push_back({p, stage, id, t0, t1,
-                             static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
-                             c.bytesSent.load(std::memory_order_relaxed) - b0});
-          scheduler.finished(p, id, t1 - t0);
+          scheduler.finished(p, id, seconds);
           if (outstanding_.done()) ringAll();
           current = kMessageSpan;
           handleMessages(pe, spans);

@@ -39,6 +39,7 @@
 #include <functional>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -178,7 +179,8 @@ class Runtime {
   void startWorkers();
   void workerMain(int p);
   void peLoop(int p, const StageJob& job);
-  void runSetup(Pe& pe, const SetupFn& setup, std::vector<TaskSpan>& spans);
+  template <class Work>
+  std::optional<double> timed(Pe& pe, TaskId task, std::vector<TaskSpan>& spans, Work&& work);
   bool handleMessages(Pe& pe, std::vector<TaskSpan>& spans);
   void waitForWork(int p);
   static void confirmWait(PeCounters& c);

@@ -76,22 +76,29 @@ TEST_CASE("Simulator: data messages a task sent are charged to the sender") {
 
 namespace {
 
-// A hand-made record of P = 2 under "balanced": one stage, tasks 0 and 1 of 1 s on PEs 0 and 1,
-// and PE 0 handling one message for 2 s, its handler sending one 1000-byte message on.
-RunRecord handlerRecord() {
+// A hand-made record of P = 2: one stage "trace" of `tasks` uniform tasks under `schedule`,
+// with the given spans, lasting `wall` seconds.
+RunRecord handMadeRecord(const std::string& schedule, std::size_t tasks, std::vector<TaskSpan> timeline, double wall) {
   RunRecord r;
   r.pes = 2;
-  r.schedule = "balanced";
+  r.schedule = schedule;
   StageRecord s;
   s.name = "trace";
-  s.schedule = "balanced";
-  s.tasks = TaskSet::uniform(2).tasks;
+  s.schedule = schedule;
+  s.tasks = TaskSet::uniform(tasks).tasks;
   s.pes.resize(2);
-  s.wallSeconds = 3.0;
+  s.wallSeconds = wall;
   r.stages.push_back(s);
-  r.timeline = {{0, 0, 0, 0.0, 1.0}, {1, 0, 1, 0.0, 1.0}, {0, 0, kMessageSpan, 1.0, 3.0, 1, 1000}};
-  r.wallSeconds = 3.0;
+  r.timeline = std::move(timeline);
+  r.wallSeconds = wall;
   return r;
+}
+
+// Under "balanced": tasks 0 and 1 of 1 s on PEs 0 and 1, and PE 0 handling one message for 2 s,
+// its handler sending one 1000-byte message on.
+RunRecord handlerRecord() {
+  return handMadeRecord("balanced", 2, {{0, 0, 0, 0.0, 1.0}, {1, 0, 1, 0.0, 1.0}, {0, 0, kMessageSpan, 1.0, 3.0, 1, 1000}},
+                        3.0);
 }
 
 }  // namespace
@@ -131,19 +138,14 @@ TEST_CASE("Simulator: message-handler time is charged on its PE with its sends")
 TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at the recorded P, evenly at another") {
   // Recorded at P = 2 under demand: PE 0 set up for 1 s, PE 1 for 3 s (sending one 1000-byte
   // message), then four tasks of 1 s.
-  RunRecord rec;
-  rec.pes = 2;
-  rec.schedule = "demand";
-  StageRecord s;
-  s.name = "trace";
-  s.schedule = "demand";
-  s.tasks = TaskSet::uniform(4).tasks;
-  s.pes.resize(2);
-  s.wallSeconds = 4.0;
-  rec.stages.push_back(s);
-  rec.timeline = {{0, 0, kSetupSpan, 0.0, 1.0},       {1, 0, kSetupSpan, 0.0, 3.0, 1, 1000}, {0, 0, 0, 1.0, 2.0},
-                  {0, 0, 1, 2.0, 3.0},                {0, 0, 2, 3.0, 4.0},                   {1, 0, 3, 3.0, 4.0}};
-  rec.wallSeconds = 4.0;
+  const RunRecord rec = handMadeRecord("demand", 4,
+                                       {{0, 0, kSetupSpan, 0.0, 1.0},
+                                        {1, 0, kSetupSpan, 0.0, 3.0, 1, 1000},
+                                        {0, 0, 0, 1.0, 2.0},
+                                        {0, 0, 1, 2.0, 3.0},
+                                        {0, 0, 2, 3.0, 4.0},
+                                        {1, 0, 3, 3.0, 4.0}},
+                                       4.0);
   const Workload w = workloadFromRecord(rec, "hand-made");
   REQUIRE(w.stages[0].setups.size() == 2);
   CHECK(w.stages[0].setups[1].seconds == doctest::Approx(3.0));

@@ -225,7 +225,7 @@ TEST_CASE("ObjectSpace: each PE holds only its voxels' geometry") {
   CHECK(run.figures.raysSent > 0);
 }
 
-TEST_CASE("ObjectSpace: each owner builds its BVH as the trace stage's set-up, before it traces anything") {
+TEST_CASE("ObjectSpace: each owner builds its BVH as the trace stage's set-up") {
   const scene::Scene s = scene::loadGltf(test::bundledScene("hotspot.gltf"));
   const scene::Camera cam = scene::selectCamera(s, "", 1.0f);
   rt::ObjectSpacePartition partition;
@@ -233,10 +233,7 @@ TEST_CASE("ObjectSpace: each owner builds its BVH as the trace stage's set-up, b
       test::renderPartitioned(partition, s, cam, 16, 16, test::partitionedOptions(rt::IntegratorKind::Path, 1), 3);
   CHECK(std::none_of(run.record.stages.begin(), run.record.stages.end(),
                      [](const par::StageRecord& st) { return st.name == "build"; }));
-  int trace = -1;
-  for (size_t i = 0; i < run.record.stages.size(); ++i)
-    if (run.record.stages[i].name == "trace") trace = int(i);
-  REQUIRE(trace >= 0);
+  const int trace = int(&test::traceStage(run.record) - run.record.stages.data());
   // Per PE: one set-up span in the trace stage, where it built its BVH over what it holds.
   for (int p = 0; p < 3; ++p) {
     CAPTURE(p);
