@@ -40,7 +40,7 @@ glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, con
 
 glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, const PrecomputedIrradiance* precomputed,
                             const rt::SurfaceInteraction& si, const DensityOptions& density, NearestPhotons& scratch) {
-  const glm::vec3 diffuse = (1.0f - m.dielectricWeight()) * m.diffuseColor();
+  const glm::vec3 diffuse = m.diffuseColor();
   if (!(rt::maxComponent(diffuse) > 0.0f)) return glm::vec3(0.0f);
   const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
   if (precomputed && !precomputed->empty())
@@ -68,10 +68,11 @@ bool gatherRay(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, Gat
 }
 
 GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& global, const rt::SurfaceInteraction& si,
-                                    const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
+                                    const rt::Ray& ray, glm::vec3 throughput, std::uint32_t id, std::uint32_t j, int bounce,
                                     const GatherOptions& options, NearestPhotons& scratch) {
   GatherInteraction out;
   rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
+  throughput *= rt::volumeTransmittance(m, si, ray);
   out.radiance = throughput * globalMapRadiance(m, global, options.precomputed, si, options.global, scratch);
   if (bounce >= options.specularBounces) return out;
   const rt::ShadingFrame sf(si, m);
@@ -97,13 +98,13 @@ bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteract
       factor = glm::vec3(1.0f);
     } else {
       wi = wt;
-      factor = m.baseColor;
+      factor = m.transmissionTint(si.frontFace);
     }
     return true;
   }
   if (!m.hasSpecular() || !m.deltaSpecular()) return false;
   wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));
-  factor = m.specularFresnel(sf.woLocal.z);
+  factor = m.specularFresnel(sf.woLocal.z) / m.opaqueProbability();
   return glm::dot(wi, sf.ng) > 0.0f;
 }
 
@@ -186,7 +187,7 @@ IrradianceRecord gatherIrradiance(const scene::Scene& scene, const rt::Bvh& bvh,
       if (!bvh.intersect(ray, hit)) break;
       const rt::SurfaceInteraction h = rt::makeInteraction(scene, ray, hit);
       if (bounce == 0) cell.distance = hit.t * glm::length(ray.direction);
-      const GatherInteraction step = gatherInteraction(scene, global, h, throughput, id, std::uint32_t(j), bounce, options, scratch);
+      const GatherInteraction step = gatherInteraction(scene, global, h, ray, throughput, id, std::uint32_t(j), bounce, options, scratch);
       cell.radiance += step.radiance;
       if (!step.continues) break;
       ray = step.next;

@@ -38,7 +38,7 @@ struct GatherOptions {
 };
 
 // The radiance the global map estimates leaving a hit si towards si.wo: the Lambertian part
-// (opaque weight x diffuse colour / pi) times the irradiance of the nearest photons, or of the
+// (diffuse colour / pi) times the irradiance of the nearest photons, or of the
 // nearest precomputed point when `precomputed` is given and not empty. Emission is not
 // included (direct light is sampled at the gathering point).
 glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
@@ -50,9 +50,10 @@ glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, 
 
 // How a gathering (or glossy) path goes on through an ideal specular surface at si to the
 // diffuse surface behind it, with u in [0, 1): a dielectric's reflection or refraction chosen
-// by its Fresnel term (which cancels the choice's weight), else an opaque mirror's reflection
-// (its selection probability 1 - dielectric cancels its weight). wi and the factor that
-// multiplies the path's throughput; false when there is no ideal specular part to follow.
+// by its Fresnel term (which cancels the choice's weight; a refraction is tinted as eye paths
+// tint it), else an opaque mirror's reflection, its Fresnel weight over its selection
+// probability 1 - dielectric. wi and the factor that multiplies the path's throughput; false
+// when there is no ideal specular part to follow.
 bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf,
                          float u, glm::vec3& wi, glm::vec3& factor);
 
@@ -68,8 +69,9 @@ GatherStrata gatherStrata(int rays);
 bool gatherRay(const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, GatherStrata strata, std::uint32_t id,
                std::uint32_t j, const GatherOptions& options, rt::Ray& ray);
 
-// One hit of a gather ray (its bounce-th, through ideal mirrors and glass): the global map's
-// radiance there times the ray's throughput, and the ray it goes on as, if any.
+// One hit of a gather ray (its bounce-th, through ideal mirrors and glass) that arrived along
+// ray: the global map's radiance there times the ray's throughput (attenuated by Beer-Lambert
+// when the ray ran inside an absorbing solid, as eye paths are), and the ray it goes on as.
 struct GatherInteraction {
   glm::vec3 radiance{0.0f};
   bool continues = false;
@@ -77,7 +79,7 @@ struct GatherInteraction {
   glm::vec3 throughput{0.0f};
 };
 GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& global, const rt::SurfaceInteraction& si,
-                                    const glm::vec3& throughput, std::uint32_t id, std::uint32_t j, int bounce,
+                                    const rt::Ray& ray, glm::vec3 throughput, std::uint32_t id, std::uint32_t j, int bounce,
                                     const GatherOptions& options, NearestPhotons& scratch);
 
 // What a record's ray j brought back: its radiance (summed over its hits in bounce order) and

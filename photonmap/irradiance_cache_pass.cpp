@@ -78,7 +78,7 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
     const scene::Scene& scene = context().scene();
     const float travelled = msg.bsdfPdf + si.t * glm::length(msg.ray.direction);
     rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures_);
-    if (rt::maxComponent((1.0f - m.dielectricWeight()) * m.diffuseColor()) > 0.0f) {
+    if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
       perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, si, travelled});
       return;
     }
@@ -151,7 +151,7 @@ class GatherProgram final : public rt::IntegratorBase<GatherProgram> {
     thread_local NearestPhotons scratch;
     const std::uint32_t id = records_[msg.pixel]->pixel;
     const GatherInteraction step =
-        gatherInteraction(context().scene(), global_, si, msg.throughput, id, msg.sample, msg.depth, options_, scratch);
+        gatherInteraction(context().scene(), global_, si, msg.ray, msg.throughput, id, msg.sample, msg.depth, options_, scratch);
     const float distance = msg.depth == 0 ? si.t * glm::length(msg.ray.direction) : std::nanf("");
     perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, msg.sample, msg.depth, step.radiance, distance});
     if (!step.continues) return;

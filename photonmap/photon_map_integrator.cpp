@@ -228,7 +228,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   // The diffuse part: caustics from the caustic map, indirect light from the cache, both
   // smooth over many pixels, so read by a stratified subset of the pixel's samples only.
   const float smooth = smoothWeight(msg.sample);
-  const glm::vec3 diffuse = opaque * m.diffuseColor() * smooth;
+  const glm::vec3 diffuse = m.diffuseColor() * smooth;
   if (rt::maxComponent(diffuse) > 0.0f) {
     if (!ctx.simulates(scene::Effect::Caustics))
       ++out.stats().causticRaysSkipped;
@@ -255,14 +255,16 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   }
 
   // The opaque specular lobe: one ideal mirror ray, or Monte Carlo glossy rays (more the
-  // rougher the lobe, one below the first hit), whose hits read the global map.
+  // rougher the lobe and the larger its share of the reflectance - a dielectric's 4 % layer
+  // over a diffuse base gets one - and one below the first hit), whose hits read the global map.
   if (opaque > 0.0f && m.hasSpecular()) {
     if (m.deltaSpecular()) {
       if (glm::dot(mirror(), sf.ng) > 0.0f)
         spawn(scene::Effect::IdealSpecular, &rt::TraceStats::specularRaysSkipped,
-              ctx.continuation(si, msg, mirror(), msg.throughput * m.specularFresnel(sf.woLocal.z) * opaque, 0.0f));
+              ctx.continuation(si, msg, mirror(), msg.throughput * m.specularFresnel(sf.woLocal.z), 0.0f));
     } else {
-      const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
+      const float share = rt::specularProbability(m, sf.woLocal.z);
+      const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness * share))) : 1;
       for (int i = 0; i < n; ++i) {
         const float u = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)), v = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u);
         const rt::BsdfSample s = ward ? sampleWard(lobe, sf.woLocal, u, v) : rt::sampleGlossy(m, sf.woLocal, u, v);
@@ -271,7 +273,7 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
         if (glm::dot(wi, sf.ng) <= 0.0f) continue;
         // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
         spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,
-              ctx.continuation(si, msg, wi, msg.throughput * s.weight * (opaque / float(n)), std::max(s.pdf, 1.0e-30f)), n);
+              ctx.continuation(si, msg, wi, msg.throughput * s.weight / float(n), std::max(s.pdf, 1.0e-30f)), n);
       }
     }
   }

@@ -98,7 +98,7 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
     PrecomputedIrradiance irradiance;
     IrradianceCache cache;
   };
-  // The map's Lambertian radiance at si: opaque weight x diffuse colour / pi x E.
+  // The map's Lambertian radiance at si: diffuse colour / pi x E.
   glm::vec3 mapRadiance(const KdTree& map, const DensityOptions& density, const rt::SurfaceInteraction& si,
                         const rt::ShadingMaterial& m) const;
 

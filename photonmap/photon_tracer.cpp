@@ -193,13 +193,18 @@ float sampleTowardsTargets(const Setup& s, const glm::vec3& p, float pick, float
   return total / float(std::max(inside, 1));
 }
 
-// Stratified (u, v) of photon j of n: a jittered cell of an m x m grid, m = floor(sqrt(n)).
-glm::vec2 stratified(std::size_t j, std::size_t n, float u, float v) {
+}  // namespace
+
+glm::vec2 stratifiedEmission(std::size_t j, std::size_t n, float u, float v) {
   const std::size_t m = std::max<std::size_t>(1, std::size_t(std::sqrt(double(n))));
-  const std::size_t cell = j % (m * m);
-  return {std::min((float(cell % m) + u) / float(m), rt::kOneMinusEpsilon),
-          std::min((float(cell / m) + v) / float(m), rt::kOneMinusEpsilon)};
+  // The n - m^2 photons past the grid are drawn independently: giving them cells again would
+  // put twice the flux into the first cells.
+  if (j >= m * m) return {u, v};
+  return {std::min((float(j % m) + u) / float(m), rt::kOneMinusEpsilon),
+          std::min((float(j / m) + v) / float(m), rt::kOneMinusEpsilon)};
 }
+
+namespace {
 
 // The origin of a photon travelling along dir from far away (a directional light, the
 // environment): a point on the disc of the scene's bounding sphere perpendicular to dir,
@@ -247,7 +252,7 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
   const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, std::uint32_t(index), map, 0, dim); };
   const std::size_t first = s.firstPhoton[map][e], n = s.firstPhoton[map][e + 1] - first;
   const std::size_t j = index - first;
-  const glm::vec2 dirUv = stratified(j, n, sample(EmitDim::kDirU), sample(EmitDim::kDirV));
+  const glm::vec2 dirUv = stratifiedEmission(j, n, sample(EmitDim::kDirU), sample(EmitDim::kDirV));
   const bool caustic = map == kCausticStream;
   const Emitter& em = s.emitters[e];
   const scene::Scene& scene = *s.scene;
@@ -361,26 +366,24 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   power *= rt::volumeTransmittance(m, si, ray);
   const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 
-  // Storage: the photon's incident flux wherever the surface has a diffuse part.
-  if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
-    const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
-    if (caustic) {
-      if (bounce > 0) {
-        out.stored = true;
-        out.photon = Photon::make(si.position, power, si.wo, PhotonMapKind::Caustic, bounce);
-        out.normal = ng;
-      }
-      return out;  // a caustic path ends at its first diffuse surface
-    }
+  // Storage: the photon's incident flux wherever the surface has a diffuse part, whatever the
+  // photon does next (the estimate weighs it by the diffuse part's BRDF). The caustic map keeps
+  // only the photons that came along L S+: every earlier interaction of a caustic photon was a
+  // specular choice, so any but its first hit (the specular object it was aimed at, or what
+  // stood before it) is one.
+  if (rt::maxComponent(m.diffuseColor()) > 0.0f && (!caustic || bounce > 0)) {
     out.stored = true;
-    out.photon = Photon::make(si.position, power, si.wo, PhotonMapKind::Global, bounce);
-    out.normal = ng;
+    out.photon = Photon::make(si.position, power, si.wo, caustic ? PhotonMapKind::Caustic : PhotonMapKind::Global, bounce);
+    out.normal = si.frontFace ? si.geometricNormal : -si.geometricNormal;
   }
 
-  // Choose the part like the path tracer: the dielectric with probability equal to its
-  // weight, reflection against refraction by the Fresnel term, else the opaque lobes by
+  // Choose the part by Russian roulette over the whole BSDF, like the path tracer: the
+  // dielectric with probability equal to its weight, reflection against refraction by the
+  // Fresnel term, else the opaque lobes (probability 1 - dielectric, divided out) by
   // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
-  // left, f cos / pdf, is the part's albedo along the sampled direction.
+  // left, f cos / pdf, is the part's albedo along the sampled direction. A caustic photon goes
+  // on only through a specular choice (Jensen): one the diffuse or glossy part takes has left
+  // L S+ D, and was stored above if the part is diffuse.
   const rt::ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
@@ -406,7 +409,7 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
     if (!b.valid) return out;
     wi = sf.frame.toWorld(b.wi);
     if (glm::dot(wi, sf.ng) <= 0.0f) return out;  // a reflection leaves on the side it arrived from
-    factor = b.weight;
+    factor = b.weight / opaque;
     specular = b.delta;
   }
   if (caustic && !specular) return out;  // glossy or diffuse: no longer an L S+ D path

@@ -1,7 +1,7 @@
 // Pass 1 of Jensen's two-pass method: photons leave every light, are traced through the scene
-// with Russian roulette, and are stored in the global map (every diffuse hit) and the caustic
-// map (the first diffuse hit after one or more specular bounces, photons aimed at specular
-// objects by a projection map). Batches of photons are tasks on the runtime; each photon's
+// with Russian roulette over each surface's whole BSDF, and are stored in the global map (every
+// hit on a surface with a diffuse part) and the caustic map (every such hit after one or more
+// specular choices, photons aimed at specular objects by a projection map). Batches of photons are tasks on the runtime; each photon's
 // random stream is a function of (seed, map, photon index) only, so the maps are the same for
 // every P and schedule. Seed chapter "Global Illumination in Complex Scenes using Photon
 // Maps", sections 2.1-2.2; Jensen, "Realistic Image Synthesis Using Photon Mapping", ch. 5.
@@ -109,6 +109,11 @@ class PhotonSource {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// The (u, v) that photon j of an emitter's n draws its direction from, given its uniform
+// (u, v): the photons 0 .. m^2 - 1 (m = floor(sqrt(n))) each take one jittered cell of an
+// m x m grid, the rest are uniform, so every cell's expected share is exactly 1/m^2 for any n.
+glm::vec2 stratifiedEmission(std::size_t j, std::size_t n, float u, float v);
 
 // Puts pass 1's figures in the run record: per PE photons emitted and stored by map
 // (perPe rows: global emitted, caustic emitted, global stored, caustic stored), and the

@@ -54,17 +54,12 @@ MaterialTraits traitsOf(const Material& m) {
   // transmission is 1 and metallic 0 everywhere.
   t.opaque = !(transmissionMin >= 1.0f && metallicMax <= 0.0f);
   t.diffuse = t.opaque && base && metallicMin < 1.0f && transmissionMin < 1.0f;
-  // specularF0 = mix(F0 (1 - transmission) [roughness < 1 only], base, metallic) > 0, or F90 > 0.
-  auto specularAt = [&](float roughnessLo) {
-    // KHR_materials_specular 0 (factor without texture) removes the dielectric lobe.
-    const bool dielectricCoat = roughnessLo < 1.0f && transmissionMin < 1.0f && metallicMin < 1.0f &&
-                                m.specularFactor > 0.0f;
-    const bool metal = metallicMax > 0.0f && base;
-    return dielectricCoat || metal;
-  };
-  t.ideal = t.opaque && roughnessMin < kIdealSpecularRoughness && specularAt(roughnessMin);
-  t.glossy = t.opaque && roughnessMax >= kIdealSpecularRoughness &&
-             specularAt(std::max(roughnessMin, kIdealSpecularRoughness));
+  // specularF0 = mix(F0 (1 - transmission), base, metallic) > 0, or F90 > 0: a dielectric layer
+  // unless KHR_materials_specular's factor is 0 (a texture only scales it), or a metal part.
+  const bool dielectricCoat = transmissionMin < 1.0f && metallicMin < 1.0f && m.specularFactor > 0.0f;
+  const bool specular = dielectricCoat || (metallicMax > 0.0f && base);
+  t.ideal = t.opaque && roughnessMin < kIdealSpecularRoughness && specular;
+  t.glossy = t.opaque && roughnessMax >= kIdealSpecularRoughness && specular;
   // The clear coat is a GGX lobe of its own, never narrow enough to be a mirror in the tracers.
   t.glossy = t.glossy || (t.opaque && m.hasClearcoat());
   t.anisotropic = m.anisotropyStrength > 0.0f;
@@ -337,14 +332,19 @@ RenderPlan analyzeEffects(const Scene& scene, const Camera* camera) {
   else
     decide(Effect::Shadows, vis.canSee, vis.canSee ? "occluders possible: " + vis.reason : "nothing can occlude a light: " + vis.reason);
 
-  // Reflection and refraction.
+  // Reflection and refraction. A reflection ray that leaves the scene still sees the
+  // environment where it emits light, so only without one does "no surface can see another"
+  // turn reflection off.
   auto transport = [&](Effect e, bool materials, const std::string& noun, auto pick, const std::string& none) {
     if (!light)
       decide(e, false, noLight);
     else if (!materials)
       decide(e, false, none);
+    else if (!vis.canSee && e != Effect::Transmission && !environment)
+      decide(e, false, what(noun, pick) + ", but no surface can see another (" + vis.reason +
+                           ") and no environment emits: reflection rays leave the scene into darkness");
     else if (!vis.canSee && e != Effect::Transmission)
-      decide(e, false, what(noun, pick) + ", but no surface can see another (" + vis.reason + "): reflection rays leave the scene");
+      decide(e, true, what(noun, pick) + ": reflection rays that leave the scene see the environment");
     else
       decide(e, true, what(noun, pick));
   };

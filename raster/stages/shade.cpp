@@ -108,6 +108,8 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
   ctx.textures = effects.has(scene::Effect::Textures);
   ctx.emission = effects.has(scene::Effect::Emission);
   ctx.direct = effects.has(scene::Effect::DirectLight);
+  ctx.specular = effects.has(scene::Effect::IdealSpecular);
+  ctx.glossy = effects.has(scene::Effect::GlossySpecular);
   ctx.lanes = shadeLanes();
   return ctx;
 }
@@ -208,9 +210,15 @@ glm::vec3 layeredLight(const scene::SurfaceMaterial& r, glm::vec3 V, glm::vec3 L
   return out;
 }
 
+// Which lobes of the environment's light the plan keeps (ShadingContext's switches).
+struct EnvironmentLobes {
+  bool diffuse, reflection, coat;
+};
+
 // Radiance reflected from the environment by image-based lighting: diffuse from the SH
-// irradiance, specular by the split sum, sheen and clear coat layered as under a light.
-glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMaterial& r, glm::vec3 V) {
+// irradiance, specular by the split sum, sheen and clear coat layered as under a light. A lobe
+// the plan turns off adds nothing; the layers still scale what is under them.
+glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMaterial& r, glm::vec3 V, EnvironmentLobes on) {
   const glm::vec3 N = r.normal;
   const float NdotV = std::max(glm::dot(N, V), 1e-4f);
   const glm::vec3 irradiance = ibl.irradiance(N);
@@ -219,12 +227,16 @@ glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMater
   const glm::vec3 F0 = glm::mix(r.dielectricF0(), r.baseColor, r.metallic);
   const float F90 = r.dielectricF90() + (1.0f - r.dielectricF90()) * r.metallic;
   const glm::vec3 R = 2.0f * glm::dot(N, V) * N - V;
-  glm::vec3 out = ((1.0f - r.metallic) / kPi) * r.baseColor * irradiance + ibl.prefiltered(R, roughness) * (F0 * ab.x + F90 * ab.y);
+  const glm::vec3 diffuse = on.diffuse ? ((1.0f - r.metallic) / kPi) * r.baseColor * irradiance : glm::vec3(0.0f);
+  glm::vec3 out = on.reflection ? diffuse + ibl.prefiltered(R, roughness) * (F0 * ab.x + F90 * ab.y) : diffuse;
   if (r.hasSheen()) {
     const float albedo = scene::sheenAlbedo(r.sheenRoughness, NdotV);
-    out = out * (1.0f - maxComponent(r.sheenColor) * albedo) + r.sheenColor * (albedo / kPi) * irradiance;
+    out = out * (1.0f - maxComponent(r.sheenColor) * albedo);
+    if (on.diffuse) out += r.sheenColor * (albedo / kPi) * irradiance;
   }
-  if (r.clearcoat > 0.0f) {
+  if (r.clearcoat > 0.0f && !on.coat) {
+    out = out * (1.0f - r.clearcoat * scene::coatFresnel(std::max(glm::dot(r.clearcoatNormal, V), 1e-4f)));
+  } else if (r.clearcoat > 0.0f) {
     const glm::vec3& C = r.clearcoatNormal;
     const float CdotV = std::max(glm::dot(C, V), 1e-4f);
     const float coatRoughness = std::max(r.clearcoatRoughness, kMinRoughness);
@@ -250,12 +262,18 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeC
   } else if (counters && m.isEmissive()) {
     ++counters->emissionSkipped;
   }
+  // The environment's reflection of this material: a mirror-smooth base lobe is the plan's
+  // specular, a rougher one its glossy (the ray tracers' reflection rays).
+  const bool mirrorLike = r.roughness < scene::kIdealSpecularRoughness;
+  const EnvironmentLobes lobes{ctx.direct, mirrorLike ? ctx.specular : ctx.glossy, ctx.glossy};
   if (!ctx.direct) {
+    // The lights, and the environment's diffuse and sheen light, are skipped.
     if (counters) counters->lightSamplesSkipped += (ctx.usesHeadlight ? 1 : ctx.lights.size()) + (ctx.ibl ? 1 : 0);
-    return radiance;
+    if (!ctx.ibl || !(lobes.reflection || lobes.coat)) return radiance;
   }
 
   glm::vec3 V = ctx.view.perspective ? glm::normalize(ctx.view.eye - sp.position) : -ctx.view.forward;
+  if (!ctx.direct) return radiance + environmentLight(*ctx.ibl, r, V, lobes);
   if (ctx.usesHeadlight) {
     // Without layers, headlightBrdf: the exact operations of the SSE lanes (shadeBatch).
     const float NdotV = glm::dot(r.normal, V);
@@ -268,7 +286,7 @@ glm::vec3 shadeSurface(const ShadingContext& ctx, const SurfacePoint& sp, ShadeC
     glm::vec3 L, E;
     if (incidentLight(light, sp.position, L, E)) radiance += layeredLight(r, V, L) * E;
   }
-  if (ctx.ibl) radiance += environmentLight(*ctx.ibl, r, V);
+  if (ctx.ibl) radiance += environmentLight(*ctx.ibl, r, V, lobes);
   return radiance;
 }
 

@@ -57,8 +57,12 @@ struct ShadingContext {
   bool alphaTested = false;
   // The RenderPlan's effects (common/scene/effect_analysis.h) this stage can skip: textures off
   // shades from the material factors, emission off adds no emitted radiance, direct off adds
-  // no light (punctual or headlight). The work not done is counted in ShadeCounters.
-  bool textures = true, emission = true, direct = true;
+  // no light (punctual or headlight) and none of the environment's on the diffuse and sheen
+  // lobes. The environment's reflection follows the switches of the ray tracers' reflection
+  // rays that would see it: specular for a mirror-smooth base lobe (roughness below
+  // scene::kIdealSpecularRoughness), glossy for a rougher one and for the clear coat. The work
+  // not done is counted in ShadeCounters.
+  bool textures = true, emission = true, direct = true, specular = true, glossy = true;
   // Pixels per SIMD step of the headlit kernel: 8 (AVX2) or 4 (SSE2), chosen once per run for
   // the processor (shadeLanes()); either gives the same bits.
   int lanes = 4;

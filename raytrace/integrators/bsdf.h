@@ -51,23 +51,23 @@ struct ShadingMaterial {
   bool thinWalled = true;
   glm::vec3 attenuation{0.0f};
 
-  // Weight of the Lambertian part: the non-metallic, non-transmissive share of baseColor.
+  // The opaque lobes below carry their own weights in the glTF spec's mix (Appendix B, with
+  // KHR_materials_transmission's mix(diffuse_brdf, specular_btdf, transmission)): the diffuse
+  // part holds (1 - metallic)(1 - transmission), the dielectric specular layer (1 - transmission)
+  // - the transmissive share's reflection is the dielectric part's exact Fresnel term - and the
+  // metal part metallic. Integrators use them as they are (never times another opaque weight);
+  // one that picks the opaque part with probability 1 - dielectricWeight() divides by it.
+  //
+  // The Lambertian part: the non-metallic, non-transmissive share of baseColor.
   glm::vec3 diffuseColor() const { return (1.0f - metallic) * (1.0f - transmission) * baseColor; }
-  // Specular reflectance at normal incidence. A dielectric has 4% (ior 1.5); a fully rough
-  // dielectric (roughness 1) is taken as pure Lambertian so its albedo is exactly baseColor
-  // (the white-furnace test relies on it), as in Jensen's purely diffuse Cornell walls.
-  glm::vec3 specularF0() const {
-    const glm::vec3 dielectric = roughness < 1.0f ? dielectricF0 : glm::vec3(0.0f);
-    return glm::mix(dielectric * (1.0f - transmission), baseColor, metallic);
-  }
-  // Reflectance at grazing incidence: 1 for metals, specularFactor for dielectrics (with the
-  // same fully-rough exception as F0).
-  float specularF90() const {
-    const float dielectric = roughness < 1.0f ? dielectricF90 : 0.0f;
-    return dielectric * (1.0f - transmission) * (1.0f - metallic) + metallic;
-  }
-  // No specular lobe at all when F0 and F90 are zero (a fully rough dielectric, or
-  // specularFactor 0): the material is then exactly Lambertian.
+  // Specular reflectance at normal incidence: the dielectric's F0 (4% at ior 1.5, or
+  // KHR_materials_specular's) on its opaque share, the base colour on the metal's. A surface
+  // meant to be purely Lambertian says so with KHR_materials_specular's specularFactor 0.
+  glm::vec3 specularF0() const { return glm::mix(dielectricF0 * (1.0f - transmission), baseColor, metallic); }
+  // Reflectance at grazing incidence: 1 for metals, specularFactor for dielectrics.
+  float specularF90() const { return dielectricF90 * (1.0f - transmission) * (1.0f - metallic) + metallic; }
+  // No specular lobe at all when F0 and F90 are zero (specularFactor 0 on a non-metal, or
+  // transmission 1): the opaque part is then exactly Lambertian.
   bool hasSpecular() const {
     const glm::vec3 f0 = specularF0();
     return f0.x > 0.0f || f0.y > 0.0f || f0.z > 0.0f || specularF90() > 0.0f;
@@ -80,8 +80,10 @@ struct ShadingMaterial {
   bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
   bool hasClearcoat() const { return clearcoat > 0.0f; }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }
-  // Share of the smooth dielectric (refracting) part.
+  // Share of the smooth dielectric (refracting) part, and the probability with which the
+  // samplers pick it over the opaque lobes.
   float dielectricWeight() const { return transmission * (1.0f - metallic); }
+  float opaqueProbability() const { return 1.0f - dielectricWeight(); }
 };
 
 // textures = false evaluates the material from its factors alone (the plan's textures off).

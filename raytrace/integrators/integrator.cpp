@@ -78,9 +78,8 @@ glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInte
 }
 
 void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
-                                    const glm::vec3& woLocal, const RayMessage& msg, float opaqueWeight, bool mis,
+                                    const glm::vec3& woLocal, const RayMessage& msg, float opaqueProbability, bool mis,
                                     Emit& out, int areaSamples, const OpaqueEval* eval) const {
-  if (!(opaqueWeight > 0.0f)) return;
   const bool area = lights_.hasAreaLights();
   if (!simulates(scene::Effect::DirectLight)) {
     out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? uint64_t(std::max(1, areaSamples)) : 0u) +
@@ -95,11 +94,11 @@ void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingM
     if (glm::dot(ls.wi, ng) <= 0.0f) return;
     const glm::vec3 wiLocal = frame.toLocal(ls.wi);
     if (wiLocal.z <= 0.0f) return;
-    const glm::vec3 f = (eval ? (*eval)(woLocal, wiLocal) : evalOpaque(m, woLocal, wiLocal)) * opaqueWeight;
+    const glm::vec3 f = eval ? (*eval)(woLocal, wiLocal) : evalOpaque(m, woLocal, wiLocal);
     float weight = 1.0f;
     if (mis && !eval && ls.pdf > 0.0f) {
       // Power heuristic (Veach 1997, eq. 9.13) against the BSDF sample that could hit this light.
-      const float pb = opaqueWeight * pdfOpaque(m, woLocal, wiLocal);
+      const float pb = opaqueProbability * pdfOpaque(m, woLocal, wiLocal);
       weight = ls.pdf * ls.pdf / (ls.pdf * ls.pdf + pb * pb);
     }
     const glm::vec3 c = msg.throughput * f * ls.radiance * (wiLocal.z * weight * scale);

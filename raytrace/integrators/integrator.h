@@ -102,7 +102,9 @@ class IntegratorContext {
   glm::vec3 emitted(const ShadingMaterial& m, const SurfaceInteraction& si, Emit& out) const;
   // Next-event estimation at a hit: one shadow ray per punctual light and one area-light
   // sample, each carrying throughput * f * L * cos / pdf (times the MIS weight against BSDF
-  // sampling when mis is set). opaqueWeight scales the diffuse + glossy part. areaSamples > 1
+  // sampling when mis is set), f the opaque lobes as evalOpaque weighs them. opaqueProbability:
+  // how often the integrator's BSDF sampling picks the opaque lobes (the MIS weight's pdf is
+  // that times pdfOpaque). areaSamples > 1
   // takes that many area-light samples, each weighted 1 / areaSamples (sample 0 on the Dim::
   // kLight* dimensions, sample i on Dim::kLightExtra + 3 (i - 1) ...). Plan: nothing
   // with direct light off, no area sample with emission off, and with shadows off the
@@ -111,7 +113,7 @@ class IntegratorContext {
   // without cos): an integrator's own lobe (the photon map's anisotropic Ward). MIS is then off.
   using OpaqueEval = std::function<glm::vec3(const glm::vec3& woLocal, const glm::vec3& wiLocal)>;
   void directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame, const glm::vec3& woLocal,
-                   const RayMessage& msg, float opaqueWeight, bool mis, Emit& out, int areaSamples = 1,
+                   const RayMessage& msg, float opaqueProbability, bool mis, Emit& out, int areaSamples = 1,
                    const OpaqueEval* eval = nullptr) const;
   // Pushes ray when the plan simulates `effect`, else counts it in TraceStats::*skipped.
   void spawn(scene::Effect effect, uint64_t TraceStats::*skipped, const RayMessage& ray, Emit& out) const {

@@ -55,7 +55,7 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& incom
   ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, mis, out);
 
   // Choose the part: the dielectric with probability `dielectric` (its selection probability
-  // cancels its weight), else the opaque lobes.
+  // cancels its weight), else the opaque lobes, whose sample is divided by `opaque`.
   const float lobe = ctx.sample(msg, Dim::kLobe);
   // A path that arrived by a diffuse or glossy bounce (a non-delta BSDF sample, bsdfPdf > 0)
   // and continues through an ideal mirror or a refraction is a caustic path (L S+ D E read
@@ -107,7 +107,8 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& incom
     wi = sf.frame.toWorld(s.wi);
     // A reflection must leave on the side it arrived from (no leaks through the surface).
     if (glm::dot(wi, sf.ng) <= 0.0f) return;
-    throughput = msg.throughput * s.weight;
+    // The opaque lobes were picked with probability `opaque`; their weights are their own.
+    throughput = msg.throughput * s.weight / opaque;
     pdf = s.delta ? 0.0f : mis ? s.pdf * opaque : -1.0f;
   }
 

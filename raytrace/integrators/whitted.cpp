@@ -31,7 +31,7 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& in
 
   // Mirror-like metals and smooth dielectric coats: one ideal reflection ray.
   if (opaque > 0.0f && m.deltaSpecular()) {
-    const glm::vec3 f = m.specularFresnel(sf.woLocal.z) * opaque;
+    const glm::vec3 f = m.specularFresnel(sf.woLocal.z);  // F0 and F90 hold the opaque share
     const glm::vec3 t = msg.throughput * f;
     if (maxComponent(t) > kMinThroughput) {
       const glm::vec3 wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));

@@ -15,6 +15,7 @@
 #include "common/scene/gltf_loader.h"
 #include "common/util/error.h"
 #include "photonmap/photon_map_integrator.h"
+#include "raytrace/integrators/integrator_scenes.h"
 #include "raytrace/partition/partition.h"
 #include "run_record_support.h"
 #include "test_support.h"
@@ -214,6 +215,27 @@ TEST_CASE("PhotonMapIntegrator: each bundled scene's analysed plan renders the a
     const image::Image all = render(s, smallSettings(), "image-space", 2, "demand", 1, scene::EffectSet::all());
     CHECK(a.pixels == all.pixels);
     if (!plan.on(scene::Effect::Caustics)) CHECK(counter(analysed, "Photons/caustic_emitted") == 0);
+  }
+}
+
+TEST_CASE("PhotonMapIntegrator: mirrors under the environment keep their reflections under the analysed plan") {
+  for (const test::ViewedScene& v : test::mirrorsUnderEnvironment()) {
+    CAPTURE(v.name);
+    const scene::RenderPlan plan = scene::analyzeEffects(v.scene, &v.camera);
+    rt::IntegratorOptions io;
+    io.effects = plan.enabled();
+    auto renderWith = [&](scene::EffectSet effects) {
+      io.effects = effects;
+      rt::TraceJob job{v.scene, v.camera, kW, kH, {}};
+      job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(v.scene, v.camera, kW, kH, io, smallSettings());
+      job.options.tileSizePx = 8;
+      par::Runtime runtime(2);
+      return rt::renderRays(job, "image-space", runtime);
+    };
+    const rt::TraceResult planned = renderWith(plan.enabled());
+    const rt::TraceResult all = renderWith(scene::EffectSet::all());
+    CHECK(planned.image.pixels == all.image.pixels);
+    CHECK(planned.rays.specularRaysSkipped == 0);
   }
 }
 

@@ -202,6 +202,102 @@ TEST_CASE("PhotonTracer: a scene without specular surfaces traces no caustic pho
   CHECK(maps.global.size() > 0);
 }
 
+TEST_CASE("PhotonTracer: stratified emission gives every direction cell its share when the count is not a square") {
+  // 4200 photons of one point light = 64^2 strata + 104 more. The direction of photon j comes
+  // from (u, v) by uniformCone: cos theta = 1 - 2u, phi = 2 pi v about the frame of +z, so
+  // (u, v) is read back from the direction. Over a 4 x 4 grid of (u, v) cells each holds 256
+  // of the strata exactly; the other 104 photons are uniform, Binomial(104, 1/16) per cell:
+  // mean 6.5, sd 2.47. Bound: 5 sd. Giving the 104 the first strata again (as before) put
+  // 272-288 photons into the four cells of the first v band.
+  const scene::Scene s = litFloor(1.0f, 1.0f);
+  pm::PhotonOptions options;
+  options.globalPhotons = 4200;
+  options.causticPhotons = 0;
+  const pm::PhotonSource source(s, options);
+  REQUIRE(source.emitted(pm::PhotonMapKind::Global) == 4200);
+  int counts[4][4] = {};
+  const rt::Frame frame(glm::vec3(0.0f, 0.0f, 1.0f));
+  for (std::size_t i = 0; i < 4200; ++i) {
+    pm::EmittedPhoton e;
+    REQUIRE(source.emit(pm::PhotonMapKind::Global, i, e));
+    const glm::vec3 local = frame.toLocal(glm::normalize(e.ray.direction));
+    const double u = (1.0 - double(local.z)) / 2.0;
+    double v = std::atan2(double(local.y), double(local.x)) / (2.0 * kPi);
+    if (v < 0.0) v += 1.0;
+    ++counts[std::min(3, int(u * 4.0))][std::min(3, int(v * 4.0))];
+  }
+  const double mean = 256.0 + 104.0 / 16.0, sd = std::sqrt(104.0 / 16.0 * 15.0 / 16.0);
+  for (int a = 0; a < 4; ++a)
+    for (int b = 0; b < 4; ++b) {
+      CAPTURE(a);
+      CAPTURE(b);
+      CHECK(std::fabs(double(counts[a][b]) - mean) <= 5.0 * sd);
+    }
+  // The function itself: photons past the grid keep their uniform (u, v).
+  CHECK(pm::stratifiedEmission(4100, 4200, 0.3f, 0.7f) == glm::vec2(0.3f, 0.7f));
+  CHECK(pm::stratifiedEmission(65, 4200, 0.5f, 0.5f) == glm::vec2(1.5f / 64.0f, 1.5f / 64.0f));
+}
+
+namespace {
+
+// The caustic flux a sphere of `material` (radius 0.5, 1 above the floor) focuses onto a
+// diffuse floor from a point light above it: the caustic map's power stored on the floor.
+double causticFluxOnFloor(const scene::Material& material) {
+  scene::Scene s;
+  test::addGround(s, 3.0f, test::addMaterial(s, test::diffuse(0.8f)));
+  test::addSphere(s, {0.0f, 1.0f, 0.0f}, 0.5f, 32, test::addMaterial(s, material));
+  scene::PunctualLight light;
+  light.position = glm::vec3(0.3f, 3.0f, 0.0f);
+  light.intensity = 10.0f;
+  s.lights.push_back(light);
+  const rt::Bvh bvh(s);
+  pm::PhotonOptions options;
+  options.globalPhotons = 0;
+  options.causticPhotons = 20000;
+  par::Runtime runtime(2);
+  const pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
+  double flux = 0.0;
+  for (const pm::Photon& p : lists.caustic)
+    if (std::fabs(p.position.y) < 1.0e-3f) flux += double(rt::luminance(p.powerRgb()));
+  return flux;
+}
+
+}  // namespace
+
+TEST_CASE("PhotonTracer: surfaces that are part diffuse, part specular still cast caustics") {
+  // Jensen's Russian roulette over the whole BSDF: a photon the specular part reflects or
+  // transmits stays on its caustic path; only one the diffuse part takes ends it. Against the
+  // same sphere fully specular (20000 photons each, aimed at the same target):
+  //   - glass of transmission 0.9 (base white, so its diffuse part is 0.1): a transmitted
+  //     photon passes two interfaces, each going on with probability ~0.9, so about 0.81 of the
+  //     clear glass's flux (0.7-0.95 allows for the reflected share and the count noise);
+  //   - smooth white plastic (metallic 0, roughness 0, F0 0.04): the Schlick reflectance
+  //     averaged over the sphere is about F0 + (1 - F0)/21 = 0.086 of a white mirror's flux
+  //     (0.03-0.25: the average is weighted by where the photons land).
+  scene::Material glass = test::diffuse(1.0f);
+  glass.specularFactor = 1.0f;
+  glass.roughnessFactor = 0.0f;
+  glass.transmissionFactor = 1.0f;
+  scene::Material partGlass = glass;
+  partGlass.transmissionFactor = 0.9f;
+  scene::Material mirror = glass;
+  mirror.transmissionFactor = 0.0f;
+  mirror.metallicFactor = 1.0f;
+  scene::Material plastic = glass;
+  plastic.transmissionFactor = 0.0f;
+  plastic.baseColorFactor = glm::vec4(0.8f, 0.8f, 0.8f, 1.0f);
+  const double clear = causticFluxOnFloor(glass), part = causticFluxOnFloor(partGlass);
+  const double white = causticFluxOnFloor(mirror), smooth = causticFluxOnFloor(plastic);
+  MESSAGE("caustic flux on the floor: glass " << clear << ", transmission 0.9 " << part << ", mirror " << white
+                                              << ", plastic " << smooth);
+  REQUIRE(clear > 0.0);
+  REQUIRE(white > 0.0);
+  CHECK(part / clear >= 0.7);
+  CHECK(part / clear <= 0.95);
+  CHECK(smooth / white >= 0.03);
+  CHECK(smooth / white <= 0.25);
+}
+
 TEST_CASE("PhotonTracer: the Cornell box's caustic map holds specular-path photons on diffuse surfaces") {
   const scene::Scene s = cornell();
   const rt::Bvh bvh(s);

@@ -16,6 +16,7 @@
 #include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
 #include "raster/sort/sort_point.h"
+#include "raytrace/integrators/integrator_scenes.h"
 #include "run_record_support.h"
 #include "test_support.h"
 
@@ -86,6 +87,24 @@ TEST_CASE("RasterPlan: emission off and direct light off skip their terms, in ev
   CHECK(lit > 0);
   CHECK(lit < emissionOnly.size() / 10);
   checkSortPoints(s, cam, without(scene::Effect::DirectLight), emissionOnly, "Plan/light_samples_skipped");
+}
+
+TEST_CASE("RasterPlan: mirrors under the environment reflect it under the analysed plan, in every sort point") {
+  for (const test::ViewedScene& v : test::mirrorsUnderEnvironment()) {
+    CAPTURE(v.name);
+    const scene::RenderPlan plan = scene::analyzeEffects(v.scene, &v.camera);
+    // Only mirrors: no direct light to receive, but the environment's reflection is specular's.
+    CHECK_FALSE(plan.on(scene::Effect::DirectLight));
+    const std::vector<glm::vec3> all = sequential(v.scene, v.camera, scene::EffectSet::all());
+    const std::vector<glm::vec3> planned = sequential(v.scene, v.camera, plan.enabled());
+    CHECK(planned == all);
+    // The mirror shows its tint of the environment (not black): some pixel is neither sky nor dark.
+    size_t tinted = 0;
+    for (const glm::vec3& p : planned)
+      if (p.x > 0.05f && p.z < 0.9f * p.x) ++tinted;
+    CHECK(tinted > planned.size() / 20);
+    checkSortPoints(v.scene, v.camera, plan.enabled(), planned, "Plan/light_samples_skipped");
+  }
 }
 
 }  // namespace pr::raster

@@ -103,6 +103,14 @@ TEST_CASE("Generate: cornell has a glass and a mirror sphere, an emissive light 
   CHECK(mirror->pbrMetallicRoughness.metallicFactor == 1.0);
   CHECK(mirror->pbrMetallicRoughness.roughnessFactor == 0.0);
 
+  // The walls are purely Lambertian, as the glTF spec writes it: no dielectric Fresnel layer.
+  for (const char* wall : {"white", "red", "green"}) {
+    const auto* paint = findMaterial(m, wall);
+    REQUIRE(paint);
+    CHECK(extensionNumber(*paint, "KHR_materials_specular", "specularFactor") == 0.0);
+  }
+  CHECK(glass->extensions.count("KHR_materials_specular") == 0);
+
   const auto* light = findMaterial(m, "light");
   REQUIRE(light);
   CHECK(light->emissiveFactor == std::vector<double>{1, 1, 1});

@@ -15,17 +15,19 @@ constexpr float kWidth = 5.56f, kHeight = 5.488f, kDepth = 5.592f;
 constexpr float kSphereRadius = 1.0f;
 
 void buildBox(GltfBuilder& b, const SceneParams& params, bool specularSpheres) {
-  // Reflectances of the Cornell box paints (about 0.73 white, red and green as measured).
-  const int white = b.addMaterial({.name = "white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}});
-  const int red = b.addMaterial({.name = "red", .baseColor = {0.63f, 0.065f, 0.05f, 1.0f}});
-  const int green = b.addMaterial({.name = "green", .baseColor = {0.14f, 0.45f, 0.091f, 1.0f}});
+  // Reflectances of the Cornell box paints (about 0.73 white, red and green as measured),
+  // purely Lambertian as in Jensen's box: KHR_materials_specular 0, no Fresnel layer.
+  const int white = b.addMaterial({.name = "white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}, .specular = 0.0f});
+  const int red = b.addMaterial({.name = "red", .baseColor = {0.63f, 0.065f, 0.05f, 1.0f}, .specular = 0.0f});
+  const int green = b.addMaterial({.name = "green", .baseColor = {0.14f, 0.45f, 0.091f, 1.0f}, .specular = 0.0f});
   // The light: a pure emitter (black base colour). Radiance = emissiveFactor * strength = 30,
   // which puts about 0.3 of diffuse radiance on the floor below it
   // (E = L A / h^2 = 30 * 1.365 / 5.48^2 = 1.36; 0.73 * 1.36 / pi = 0.32).
   const int light = b.addMaterial({.name = "light",
                                    .baseColor = {0.0f, 0.0f, 0.0f, 1.0f},
                                    .emissive = glm::vec3(1.0f),
-                                   .emissiveStrength = 30.0f});
+                                   .emissiveStrength = 30.0f,
+                                   .specular = 0.0f});
 
   // Walls: each quad faces into the box (makeQuad faces cross(u, v)).
   const glm::vec3 x(kWidth, 0, 0), y(0, kHeight, 0), z(0, 0, -kDepth);
@@ -49,7 +51,7 @@ void buildBox(GltfBuilder& b, const SceneParams& params, bool specularSpheres) {
     glassMaterial = b.addMaterial(
         {.name = "glass", .baseColor = glm::vec4(1.0f), .roughness = 0.0f, .transmission = 1.0f, .ior = 1.5f});
   } else {
-    mirrorMaterial = glassMaterial = b.addMaterial({.name = "sphere white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}});
+    mirrorMaterial = glassMaterial = b.addMaterial({.name = "sphere white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}, .specular = 0.0f});
   }
   const int mirrorMesh = b.addMesh(specularSpheres ? "mirror sphere" : "back sphere", sphere, mirrorMaterial);
   const int glassMesh = specularSpheres ? b.addMeshSharingGeometry("glass sphere", mirrorMesh, glassMaterial) : mirrorMesh;

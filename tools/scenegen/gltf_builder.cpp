@@ -89,6 +89,11 @@ int GltfBuilder::addMaterial(const MaterialDesc& desc) {
     m.extensions["KHR_materials_volume"] = tinygltf::Value(volume);
     useExtension("KHR_materials_volume");
   }
+  if (desc.specular != 1.0f) {
+    tinygltf::Value::Object specular{{"specularFactor", tinygltf::Value(clean(desc.specular))}};
+    m.extensions["KHR_materials_specular"] = tinygltf::Value(specular);
+    useExtension("KHR_materials_specular");
+  }
   m.doubleSided = desc.doubleSided;
   model_.materials.push_back(std::move(m));
   return static_cast<int>(model_.materials.size()) - 1;

@@ -32,6 +32,9 @@ struct MaterialDesc {
   float attenuationDistance = 0.0f;
   glm::vec3 attenuationColor{1.0f};
   float thickness = 0.0f;
+  // KHR_materials_specular's specularFactor, written when not 1: 0 makes a dielectric purely
+  // Lambertian (no Fresnel layer), which is how the glTF spec spells a diffuse-only surface.
+  float specular = 1.0f;
 };
 
 // Node placement: translation, rotation (unit quaternion), uniform scale.

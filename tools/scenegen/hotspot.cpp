@@ -22,7 +22,7 @@ constexpr glm::vec3 kClusterCenter{-5.4f, 8.4f, -4.0f};
 }  // namespace
 
 void buildHotspot(GltfBuilder& b, const SceneParams& params) {
-  const int wall = b.addMaterial({.name = "wall", .baseColor = {0.7f, 0.7f, 0.7f, 1.0f}});
+  const int wall = b.addMaterial({.name = "wall", .baseColor = {0.7f, 0.7f, 0.7f, 1.0f}, .specular = 0.0f});
   b.addMeshNode("floor", b.addMesh("floor", makeQuad({-10, 0, 12}, {20, 0, 0}, {0, 0, -18}), wall));
   b.addMeshNode("back wall", b.addMesh("back wall", makeQuad({-10, 0, -6}, {20, 0, 0}, {0, 12, 0}), wall));
 
@@ -32,7 +32,7 @@ void buildHotspot(GltfBuilder& b, const SceneParams& params) {
                                             glm::vec4(0.2f, 0.3f, 0.8f, 1), glm::vec4(0.8f, 0.7f, 0.2f, 1)};
   std::array<int, 6> materials{};
   for (int i = 0; i < 4; ++i)
-    materials[i] = b.addMaterial({.name = "diffuse " + std::to_string(i), .baseColor = colours[i]});
+    materials[i] = b.addMaterial({.name = "diffuse " + std::to_string(i), .baseColor = colours[i], .specular = 0.0f});
   materials[4] = b.addMaterial(
       {.name = "glass", .baseColor = glm::vec4(1.0f), .roughness = 0.0f, .transmission = 1.0f, .ior = 1.5f});
   materials[5] = b.addMaterial({.name = "mirror", .baseColor = glm::vec4(1.0f), .metallic = 1.0f, .roughness = 0.0f});
@@ -76,7 +76,8 @@ void buildHotspot(GltfBuilder& b, const SceneParams& params) {
   const int emitter = b.addMaterial({.name = "light",
                                      .baseColor = {0.0f, 0.0f, 0.0f, 1.0f},
                                      .emissive = glm::vec3(1.0f),
-                                     .emissiveStrength = 20.0f});
+                                     .emissiveStrength = 20.0f,
+                                     .specular = 0.0f});
   b.addMeshNode("area light", b.addMesh("area light", makeQuad({2.6f, 9.0f, -0.6f}, {0, 0, -0.8f}, {0.8f, 0, 0}), emitter));
 
   b.addPerspectiveCamera("camera", 50.0f * std::numbers::pi_v<float> / 180.0f, 1.0f, 0.1f, 100.0f, {0.0f, 3.0f, 12.0f},

@@ -32,13 +32,14 @@ constexpr float kLightStrength = 2000.0f;
 }  // namespace
 
 void buildLandscape(GltfBuilder& b, const SceneParams& params) {
-  const int terrainMaterial = b.addMaterial({.name = "terrain", .baseColor = {0.55f, 0.5f, 0.4f, 1.0f}});
+  const int terrainMaterial = b.addMaterial({.name = "terrain", .baseColor = {0.55f, 0.5f, 0.4f, 1.0f}, .specular = 0.0f});
   const int glass = b.addMaterial(
       {.name = "lens glass", .baseColor = glm::vec4(1.0f), .roughness = 0.0f, .transmission = 1.0f, .ior = 1.5f});
   const int light = b.addMaterial({.name = "light",
                                    .baseColor = {0.0f, 0.0f, 0.0f, 1.0f},
                                    .emissive = glm::vec3(1.0f),
-                                   .emissiveStrength = kLightStrength});
+                                   .emissiveStrength = kLightStrength,
+                                   .specular = 0.0f});
 
   const PerlinNoise noise(params.seed);
   const float half = kExtent / 2;

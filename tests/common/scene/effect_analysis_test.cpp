@@ -168,6 +168,22 @@ TEST_CASE("EffectAnalysis: a single plane has nothing to occlude or bounce light
   CHECK(plan[Effect::IndirectDiffuse].reason.find("one plane") != std::string::npos);
 }
 
+TEST_CASE("EffectAnalysis: reflection that leaves the scene sees a light-emitting environment") {
+  for (const test::ViewedScene& v : test::mirrorsUnderEnvironment()) {
+    CAPTURE(v.name);
+    const scene::RenderPlan plan = scene::analyzeEffects(v.scene, &v.camera);
+    CAPTURE(plan.line(Effect::IdealSpecular));
+    CHECK(plan.on(Effect::IdealSpecular));
+    CHECK(plan[Effect::IdealSpecular].reason.find("see the environment") != std::string::npos);
+    CHECK_FALSE(plan.on(Effect::DirectLight));  // nothing diffuse or glossy to receive it
+    // Without the environment (a point light instead) a lone mirror's reflections see nothing.
+    scene::Scene dark = v.scene;
+    dark.environment.reset();
+    dark.lights.push_back(pointLight({0, 4, 0}));
+    CHECK_FALSE(scene::analyzeEffects(dark, &v.camera).on(Effect::IdealSpecular));
+  }
+}
+
 TEST_CASE("EffectAnalysis: forcing an effect changes its state, says forced and keeps the analysis") {
   const scene::RenderPlan analysed = bundledPlan("cornell-diffuse.gltf");
   const scene::RenderPlan plan =

@@ -22,6 +22,14 @@ rt::ShadingMaterial material(float base, float metallic, float roughness) {
   return m;
 }
 
+// A purely Lambertian surface: KHR_materials_specular's specularFactor 0 (F0 = F90 = 0).
+rt::ShadingMaterial lambertian(float base) {
+  rt::ShadingMaterial m = material(base, 0.0f, 1.0f);
+  m.dielectricF0 = glm::vec3(0.0f);
+  m.dielectricF90 = 0.0f;
+  return m;
+}
+
 // Directional albedo: E[weight] over sampleOpaque, n samples (counter-based numbers).
 double albedo(const rt::ShadingMaterial& m, const glm::vec3& wo, int n) {
   double sum = 0.0;
@@ -51,10 +59,13 @@ TEST_CASE("Bsdf: sampled weight is f cos / pdf, and f is reciprocal") {
   }
 }
 
-TEST_CASE("Bsdf: a rough dielectric is Lambertian with albedo = base colour, glossy lobes do not create energy") {
+TEST_CASE("Bsdf: a dielectric with specularFactor 0 is Lambertian with albedo = base colour, glossy lobes do not create energy") {
   const glm::vec3 wo = glm::normalize(glm::vec3(0.5f, 0.0f, 0.7f));
   // Cosine sampling of a Lambertian lobe has weight = albedo exactly for every sample.
-  CHECK(albedo(material(0.5f, 0.0f, 1.0f), wo, 1000) == doctest::Approx(0.5).epsilon(1e-5));
+  CHECK(albedo(lambertian(0.5f), wo, 1000) == doctest::Approx(0.5).epsilon(1e-5));
+  // Roughness 1 alone keeps the dielectric's Fresnel layer (the glTF spec has no exception for
+  // it): some samples take the GGX lobe, whose weight is not the base colour.
+  CHECK(rt::specularProbability(material(0.5f, 0.0f, 1.0f), wo.z) > 0.0f);
   // A white metal with a GGX lobe reflects at most everything: single scattering loses the
   // light that would scatter between microfacets, more as roughness grows. The lower bounds
   // are an independent Monte Carlo integration of the same model (separable Smith G):
@@ -120,10 +131,10 @@ TEST_CASE("Bsdf: KHR_materials_specular 0 leaves a dielectric exactly Lambertian
 }
 
 TEST_CASE("Bsdf: clear coat and sheen sample what they evaluate and create no energy") {
-  rt::ShadingMaterial coat = material(1.0f, 0.0f, 1.0f);  // white Lambertian base
+  rt::ShadingMaterial coat = lambertian(1.0f);  // white Lambertian base
   coat.clearcoat = 1.0f;
   coat.clearcoatRoughness = 0.3f;
-  rt::ShadingMaterial sheen = material(1.0f, 0.0f, 1.0f);
+  rt::ShadingMaterial sheen = lambertian(1.0f);
   sheen.sheenColor = glm::vec3(1.0f);
   sheen.sheenRoughness = 0.5f;
   for (const rt::ShadingMaterial* m : {&coat, &sheen})
@@ -138,7 +149,7 @@ TEST_CASE("Bsdf: clear coat and sheen sample what they evaluate and create no en
   // The coat reflects more at grazing angles than at normal incidence (its Fresnel term).
   const glm::vec3 n(0, 0, 1), grazing = glm::normalize(glm::vec3(0.95f, 0.0f, 0.3f));
   const glm::vec3 mirror(-grazing.x, 0.0f, grazing.z);
-  CHECK(rt::evalOpaque(coat, grazing, mirror).x > rt::evalOpaque(material(1.0f, 0.0f, 1.0f), grazing, mirror).x * 2.0f);
+  CHECK(rt::evalOpaque(coat, grazing, mirror).x > rt::evalOpaque(lambertian(1.0f), grazing, mirror).x * 2.0f);
   CHECK(rt::evalOpaque(coat, n, n).x > rt::kInvPi);
 }
 

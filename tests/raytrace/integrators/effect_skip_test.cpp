@@ -94,6 +94,22 @@ TEST_CASE("EffectSkip: one convex sphere under a light skips shadow tests and bo
   }
 }
 
+TEST_CASE("EffectSkip: mirrors under the environment keep their reflections under the analysed plan") {
+  for (const test::ViewedScene& v : test::mirrorsUnderEnvironment()) {
+    CAPTURE(v.name);
+    const scene::RenderPlan plan = scene::analyzeEffects(v.scene, &v.camera);
+    // Nothing can see anything else, but every reflection ray sees the environment.
+    CHECK(plan.on(Effect::IdealSpecular));
+    for (rt::IntegratorKind kind : {rt::IntegratorKind::Whitted, rt::IntegratorKind::Path}) {
+      CAPTURE(rt::toString(kind));
+      const rt::TraceResult all = render(v.scene, v.camera, kind, scene::EffectSet::all());
+      const rt::TraceResult planned = render(v.scene, v.camera, kind, plan.enabled());
+      CHECK(planned.image.pixels == all.image.pixels);
+      CHECK(planned.rays.specularRaysSkipped == 0);
+    }
+  }
+}
+
 TEST_CASE("EffectSkip: forcing on effects that cannot appear leaves the image the same") {
   const Bundled b = bundled("cornell-diffuse.gltf");
   const scene::EffectSet on = forced(b.plan, "caustics=on,specular=on,glossy=on,transmission=on");

@@ -4,9 +4,13 @@
 
 #include <cmath>
 #include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include <glm/glm.hpp>
 
+#include "common/scene/environment.h"
 #include "common/scene/scene.h"
 
 namespace pr::test {
@@ -16,11 +20,14 @@ inline uint32_t addMaterial(scene::Scene& s, scene::Material m) {
   return uint32_t(s.materials.size() - 1);
 }
 
+// A purely Lambertian material of the given albedo: KHR_materials_specular's specularFactor 0
+// removes the dielectric Fresnel layer, as the glTF spec spells a diffuse-only surface.
 inline scene::Material diffuse(float albedo) {
   scene::Material m;
   m.baseColorFactor = glm::vec4(albedo, albedo, albedo, 1.0f);
   m.metallicFactor = 0.0f;
   m.roughnessFactor = 1.0f;
+  m.specularFactor = 0.0f;
   return m;
 }
 
@@ -84,6 +91,34 @@ inline scene::Camera perspectiveAt(glm::vec3 eye, float yfov) {
   c.cameraToWorld = glm::mat4(1.0f);
   c.cameraToWorld[3] = glm::vec4(eye, 1.0f);
   return c;
+}
+
+// A scene with its camera, for tests that run one check over several scenes.
+struct ViewedScene {
+  std::string name;
+  scene::Scene scene;
+  scene::Camera camera;
+};
+
+// Mirrors alone under the default light of a scene without lights, a uniform white
+// environment (tools/lighting.cpp): a tinted mirror plane seen at an angle, and a lone mirror
+// sphere. No surface sees another, yet every reflection sees the environment.
+inline std::vector<ViewedScene> mirrorsUnderEnvironment() {
+  scene::Material mirror;
+  mirror.baseColorFactor = glm::vec4(0.9f, 0.6f, 0.3f, 1.0f);
+  mirror.metallicFactor = 1.0f;
+  mirror.roughnessFactor = 0.0f;
+  const auto sky = std::make_shared<const scene::Environment>(scene::Environment::uniform(glm::vec3(1.0f), "uniform white"));
+  std::vector<ViewedScene> out;
+  ViewedScene plane{"mirror plane", {}, perspectiveAt({0.0f, 1.0f, 3.0f}, 0.9f)};
+  addGround(plane.scene, 2.0f, addMaterial(plane.scene, mirror));
+  plane.scene.environment = sky;
+  out.push_back(std::move(plane));
+  ViewedScene sphere{"mirror sphere", {}, perspectiveAt({0.0f, 0.0f, 4.0f}, 0.7f)};
+  addSphere(sphere.scene, {0.0f, 0.0f, 0.0f}, 1.0f, 24, addMaterial(sphere.scene, mirror));
+  sphere.scene.environment = sky;
+  out.push_back(std::move(sphere));
+  return out;
 }
 
 }  // namespace pr::test
