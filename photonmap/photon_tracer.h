@@ -1,9 +1,9 @@
 // Pass 1 of Jensen's two-pass method: photons leave every light, are traced through the scene
 // with Russian roulette over each surface's whole BSDF, and are stored in the global map (every
 // hit on a surface with a diffuse part) and the caustic map (every such hit after one or more
-// specular choices, photons aimed at specular objects by a projection map). Batches of photons are tasks on the runtime; each photon's
-// random stream is a function of (seed, map, photon index) only, so the maps are the same for
-// every P and schedule. Seed chapter "Global Illumination in Complex Scenes using Photon
+// specular choices, photons aimed at specular objects by a projection map). Batches of photons
+// are tasks on the runtime; each photon's random stream is a function of (seed, map, photon
+// index) only, so the maps are the same for every P and schedule. Seed chapter "Global Illumination in Complex Scenes using Photon
 // Maps", sections 2.1-2.2; Jensen, "Realistic Image Synthesis Using Photon Mapping", ch. 5.
 #pragma once
 

@@ -134,10 +134,14 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   // The raster stages (raster/stages/shade.cpp) shade each visible pixel once: direct light
   // from punctual lights and the environment (image-based; a headlight without either) with
   // its glossy highlight, emission and textures, each skipped (and counted) when the plan has
-  // it off; no shadows, reflection or refraction rays.
+  // it off; the environment's reflection under the plan's specular and glossy (shade.h); no
+  // shadows, reflection or refraction rays.
+  const bool environment = raster::showsEnvironment(r.scene, o.headlight);
   scene::EffectSet rasterEffects = scene::EffectSet::none();
   for (scene::Effect e : {scene::Effect::DirectLight, scene::Effect::Emission, scene::Effect::Textures})
     rasterEffects.set(e, true);
+  rasterEffects.set(scene::Effect::IdealSpecular, environment);
+  rasterEffects.set(scene::Effect::GlossySpecular, environment);
   const std::string missing = notSimulated(r.plan, rasterEffects);
   const auto count = [&](std::string_view counter) { return std::to_string(counterTotal(record, counter)); };
   RenderOutcome out;
@@ -146,7 +150,6 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   for (const char* c : {"Plan/texture_evaluations_skipped", "Plan/emission_skipped", "Plan/light_samples_skipped"})
     if (const uint64_t n = counterTotal(record, c); n > 0)
       skipped += (skipped.empty() ? "" : ", ") + std::string(c + 5) + " " + std::to_string(n);
-  const bool environment = raster::showsEnvironment(r.scene, o.headlight);
   out.effects = std::string("rasterization simulates direct light (") +
                 (raster::litByHeadlight(r.scene, o.headlight)
                      ? "a headlight"
@@ -154,7 +157,8 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
                            (environment ? std::string(r.scene.lights.empty() ? "" : ", ") +
                                               "the environment by image-based lighting"
                                         : "")) +
-                ", no shadows), emission and textures" +
+                ", no shadows), " + (environment ? "the environment's specular and glossy reflection, " : "") +
+                "emission and textures" +
                 (missing.empty() ? std::string() : "; not simulated: " + missing) +
                 "; skipped work: " + (skipped.empty() ? "none" : skipped);
   out.details = "frames " + std::to_string(o.frames) + (o.orbit ? " (orbit)" : "") + ", regions " + o.regions +

@@ -231,19 +231,17 @@ glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMater
   glm::vec3 out = on.reflection ? diffuse + ibl.prefiltered(R, roughness) * (F0 * ab.x + F90 * ab.y) : diffuse;
   if (r.hasSheen()) {
     const float albedo = scene::sheenAlbedo(r.sheenRoughness, NdotV);
-    out = out * (1.0f - maxComponent(r.sheenColor) * albedo);
-    if (on.diffuse) out += r.sheenColor * (albedo / kPi) * irradiance;
+    const glm::vec3 sheen = on.diffuse ? r.sheenColor * (albedo / kPi) * irradiance : glm::vec3(0.0f);
+    out = out * (1.0f - maxComponent(r.sheenColor) * albedo) + sheen;
   }
-  if (r.clearcoat > 0.0f && !on.coat) {
-    out = out * (1.0f - r.clearcoat * scene::coatFresnel(std::max(glm::dot(r.clearcoatNormal, V), 1e-4f)));
-  } else if (r.clearcoat > 0.0f) {
+  if (r.clearcoat > 0.0f) {
     const glm::vec3& C = r.clearcoatNormal;
     const float CdotV = std::max(glm::dot(C, V), 1e-4f);
     const float coatRoughness = std::max(r.clearcoatRoughness, kMinRoughness);
     const glm::vec2 abc = specularAlbedo(CdotV, coatRoughness);
     const glm::vec3 Rc = 2.0f * glm::dot(C, V) * C - V;
-    out = out * (1.0f - r.clearcoat * scene::coatFresnel(CdotV)) +
-          r.clearcoat * ibl.prefiltered(Rc, coatRoughness) * (0.04f * abc.x + abc.y);
+    const glm::vec3 coat = on.coat ? r.clearcoat * ibl.prefiltered(Rc, coatRoughness) * (0.04f * abc.x + abc.y) : glm::vec3(0.0f);
+    out = out * (1.0f - r.clearcoat * scene::coatFresnel(CdotV)) + coat;
   }
   return out;
 }

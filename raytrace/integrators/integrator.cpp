@@ -80,6 +80,8 @@ glm::vec3 IntegratorContext::emitted(const ShadingMaterial& m, const SurfaceInte
 void IntegratorContext::directLight(const SurfaceInteraction& si, const ShadingMaterial& m, const Frame& frame,
                                     const glm::vec3& woLocal, const RayMessage& msg, float opaqueProbability, bool mis,
                                     Emit& out, int areaSamples, const OpaqueEval* eval) const {
+  // Clear glass (opaque lobes never picked, and none with a weight): no light to sample.
+  if (!(opaqueProbability > 0.0f)) return;
   const bool area = lights_.hasAreaLights();
   if (!simulates(scene::Effect::DirectLight)) {
     out.stats().lightSamplesSkipped += scene_->lights.size() + (area ? uint64_t(std::max(1, areaSamples)) : 0u) +

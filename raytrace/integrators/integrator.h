@@ -104,7 +104,7 @@ class IntegratorContext {
   // sample, each carrying throughput * f * L * cos / pdf (times the MIS weight against BSDF
   // sampling when mis is set), f the opaque lobes as evalOpaque weighs them. opaqueProbability:
   // how often the integrator's BSDF sampling picks the opaque lobes (the MIS weight's pdf is
-  // that times pdfOpaque). areaSamples > 1
+  // that times pdfOpaque; at 0, clear glass, nothing is sampled). areaSamples > 1
   // takes that many area-light samples, each weighted 1 / areaSamples (sample 0 on the Dim::
   // kLight* dimensions, sample i on Dim::kLightExtra + 3 (i - 1) ...). Plan: nothing
   // with direct light off, no area sample with emission off, and with shadows off the

@@ -60,6 +60,16 @@ double pointLightIrradiance(const glm::vec3& x) {
   return double(toLight.y / d) / double(d * d);
 }
 
+// Both maps' photon lists for `global` and `caustic` photons emitted, traced on two PEs.
+pm::PhotonLists traceLists(const scene::Scene& s, std::size_t global, std::size_t caustic) {
+  const rt::Bvh bvh(s);
+  pm::PhotonOptions options;
+  options.globalPhotons = global;
+  options.causticPhotons = caustic;
+  par::Runtime runtime(2);
+  return pm::tracePhotonLists(s, bvh, options, runtime);
+}
+
 // The global map's photons of first hits (bounce 0): the direct light, in a kd-tree.
 pm::KdTree firstHitMap(const pm::PhotonLists& lists, par::Runtime& runtime) {
   std::vector<pm::Photon> direct;
@@ -85,17 +95,12 @@ TEST_CASE("PhotonTracer: white furnace stores the geometric series of the light'
   // so the relative standard error is sd(C) / (E[C] sqrt(N)); the bound is 4 of those plus the
   // RGBE packing error of the (equal) photon powers, 1/255.5 (photon.h).
   const float rho = 0.5f;
-  const scene::Scene s = furnace(rho);
-  const rt::Bvh bvh(s);
-  pm::PhotonOptions options;
-  options.globalPhotons = 20000;
-  options.causticPhotons = 0;
-  par::Runtime runtime(2);
-  const pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
+  constexpr std::size_t kPhotons = 20000;
+  const pm::PhotonLists lists = traceLists(furnace(rho), kPhotons, 0);
   CHECK(lists.caustic.empty());
-  CHECK(lists.stats.globalEmitted == options.globalPhotons);
+  CHECK(lists.stats.globalEmitted == kPhotons);
   const double phi = 4.0 * kPi;
-  const double n = double(options.globalPhotons);
+  const double n = double(kPhotons);
   std::vector<double> stored(8, 0.0);
   double total = 0.0;
   for (const pm::Photon& p : lists.global) {
@@ -250,12 +255,7 @@ double causticFluxOnFloor(const scene::Material& material) {
   light.position = glm::vec3(0.3f, 3.0f, 0.0f);
   light.intensity = 10.0f;
   s.lights.push_back(light);
-  const rt::Bvh bvh(s);
-  pm::PhotonOptions options;
-  options.globalPhotons = 0;
-  options.causticPhotons = 20000;
-  par::Runtime runtime(2);
-  const pm::PhotonLists lists = pm::tracePhotonLists(s, bvh, options, runtime);
+  const pm::PhotonLists lists = traceLists(s, 0, 20000);
   double flux = 0.0;
   for (const pm::Photon& p : lists.caustic)
     if (std::fabs(p.position.y) < 1.0e-3f) flux += double(rt::luminance(p.powerRgb()));
@@ -271,9 +271,12 @@ TEST_CASE("PhotonTracer: surfaces that are part diffuse, part specular still cas
   //   - glass of transmission 0.9 (base white, so its diffuse part is 0.1): a transmitted
   //     photon passes two interfaces, each going on with probability ~0.9, so about 0.81 of the
   //     clear glass's flux (0.7-0.95 allows for the reflected share and the count noise);
-  //   - smooth white plastic (metallic 0, roughness 0, F0 0.04): the Schlick reflectance
-  //     averaged over the sphere is about F0 + (1 - F0)/21 = 0.086 of a white mirror's flux
-  //     (0.03-0.25: the average is weighted by where the photons land).
+  //   - smooth white plastic (metallic 0, roughness 0, F0 0.04): its caustic follows the white
+  //     mirror's paths, each weighted by Schlick's F at its incidence angle, so the ratio is F
+  //     averaged over the paths that reach the floor - at least F0 = 0.04, and well below 1,
+  //     since light from above reaches the floor only off the sphere's sides, where F rises
+  //     steeply at grazing incidence (0.27 measured; bounds 0.03-0.6 allow for the count noise
+  //     of the few photons the plastic's specular part takes).
   scene::Material glass = test::diffuse(1.0f);
   glass.specularFactor = 1.0f;
   glass.roughnessFactor = 0.0f;
@@ -295,7 +298,7 @@ TEST_CASE("PhotonTracer: surfaces that are part diffuse, part specular still cas
   CHECK(part / clear >= 0.7);
   CHECK(part / clear <= 0.95);
   CHECK(smooth / white >= 0.03);
-  CHECK(smooth / white <= 0.25);
+  CHECK(smooth / white <= 0.6);
 }
 
 TEST_CASE("PhotonTracer: the Cornell box's caustic map holds specular-path photons on diffuse surfaces") {

@@ -16,13 +16,20 @@
 #include "tests/test_support.h"
 
 namespace {
-// Whether the process has a handler for SIGINT (the SigCgt mask of /proc/PID/status), polled
-// until it has one or the wait runs out.
-bool catchesSigint(pid_t pid, std::chrono::seconds wait) {
+// Whether the process runs `exe` and has a handler for SIGINT (the SigCgt mask of
+// /proc/PID/status), polled until it does or the wait runs out. Between fork and exec the child
+// still carries the test runner's own SIGINT handler, so the mask alone would say yes too early.
+bool catchesSigint(pid_t pid, const std::filesystem::path& exe, std::chrono::seconds wait) {
   const auto until = std::chrono::steady_clock::now() + wait;
-  const std::string path = "/proc/" + std::to_string(pid) + "/status";
+  const std::string proc = "/proc/" + std::to_string(pid);
+  const auto target = std::filesystem::canonical(exe);
   while (std::chrono::steady_clock::now() < until) {
-    std::ifstream status(path);
+    std::error_code error;
+    if (std::filesystem::read_symlink(proc + "/exe", error) != target) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      continue;
+    }
+    std::ifstream status(proc + "/status");
     for (std::string line; std::getline(status, line);) {
       if (line.rfind("SigCgt:", 0) != 0) continue;
       const unsigned long long caught = std::stoull(line.substr(7), nullptr, 16);
@@ -94,15 +101,17 @@ TEST_CASE("ResourceLimits: SIGINT stops a long render promptly with exit 130 and
             "--quiet", "-o", output.c_str(), static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  // Interrupt only once the handler is in place: on a loaded machine the start-up (loading the
-  // shared libraries) can take longer than any fixed wait, and a signal before it kills the child.
-  REQUIRE(catchesSigint(child, std::chrono::seconds(60)));
+  // Interrupt only once parrender's handler is in place: on a loaded machine the start-up
+  // (loading the shared libraries) can take longer than any fixed wait, and a signal before it
+  // kills the child.
+  REQUIRE(catchesSigint(child, PARRENDER_EXE, std::chrono::seconds(60)));
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const auto sent = std::chrono::steady_clock::now();
   ::kill(child, SIGINT);
   int status = 0;
   REQUIRE(::waitpid(child, &status, 0) == child);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - sent).count();
+  INFO("killed by signal " << (WIFSIGNALED(status) ? WTERMSIG(status) : 0));
   REQUIRE(WIFEXITED(status));
   CHECK(WEXITSTATUS(status) == 130);
   CHECK(seconds < 5.0);  // promptly: the handler exits at once (bound generous for loaded machines)
