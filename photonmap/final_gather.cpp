@@ -20,7 +20,7 @@ using rt::kPi;
 // Streams of sample1D(seed ^ kGatherSalt, record, ray, bounce, dim), apart from the camera
 // paths' (seed, pixel, sample, depth, dim).
 constexpr std::uint64_t kGatherSalt = 0x6761746865720000ull;  // "gather"
-constexpr std::uint32_t kThetaDim = 0, kPhiDim = 1, kBranchDim = 2;
+constexpr std::uint32_t kThetaDim = 0, kPhiDim = 1, kBranchDim = 2, kGlossyDim = 3;
 constexpr std::uint32_t kDirectionDepth = 255;
 
 // The jittered (sin^2 theta, phi) of ray j.
@@ -32,20 +32,42 @@ void cellAngles(GatherStrata strata, std::uint32_t id, std::uint32_t j, std::uin
 
 }  // namespace
 
-glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
-                            const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
-                            NearestPhotons& scratch) {
-  return globalMapRadiance(rt::evalMaterial(scene, si, textures), global, precomputed, si, density, scratch);
-}
+glm::vec3 mapRadiance(const rt::ShadingMaterial& m, const rt::ShadingFrame& sf, const KdTree& map,
+                      const PrecomputedIrradiance* precomputed, const rt::SurfaceInteraction& si,
+                      const DensityOptions& density, NearestPhotons& scratch, MapRead read, float roulette) {
+  if (!m.hasNonDeltaPart() || map.empty()) return glm::vec3(0.0f);
+  // Photons were stored with the geometric normal's side; the estimate's disc lies on it.
+  const glm::vec3& ng = sf.ng;
+  const glm::vec3& wo = sf.woLocal;
+  const auto full = [&](const Photon& p) { return rt::evalOpaque(m, wo, sf.frame.toLocal(p.incoming())); };
+  if (read == MapRead::All) return estimateRadiance(map, si.position, ng, density, scratch, full);
+  if (read == MapRead::GlossyCaustic)
+    return estimateRadiance(map, si.position, ng, density, scratch, full, {PhotonPath::kGlossy, PhotonPath::kDiffuse});
 
-glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, const PrecomputedIrradiance* precomputed,
-                            const rt::SurfaceInteraction& si, const DensityOptions& density, NearestPhotons& scratch) {
+  if (m.hasSheen() || m.hasClearcoat()) {
+    // Photon by photon: the layered base for every one, the lobes above it for diffuse paths.
+    return estimateRadiance(map, si.position, ng, density, scratch, [&](const Photon& p) {
+      const glm::vec3 wi = sf.frame.toLocal(p.incoming());
+      const glm::vec3 f = rt::evalOpaque(m, wo, wi);
+      return (p.path() & PhotonPath::kDiffuse) ? f : f - rt::evalNonLambertian(m, wo, wi);
+    });
+  }
+  glm::vec3 radiance(0.0f);
   const glm::vec3 diffuse = m.diffuseColor();
-  if (!(rt::maxComponent(diffuse) > 0.0f)) return glm::vec3(0.0f);
-  const glm::vec3 ng = si.frontFace ? si.geometricNormal : -si.geometricNormal;
-  if (precomputed && !precomputed->empty())
-    return lambertianRadiance(diffuse, precomputed->irradiance(si.position, ng, density.maxRadius, scratch));
-  return lambertianRadiance(diffuse, estimateIrradiance(global, si.position, ng, density, scratch).irradiance);
+  if (rt::maxComponent(diffuse) > 0.0f) {
+    const glm::vec3 irradiance = precomputed && !precomputed->empty()
+                                     ? precomputed->irradiance(si.position, ng, density.maxRadius, scratch)
+                                     : estimateIrradiance(map, si.position, ng, density, scratch).irradiance;
+    radiance += lambertianRadiance(diffuse, irradiance);
+  }
+  if (m.hasSpecular() && !m.deltaSpecular()) {
+    const float p = std::clamp(rt::specularProbability(m, wo.z), 0.1f, 1.0f);
+    if (roulette < p) {
+      const auto glossy = [&](const Photon& photon) { return rt::evalGlossy(m, wo, sf.frame.toLocal(photon.incoming())); };
+      radiance += estimateRadiance(map, si.position, ng, density, scratch, glossy, {PhotonPath::kDiffuse, 0}) / p;
+    }
+  }
+  return radiance;
 }
 
 GatherStrata gatherStrata(int rays) {
@@ -73,9 +95,11 @@ GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& glo
   GatherInteraction out;
   rt::ShadingMaterial m = rt::evalMaterial(scene, si, options.textures);
   throughput *= rt::volumeTransmittance(m, si, ray);
-  out.radiance = throughput * globalMapRadiance(m, global, options.precomputed, si, options.global, scratch);
-  if (bounce >= options.specularBounces) return out;
   const rt::ShadingFrame sf(si, m);
+  const float glossyU = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kGlossyDim);
+  out.radiance = throughput * mapRadiance(m, sf, global, options.precomputed, si, options.global, scratch,
+                                          MapRead::Secondary, glossyU);
+  if (bounce >= options.specularBounces) return out;
   const float u = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kBranchDim);
   glm::vec3 wi, factor;
   if (!idealSpecularBounce(m, si, sf, u, wi, factor)) return out;

@@ -37,17 +37,35 @@ struct GatherOptions {
   std::uint64_t seed = 1;
 };
 
-// The radiance the global map estimates leaving a hit si towards si.wo: the Lambertian part
-// (diffuse colour / pi) times the irradiance of the nearest photons, or of the
-// nearest precomputed point when `precomputed` is given and not empty. Emission is not
-// included (direct light is sampled at the gathering point).
-glm::vec3 globalMapRadiance(const scene::Scene& scene, const KdTree& global, const PrecomputedIrradiance* precomputed,
-                            const rt::SurfaceInteraction& si, const DensityOptions& density, bool textures,
-                            NearestPhotons& scratch);
-// The same with the material at si already evaluated.
-glm::vec3 globalMapRadiance(const rt::ShadingMaterial& m, const KdTree& global, const PrecomputedIrradiance* precomputed,
-                            const rt::SurfaceInteraction& si, const DensityOptions& density, NearestPhotons& scratch);
+// What a photon-map read at a hit stands for, in Jensen's split of the light a point receives
+// (direct, caustic, glossy-caustic, indirect; photon.h's PhotonPath):
+enum class MapRead {
+  // Every photon (the map views; the caustic map at an eye point, whose photons came along
+  // ideal specular paths only).
+  All,
+  // A gather or glossy ray's hit: the light leaving it towards the ray's origin after a diffuse
+  // bounce. The diffuse part reads every photon (its own reflection is that bounce); the
+  // non-Lambertian lobes only photons whose paths took a diffuse bounce - light that came
+  // along glossy and specular bounces alone is the receiver's glossy-caustic term.
+  Secondary,
+  // An eye point's glossy caustics: the global map's photons whose paths took a glossy bounce
+  // but no diffuse one (light a rough metal throws onto a wall), read where they land.
+  GlossyCaustic,
+};
 
+// The radiance a photon map estimates leaving a hit si towards si.wo for `read` (sf: its
+// shading frame, made with m, which it turns to the anisotropy and coat frames): Jensen's
+// estimate with the full non-delta BRDF of the opaque part and each photon's direction. In a
+// Secondary read an exactly Lambertian part reads the photons' irradiance times diffuse colour
+// / pi - from the nearest precomputed point when `precomputed` is given and not empty - and a
+// rough specular lobe is read only when `roulette` < its share of the reflectance (at least
+// 1/10) and then divided by that share, which keeps the mean and spares a search where the
+// lobe is a faint 4 % layer. Emission is not included (direct light is sampled where the ray
+// started).
+glm::vec3 mapRadiance(const rt::ShadingMaterial& m, const rt::ShadingFrame& sf, const KdTree& map,
+                      const PrecomputedIrradiance* precomputed, const rt::SurfaceInteraction& si,
+                      const DensityOptions& density, NearestPhotons& scratch, MapRead read = MapRead::All,
+                      float roulette = 0.0f);
 // How a gathering (or glossy) path goes on through an ideal specular surface at si to the
 // diffuse surface behind it, with u in [0, 1): a dielectric's reflection or refraction chosen
 // by its Fresnel term (which cancels the choice's weight; a refraction is tinted as eye paths

@@ -111,9 +111,19 @@ inline Octahedral packDirection(const glm::vec3& dir) {
 }
 
 // ---- the stored photon ----------------------------------------------------------------------
+// The kinds of reflection a photon's path took before it was stored, as bits: what splits the
+// light a point receives into Jensen's terms - direct (no bounce), caustic (ideal specular
+// bounces only), glossy-caustic (a glossy bounce but no diffuse one) and indirect (a diffuse
+// bounce) - so each term reads only its own photons and no path is counted twice.
+namespace PhotonPath {
+inline constexpr std::uint8_t kDiffuse = 1;  // a Lambertian reflection
+inline constexpr std::uint8_t kGlossy = 2;   // a rough specular, sheen or clear-coat reflection
+}
+
 // flags: bits 0-1 the kd-tree split axis of the node holding the photon (0 x, 1 y, 2 z; written
-// by KdTree::build, meaningless before), bit 2 the map kind. bounces: how many surface
-// interactions the path had before this photon was stored (0 = direct light), saturating.
+// by KdTree::build, meaningless before), bit 2 the map kind, bits 3-4 the PhotonPath bits.
+// bounces: how many surface interactions the path had before this photon was stored (0 =
+// direct light), saturating.
 struct Photon {
   glm::vec3 position{0.0f};
   Rgbe power{0, 0, 0, 0};
@@ -122,13 +132,14 @@ struct Photon {
   std::uint8_t bounces = 0;
 
   static Photon make(const glm::vec3& position, const glm::vec3& power, const glm::vec3& wi,
-                     PhotonMapKind kind = PhotonMapKind::Global, int bounces = 0) {
+                     PhotonMapKind kind = PhotonMapKind::Global, int bounces = 0, std::uint8_t path = 0) {
     Photon p;
     p.position = position;
     p.power = packRgbe(power);
     p.direction = packDirection(wi);
     p.setKind(kind);
     p.bounces = static_cast<std::uint8_t>(std::clamp(bounces, 0, 255));
+    p.flags = static_cast<std::uint8_t>(p.flags | ((path & 3u) << 3));
     return p;
   }
 
@@ -137,6 +148,7 @@ struct Photon {
   int splitAxis() const { return flags & 3; }
   void setSplitAxis(int axis) { flags = static_cast<std::uint8_t>((flags & ~3u) | (static_cast<unsigned>(axis) & 3u)); }
   PhotonMapKind kind() const { return static_cast<PhotonMapKind>((flags >> 2) & 1u); }
+  std::uint8_t path() const { return static_cast<std::uint8_t>((flags >> 3) & 3u); }
   void setKind(PhotonMapKind kind) {
     flags = static_cast<std::uint8_t>((flags & ~4u) | ((static_cast<unsigned>(kind) & 1u) << 2));
   }

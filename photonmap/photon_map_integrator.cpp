@@ -15,7 +15,6 @@
 #include "photonmap/final_gather.h"
 #include "photonmap/irradiance_cache_pass.h"
 #include "photonmap/photon_pass.h"
-#include "photonmap/ward_brdf.h"
 #include "raytrace/core/bvh.h"
 
 namespace pr::pm {
@@ -28,9 +27,11 @@ using rt::RayMessage;
 
 // Rays weaker than this add nothing visible (below 1/4096 of a camera ray's weight).
 constexpr float kMinThroughput = 1.0f / 4096.0f;
-// Random dimensions of this integrator at a vertex: fallback gather rays, then glossy rays.
+// Random dimensions of this integrator at a vertex: fallback gather rays, glossy rays, the
+// choice whether a secondary hit reads its map's glossy part (mapRadiance's roulette).
 constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
 constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
+constexpr std::uint32_t kMapReadDim = rt::Dim::kIntegratorOwn + 512 + 3 * 256;
 constexpr int kMaxRaysPerVertex = 256;
 // Photons per map at most (CLI range; the photon program's pixel index is 32 bits).
 constexpr std::size_t kMaxPhotons = 100000000;
@@ -109,13 +110,6 @@ float PhotonMapIntegrator::smoothWeight(std::uint16_t sample) const {
   return float(smoothBlock_.x * smoothBlock_.y);
 }
 
-glm::vec3 PhotonMapIntegrator::mapRadiance(const KdTree& map, const DensityOptions& density,
-                                           const rt::SurfaceInteraction& si, const rt::ShadingMaterial& m) const {
-  if (map.empty()) return glm::vec3(0.0f);
-  thread_local NearestPhotons scratch;
-  return globalMapRadiance(m, map, nullptr, si, density, scratch);  // any map's density estimate, read the same way
-}
-
 // ---- pre-pass ---------------------------------------------------------------------------------
 
 void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) const {
@@ -135,6 +129,10 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
   // Pass 1 through the render's tracer; the maps are built from the merged photons.
   PhotonLists lists = tracePhotonMessages(ctx.scene(), camera_, photons, tracer, rt);
   state_->maps.stats = lists.stats;
+  // Whether any global photon came along glossy bounces without a diffuse one: only then is
+  // the glossy-caustic term read at eye points (a search that finds nothing still costs).
+  const PhotonSelection glossyOnly{PhotonPath::kGlossy, PhotonPath::kDiffuse};
+  state_->glossyCaustics = std::any_of(lists.global.begin(), lists.global.end(), [&](const Photon& p) { return glossyOnly.accepts(p); });
   state_->maps.global = KdTree::build(lists.global, rt);
   state_->maps.caustic = KdTree::build(std::move(lists.caustic), rt);
   state_->irradiance = PrecomputedIrradiance();
@@ -169,14 +167,15 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   rt::ShadingMaterial m = ctx.material(si, out);
   const RayMessage msg = ctx.arrived(si, m, incoming);
 
+  const rt::ShadingFrame sf(si, m);
+  thread_local NearestPhotons scratch;
   if (settings_.view != PhotonView::Full) {
     const bool global = settings_.view == PhotonView::GlobalMap;
-    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(global ? state.maps.global : state.maps.caustic,
-                                                            global ? globalDensity_ : causticDensity_, si, m));
+    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(m, sf, global ? state.maps.global : state.maps.caustic, nullptr,
+                                                            si, global ? globalDensity_ : causticDensity_, scratch));
     return;
   }
 
-  const rt::ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
   // One of `of` rays that share a weight: the cut-off applies to their sum, not to each.
@@ -192,9 +191,8 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   // kind (a glossy ray its bsdfPdf > 0 mark).
   const bool secondary = msg.kind == RayKind::Gather || (msg.kind == RayKind::Continuation && msg.bsdfPdf > 0.0f);
   if (secondary) {
-    thread_local NearestPhotons scratch;
-    out.addRadiance(msg.pixel, msg.throughput * globalMapRadiance(m, state.maps.global, &state.irradiance, si,
-                                                                  globalDensity_, scratch));
+    out.addRadiance(msg.pixel, msg.throughput * mapRadiance(m, sf, state.maps.global, &state.irradiance, si, globalDensity_,
+                                                            scratch, MapRead::Secondary, ctx.sample(msg, kMapReadDim)));
     if (msg.depth >= options().maxDepth) return;
     glm::vec3 wi, factor;
     if (!idealSpecularBounce(m, si, sf, ctx.sample(msg, rt::Dim::kLobe), wi, factor)) return;
@@ -211,29 +209,26 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   const glm::vec3 le = ctx.emitted(m, si, out);
   if (rt::maxComponent(le) > 0.0f) out.addRadiance(msg.pixel, msg.throughput * le);
   if (msg.depth >= options().maxDepth) return;
-  // An anisotropic material's glossy lobe is Ward's, in the shading frame, which ShadingFrame
-  // turned to the anisotropy direction (m.anisotropy is 0 when the plan has anisotropy off).
-  const bool ward = m.anisotropy > 0.0f && m.hasSpecular() && !m.deltaSpecular();
-  const WardLobe lobe = ward ? wardLobe(m) : WardLobe{};
-  if (ward) {
-    const glm::vec3 diffuseF = m.diffuseColor() * rt::kInvPi;
-    const rt::IntegratorContext::OpaqueEval eval = [&](const glm::vec3& woLocal, const glm::vec3& wiLocal) {
-      return diffuseF + evalWard(lobe, woLocal, wiLocal);
-    };
-    ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_, &eval);
-  } else {
-    ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_);
-  }
+  ctx.directLight(si, m, sf.frame, sf.woLocal, msg, opaque, false, out, areaSamples_);
 
-  // The diffuse part: caustics from the caustic map, indirect light from the cache, both
-  // smooth over many pixels, so read by a stratified subset of the pixel's samples only.
+  // Caustics and indirect light are smooth over many pixels, so read by a stratified subset of
+  // the pixel's samples only. Caustics from the caustic map with the full non-delta BRDF (the
+  // layers and the glossy lobe too: light focused by a mirror seen in a glossy floor); glossy
+  // caustics - light that came along glossy bounces but no diffuse one, which gather rays
+  // leave out - from the global map where they land.
   const float smooth = smoothWeight(msg.sample);
-  const glm::vec3 diffuse = m.diffuseColor() * smooth;
-  if (rt::maxComponent(diffuse) > 0.0f) {
+  if (smooth > 0.0f && m.hasNonDeltaPart()) {
     if (!ctx.simulates(scene::Effect::Caustics))
       ++out.stats().causticRaysSkipped;
     else if (!state.maps.caustic.empty())
-      out.addRadiance(msg.pixel, msg.throughput * smooth * mapRadiance(state.maps.caustic, causticDensity_, si, m));
+      out.addRadiance(msg.pixel, msg.throughput * smooth * mapRadiance(m, sf, state.maps.caustic, nullptr, si, causticDensity_, scratch));
+    if (state.glossyCaustics)
+      out.addRadiance(msg.pixel, msg.throughput * smooth * mapRadiance(m, sf, state.maps.global, nullptr, si, globalDensity_,
+                                                                       scratch, MapRead::GlossyCaustic));
+  }
+  // Indirect light on the diffuse base (under its layers) from the cache.
+  const glm::vec3 diffuse = m.diffuseColor() * (smooth * rt::diffuseLayerScale(m, sf.woLocal));
+  if (rt::maxComponent(diffuse) > 0.0f) {
     glm::vec3 irradiance;
     if (!ctx.simulates(scene::Effect::IndirectDiffuse)) {
       ++out.stats().indirectRaysSkipped;
@@ -254,27 +249,31 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     }
   }
 
-  // The opaque specular lobe: one ideal mirror ray, or Monte Carlo glossy rays (more the
-  // rougher the lobe and the larger its share of the reflectance - a dielectric's 4 % layer
-  // over a diffuse base gets one - and one below the first hit), whose hits read the global map.
-  if (opaque > 0.0f && m.hasSpecular()) {
-    if (m.deltaSpecular()) {
-      if (glm::dot(mirror(), sf.ng) > 0.0f)
-        spawn(scene::Effect::IdealSpecular, &rt::TraceStats::specularRaysSkipped,
-              ctx.continuation(si, msg, mirror(), msg.throughput * m.specularFresnel(sf.woLocal.z), 0.0f));
-    } else {
-      const float share = rt::specularProbability(m, sf.woLocal.z);
-      const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness * share))) : 1;
-      for (int i = 0; i < n; ++i) {
-        const float u = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i)), v = ctx.sample(msg, kGlossyDim + 2u * std::uint32_t(i) + 1u);
-        const rt::BsdfSample s = ward ? sampleWard(lobe, sf.woLocal, u, v) : rt::sampleGlossy(m, sf.woLocal, u, v);
-        if (!s.valid) continue;
-        const glm::vec3 wi = sf.frame.toWorld(s.wi);
-        if (glm::dot(wi, sf.ng) <= 0.0f) continue;
-        // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
-        spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,
-              ctx.continuation(si, msg, wi, msg.throughput * s.weight / float(n), std::max(s.pdf, 1.0e-30f)), n);
-      }
+  // An ideal mirror base: one ray, under the coat's share.
+  if (opaque > 0.0f && m.hasSpecular() && m.deltaSpecular() && glm::dot(mirror(), sf.ng) > 0.0f)
+    spawn(scene::Effect::IdealSpecular, &rt::TraceStats::specularRaysSkipped,
+          ctx.continuation(si, msg, mirror(),
+                           msg.throughput * m.specularFresnel(sf.woLocal.z) * rt::baseLayerWeight(m, sf.woLocal), 0.0f));
+  // The other non-Lambertian lobes (a rough specular lobe, sheen, clear coat): Monte Carlo
+  // glossy rays whose hits read the global map, more the rougher the lobes and the larger their
+  // share of the reflectance - a dielectric's 4 % layer over a diffuse base gets one - and one
+  // below the first hit.
+  if (opaque > 0.0f && rt::hasNonLambertian(m)) {
+    float spread = 0.0f;
+    if (m.hasSpecular() && !m.deltaSpecular()) spread = m.roughness * rt::specularProbability(m, sf.woLocal.z);
+    if (m.hasClearcoat()) spread = std::max(spread, m.clearcoatRoughness * rt::coatProbability(m, sf.woLocal));
+    if (m.hasSheen()) spread = std::max(spread, m.sheenRoughness * rt::maxComponent(m.sheenColor));
+    const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * spread))) : 1;
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t dim = kGlossyDim + 3u * std::uint32_t(i);
+      const rt::BsdfSample s = rt::sampleNonLambertian(m, sf.woLocal, ctx.sample(msg, dim), ctx.sample(msg, dim + 1u),
+                                                       ctx.sample(msg, dim + 2u));
+      if (!s.valid) continue;
+      const glm::vec3 wi = sf.frame.toWorld(s.wi);
+      if (glm::dot(wi, sf.ng) <= 0.0f) continue;
+      // bsdfPdf > 0 marks the ray as glossy: its hit reads the global map.
+      spawn(scene::Effect::GlossySpecular, &rt::TraceStats::glossyRaysSkipped,
+            ctx.continuation(si, msg, wi, msg.throughput * s.weight / float(n), std::max(s.pdf, 1.0e-30f)), n);
     }
   }
 

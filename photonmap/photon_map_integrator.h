@@ -3,13 +3,17 @@
 // seen from the eye split into
 //   - emission and direct light, by next-event estimation (shadow rays; several on area lights),
 //   - ideal specular reflection and refraction, by one ray each (Fresnel-weighted),
-//   - glossy reflection, by Monte Carlo rays from the GGX lobe (Ward's anisotropic lobe for
-//     KHR_materials_anisotropy), as many as the roughness asks,
-//   - caustics, straight from the caustic map (cone filter),
+//   - glossy reflection (the rough GGX lobe, anisotropic for KHR_materials_anisotropy, sheen and
+//     clear coat), by Monte Carlo rays, as many as the lobes' roughness asks,
+//   - caustics, straight from the caustic map (cone filter) with the full non-delta BRDF, and
+//     glossy caustics (light that came along glossy bounces but no diffuse one) from the
+//     global map where they land,
 //   - indirect diffuse light, by final gathering whose hits read the global map, through an
 //     irradiance cache with Ward-Heckbert gradients built in a pre-pass over the image.
-// Hits of glossy and gathering rays read the global map for all their light (Jensen's rule
-// for paths after a diffuse or glossy bounce). The pre-pass (prePass: photon tracing, both
+// Hits of glossy and gathering rays read the global map for all their light after a diffuse
+// bounce (Jensen's rule), with the hit's full non-delta BRDF and each photon's direction; the
+// photons' PhotonPath bits keep each path in exactly one term.
+// The BSDF is the other integrators' (raytrace/integrators/bsdf.h), in both passes. The pre-pass (prePass: photon tracing, both
 // kd-trees, cache records) runs through the render's own tracer before the render; every shade
 // call after it only reads the maps and the cache, so shading is the same ray-message state
 // machine as the other integrators and gives the same image for every tracer, P and schedule.
@@ -97,11 +101,8 @@ class PhotonMapIntegrator final : public rt::IntegratorBase<PhotonMapIntegrator>
     PhotonMaps maps;
     PrecomputedIrradiance irradiance;
     IrradianceCache cache;
+    bool glossyCaustics = false;  // some global photon took a glossy bounce and no diffuse one
   };
-  // The map's Lambertian radiance at si: diffuse colour / pi x E.
-  glm::vec3 mapRadiance(const KdTree& map, const DensityOptions& density, const rt::SurfaceInteraction& si,
-                        const rt::ShadingMaterial& m) const;
-
   // The weight of sample `sample`'s caustic and indirect estimates: 0 outside the stratified
   // subset of the pixel's samples that reads them, the subset's inverse share inside it.
   float smoothWeight(std::uint16_t sample) const;

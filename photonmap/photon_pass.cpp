@@ -34,7 +34,8 @@ std::uint64_t keyOf(PhotonMapKind map, std::uint32_t index, int bounce) {
 
 // RayMessage fields as the program uses them: pixel = program pixel (the photon), depth = the
 // interaction the ray leads to (bounce), throughput = the photon's power, bsdfPdf = the range
-// of its punctual light while depth is 0 (applied at the first hit; 0 = none).
+// of its punctual light while depth is 0 (applied at the first hit; 0 = none), sample = the
+// PhotonPath bits of the reflections so far.
 class PhotonProgram final : public rt::IntegratorBase<PhotonProgram> {
  public:
   PhotonProgram(const scene::Scene& scene, const scene::Camera& camera, int width, int height,
@@ -73,7 +74,8 @@ class PhotonProgram final : public rt::IntegratorBase<PhotonProgram> {
     rt::Hit hit;
     hit.t = si.t;
     const PhotonInteraction step =
-        source_.interact(map, index, msg.depth, msg.throughput, msg.depth == 0 ? msg.bsdfPdf : 0.0f, msg.ray, hit, si);
+        source_.interact(map, index, msg.depth, msg.throughput, msg.depth == 0 ? msg.bsdfPdf : 0.0f,
+                         std::uint8_t(msg.sample), msg.ray, hit, si);
     PerPe& mine = perPe_[std::size_t(out.pe())];
     if (step.stored) {
       mine.stored.push_back({keyOf(map, index, msg.depth), step.photon, step.normal});
@@ -85,6 +87,7 @@ class PhotonProgram final : public rt::IntegratorBase<PhotonProgram> {
     next.throughput = step.power;
     next.depth = std::uint8_t(msg.depth + 1);
     next.bsdfPdf = 0.0f;
+    next.sample = step.path;
     out.push(next);
   }
 

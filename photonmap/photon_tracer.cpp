@@ -356,7 +356,7 @@ bool emit(const Setup& s, int map, std::size_t e, std::size_t index, EmittedPhot
 
 // One surface interaction of photon `index` of `map` (see photonInteraction in the header).
 PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bounce, glm::vec3 power, float range,
-                           const rt::Ray& ray, const rt::Hit& hit, const rt::SurfaceInteraction& si) {
+                           std::uint8_t path, const rt::Ray& ray, const rt::Hit& hit, const rt::SurfaceInteraction& si) {
   PhotonInteraction out;
   const bool caustic = map == kCausticStream;
   const std::uint64_t seed = s.options->seed;
@@ -366,24 +366,26 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   power *= rt::volumeTransmittance(m, si, ray);
   const auto sample = [&](std::uint32_t dim) { return rt::sample1D(seed, index, map, std::uint32_t(bounce + 1), dim); };
 
-  // Storage: the photon's incident flux wherever the surface has a diffuse part, whatever the
-  // photon does next (the estimate weighs it by the diffuse part's BRDF). The caustic map keeps
-  // only the photons that came along L S+: every earlier interaction of a caustic photon was a
-  // specular choice, so any but its first hit (the specular object it was aimed at, or what
-  // stood before it) is one.
-  if (rt::maxComponent(m.diffuseColor()) > 0.0f && (!caustic || bounce > 0)) {
+  // Storage: the photon's incident flux and direction wherever the surface has a part that is
+  // not a perfect mirror (diffuse, a rough specular lobe, sheen, a clear coat), whatever the
+  // photon does next: the estimates weigh it by that part's BRDF for its direction. The caustic
+  // map keeps only the photons that came along L S+: every earlier interaction of a caustic
+  // photon was a specular choice, so any but its first hit (the specular object it was aimed
+  // at, or what stood before it) is one.
+  if (m.hasNonDeltaPart() && (!caustic || bounce > 0)) {
     out.stored = true;
-    out.photon = Photon::make(si.position, power, si.wo, caustic ? PhotonMapKind::Caustic : PhotonMapKind::Global, bounce);
+    out.photon = Photon::make(si.position, power, si.wo, caustic ? PhotonMapKind::Caustic : PhotonMapKind::Global, bounce, path);
     out.normal = si.frontFace ? si.geometricNormal : -si.geometricNormal;
   }
 
-  // Choose the part by Russian roulette over the whole BSDF, like the path tracer: the
-  // dielectric with probability equal to its weight, reflection against refraction by the
-  // Fresnel term, else the opaque lobes (probability 1 - dielectric, divided out) by
-  // sampleOpaque's lobe choice. Each choice's probability cancels its weight, so the factor
-  // left, f cos / pdf, is the part's albedo along the sampled direction. A caustic photon goes
-  // on only through a specular choice (Jensen): one the diffuse or glossy part takes has left
-  // L S+ D, and was stored above if the part is diffuse.
+  // Choose the part by Russian roulette over the whole BSDF: the dielectric with probability
+  // equal to its weight, reflection against refraction by the Fresnel term, else one
+  // component of the opaque part (probability 1 - dielectric, divided out) - the Lambertian
+  // base, the glossy lobes or an ideal mirror - weighted by its own BRDF, so the reflection the
+  // photon takes is of that kind and its path's PhotonPath bits say so. Each choice's
+  // probability cancels its weight, so the factor left, f cos / pdf, is the part's albedo along
+  // the sampled direction. A caustic photon goes on only through a specular choice (Jensen):
+  // one the diffuse or glossy part takes has left L S+, and was stored above.
   const rt::ShadingFrame sf(si, m);
   const float dielectric = m.dielectricWeight();
   const float opaque = 1.0f - dielectric;
@@ -405,12 +407,15 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
     specular = true;
   } else {
     const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, rt::kOneMinusEpsilon);
-    const rt::BsdfSample b = rt::sampleOpaque(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));
+    const rt::PartSample part = rt::sampleOpaquePart(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));
+    const rt::BsdfSample& b = part.sample;
     if (!b.valid) return out;
     wi = sf.frame.toWorld(b.wi);
     if (glm::dot(wi, sf.ng) <= 0.0f) return out;  // a reflection leaves on the side it arrived from
     factor = b.weight / opaque;
     specular = b.delta;
+    if (part.part == rt::OpaquePart::Diffuse) path |= PhotonPath::kDiffuse;
+    if (part.part == rt::OpaquePart::Glossy) path |= PhotonPath::kGlossy;
   }
   if (caustic && !specular) return out;  // glossy or diffuse: no longer an L S+ D path
 
@@ -423,6 +428,7 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   if (!(rt::maxComponent(power) > 0.0f) || !rt::isFinite(power) || bounce + 1 >= s.options->maxBounces) return out;
   out.continues = true;
   out.power = power;
+  out.path = path;
   out.next = rt::spawnRay(si, wi);
   return out;
 }
@@ -541,9 +547,9 @@ bool PhotonSource::emit(PhotonMapKind map, std::size_t index, EmittedPhoton& out
 }
 
 PhotonInteraction PhotonSource::interact(PhotonMapKind map, std::uint32_t index, int bounce, const glm::vec3& power,
-                                         float range, const rt::Ray& ray, const rt::Hit& hit,
+                                         float range, std::uint8_t path, const rt::Ray& ray, const rt::Hit& hit,
                                          const rt::SurfaceInteraction& si) const {
-  return pm::interact(impl_->setup, int(map), index, bounce, power, range, ray, hit, si);
+  return pm::interact(impl_->setup, int(map), index, bounce, power, range, path, ray, hit, si);
 }
 
 void tracePhoton(const PhotonSource& source, const scene::Scene& scene, const rt::Bvh& bvh, PhotonMapKind map,
@@ -552,10 +558,11 @@ void tracePhoton(const PhotonSource& source, const scene::Scene& scene, const rt
   if (!source.emit(map, index, photon)) return;
   rt::Ray ray = photon.ray;
   glm::vec3 power = photon.power;
+  std::uint8_t path = 0;
   for (int bounce = 0;; ++bounce) {
     rt::Hit hit;
     if (!bvh.intersect(ray, hit)) return;
-    const PhotonInteraction step = source.interact(map, index, bounce, power, photon.range, ray, hit,
+    const PhotonInteraction step = source.interact(map, index, bounce, power, photon.range, path, ray, hit,
                                                    rt::makeInteraction(scene, ray, hit));
     if (step.stored) {
       store.push_back(step.photon);
@@ -564,6 +571,7 @@ void tracePhoton(const PhotonSource& source, const scene::Scene& scene, const rt
     if (!step.continues) return;
     ray = step.next;
     power = step.power;
+    path = step.path;
   }
 }
 

@@ -75,7 +75,8 @@ struct EmittedPhoton {
 };
 
 // What one surface interaction does with a photon: stores it (on the surface with normal
-// `normal`), and continues it along `next` with `power`, or ends it.
+// `normal`), and continues it along `next` with `power` and the PhotonPath bits of its path so
+// far, or ends it.
 struct PhotonInteraction {
   bool stored = false;
   Photon photon;
@@ -83,6 +84,7 @@ struct PhotonInteraction {
   bool continues = false;
   rt::Ray next;
   glm::vec3 power{0.0f};
+  std::uint8_t path = 0;
 };
 
 // The emitters, projection map and photon split of one pass 1, built once by the controlling
@@ -101,9 +103,11 @@ class PhotonSource {
   PhotonStats plan() const;
   // Photon `index` of `map` leaving its light; false when it carries no power (or index is out of range).
   bool emit(PhotonMapKind map, std::size_t index, EmittedPhoton& out) const;
-  // Its interaction number `bounce` (0 = the first surface hit) at si, reached along ray with power.
+  // Its interaction number `bounce` (0 = the first surface hit) at si, reached along ray with
+  // power after the reflections `path` (PhotonPath bits; 0 as it leaves the light).
   PhotonInteraction interact(PhotonMapKind map, std::uint32_t index, int bounce, const glm::vec3& power, float range,
-                             const rt::Ray& ray, const rt::Hit& hit, const rt::SurfaceInteraction& si) const;
+                             std::uint8_t path, const rt::Ray& ray, const rt::Hit& hit,
+                             const rt::SurfaceInteraction& si) const;
 
  private:
   struct Impl;

@@ -218,21 +218,23 @@ BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, 
 
 namespace {
 
-// The base (diffuse + GGX) with the sheen layer over it: the base loses what the sheen's
-// directional albedo takes, so the pair never reflects more than the base alone could.
-glm::vec3 evalBaseAndSheen(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
-  glm::vec3 f = m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi);
-  if (!m.hasSheen()) return f;
-  const glm::vec3 h = glm::normalize(wo + wi);
-  const float r = m.sheenRoughness;
-  const float scale = 1.0f - maxComponent(m.sheenColor) * std::max(scene::sheenAlbedo(r, wo.z), scene::sheenAlbedo(r, wi.z));
-  return f * scale + m.sheenColor * scene::sheenLobe(r, h.z, wi.z, wo.z);
-}
-
 // The clear coat's share of the reflection towards wo (its Fresnel term times its factor).
 float coatWeight(const ShadingMaterial& m, const glm::vec3& wo) {
   if (!m.hasClearcoat()) return 0.0f;
   return m.clearcoat * scene::coatFresnel(std::max(glm::dot(m.clearcoatNormal, wo), 0.0f));
+}
+
+// What the sheen leaves the base for the pair (wo, wi): the base loses the sheen's directional
+// albedo, so the pair never reflects more than the base alone could.
+float sheenScale(const ShadingMaterial& m, float cosO, float cosI) {
+  const float r = m.sheenRoughness;
+  return 1.0f - maxComponent(m.sheenColor) * std::max(scene::sheenAlbedo(r, cosO), scene::sheenAlbedo(r, cosI));
+}
+
+// The Lambertian base as the layers leave it: diffuse / pi, less the sheen's and the coat's share.
+glm::vec3 layeredDiffuse(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  const float sheen = m.hasSheen() ? sheenScale(m, wo.z, wi.z) : 1.0f;
+  return m.diffuseColor() * (kInvPi * sheen * (1.0f - coatWeight(m, wo)));
 }
 
 glm::vec3 evalCoat(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
@@ -240,6 +242,17 @@ glm::vec3 evalCoat(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec
   const glm::vec3 h = glm::normalize(wo + wi);
   return glm::vec3(m.clearcoat * scene::coatLobe(m.clearcoatRoughness, glm::dot(n, h), glm::dot(n, wi), glm::dot(n, wo),
                                                  glm::dot(wo, h)));
+}
+
+// The sheen and clear-coat layers over a base reflection f_base(wo, wi): the base scaled by
+// what the layers leave it, plus the layers' own lobes.
+glm::vec3 overLayers(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi, glm::vec3 base) {
+  if (m.hasSheen()) {
+    const glm::vec3 h = glm::normalize(wo + wi);
+    base = base * sheenScale(m, wo.z, wi.z) + m.sheenColor * scene::sheenLobe(m.sheenRoughness, h.z, wi.z, wo.z);
+  }
+  if (m.hasClearcoat()) base = base * (1.0f - coatWeight(m, wo)) + evalCoat(m, wo, wi);
+  return base;
 }
 
 // Pdf of a GGX reflection about the coat normal.
@@ -265,9 +278,78 @@ float coatProbability(const ShadingMaterial& m, const glm::vec3& wo) { return st
 
 glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
-  const glm::vec3 base = evalBaseAndSheen(m, wo, wi);
-  if (!m.hasClearcoat()) return base;
-  return base * (1.0f - coatWeight(m, wo)) + evalCoat(m, wo, wi);
+  return overLayers(m, wo, wi, m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi));
+}
+
+float baseLayerWeight(const ShadingMaterial& m, const glm::vec3& wo) { return 1.0f - coatWeight(m, wo); }
+
+float diffuseLayerScale(const ShadingMaterial& m, const glm::vec3& wo) {
+  float scale = baseLayerWeight(m, wo);
+  if (!m.hasSheen()) return scale;
+  // The cosine-weighted mean over wi of the sheen's scale: cos^2 theta_i uniform in [0, 1).
+  constexpr int kSteps = 16;
+  float mean = 0.0f;
+  for (int i = 0; i < kSteps; ++i) mean += sheenScale(m, wo.z, std::sqrt((float(i) + 0.5f) / float(kSteps)));
+  return scale * mean / float(kSteps);
+}
+
+bool hasNonLambertian(const ShadingMaterial& m) {
+  return (m.hasSpecular() && !m.deltaSpecular()) || m.hasSheen() || m.hasClearcoat();
+}
+
+glm::vec3 evalNonLambertian(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
+  return overLayers(m, wo, wi, evalGlossy(m, wo, wi));
+}
+
+namespace {
+
+// The lobes sampleNonLambertian draws from and their probabilities: the coat by its weight,
+// the rough specular lobe, and the cosine hemisphere for sheen (alone, or a fifth beside the
+// specular lobe, whose narrow peak would leave the broad sheen lobe undersampled).
+struct NonLambertianLobes {
+  float coat = 0.0f, glossy = 0.0f, cosine = 0.0f;
+  NonLambertianLobes(const ShadingMaterial& m, const glm::vec3& wo) {
+    const bool rough = m.hasSpecular() && !m.deltaSpecular();
+    coat = m.hasClearcoat() ? coatProbability(m, wo) : 0.0f;
+    const float rest = 1.0f - coat;
+    glossy = rough ? rest * (m.hasSheen() ? 0.8f : 1.0f) : 0.0f;
+    cosine = m.hasSheen() ? rest - glossy : 0.0f;
+    const float total = coat + glossy + cosine;
+    if (total > 0.0f) {
+      coat /= total;
+      glossy /= total;
+      cosine /= total;
+    }
+  }
+  float pdf(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) const {
+    float p = cosine * wi.z * kInvPi;
+    if (coat > 0.0f) p += coat * coatPdf(m, wo, wi);
+    if (glossy > 0.0f) p += glossy * GlossyLobe(m).pdf(wo, wi);
+    return p;
+  }
+};
+
+}  // namespace
+
+BsdfSample sampleNonLambertian(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v) {
+  BsdfSample s;
+  if (wo.z <= 0.0f || !hasNonLambertian(m)) return s;
+  const NonLambertianLobes lobes(m, wo);
+  if (lobe < lobes.coat) {
+    const Frame coat(m.clearcoatNormal);
+    s.wi = coat.toWorld(ggxReflection(scene::coatAlpha(m.clearcoatRoughness), coat.toLocal(wo), u, v));
+  } else if (lobe < lobes.coat + lobes.glossy) {
+    s.wi = GlossyLobe(m).reflect(wo, u, v);
+  } else {
+    s.wi = cosineHemisphere(u, v);
+  }
+  if (s.wi.z <= 0.0f) return s;
+  s.pdf = lobes.pdf(m, wo, s.wi);
+  if (!(s.pdf > 0.0f) || !std::isfinite(s.pdf)) return s;
+  s.weight = evalNonLambertian(m, wo, s.wi) * (s.wi.z / s.pdf);
+  s.valid = isFinite(s.weight);
+  return s;
 }
 
 float pdfOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
@@ -314,6 +396,49 @@ BsdfSample sampleOpaque(const ShadingMaterial& m, const glm::vec3& wo, float lob
   s.weight = evalOpaque(m, wo, s.wi) * (s.wi.z / s.pdf);
   s.valid = isFinite(s.weight);
   return s;
+}
+
+PartSample sampleOpaquePart(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v) {
+  PartSample out;
+  BsdfSample& s = out.sample;
+  if (wo.z <= 0.0f) return out;
+  // Choice probabilities from each component's reflectance towards wo (luminance).
+  const bool mirror = m.hasSpecular() && m.deltaSpecular();
+  const float wMirror = mirror ? luminance(m.specularFresnel(wo.z)) * baseLayerWeight(m, wo) : 0.0f;
+  const float wDiffuse = luminance(m.diffuseColor()) * diffuseLayerScale(m, wo);
+  float wGlossy = 0.0f;
+  if (hasNonLambertian(m)) {
+    if (m.hasSpecular() && !m.deltaSpecular()) wGlossy += luminance(m.specularFresnel(wo.z));
+    if (m.hasClearcoat()) wGlossy += coatWeight(m, wo);
+    if (m.hasSheen()) wGlossy += maxComponent(m.sheenColor);
+  }
+  const float total = wMirror + wDiffuse + wGlossy;
+  if (!(total > 0.0f)) return out;
+  const float x = lobe * total;
+  if (x < wDiffuse) {
+    const float p = wDiffuse / total;
+    s.wi = cosineHemisphere(u, v);
+    if (s.wi.z <= 0.0f) return out;
+    // f = diffuse / pi under the layers; pdf = cos / pi.
+    s.pdf = p * s.wi.z * kInvPi;
+    s.weight = layeredDiffuse(m, wo, s.wi) * (kPi / p);
+    out.part = OpaquePart::Diffuse;
+  } else if (x < wDiffuse + wGlossy) {
+    s = sampleNonLambertian(m, wo, (x - wDiffuse) / wGlossy, u, v);
+    const float p = wGlossy / total;
+    s.weight /= p;
+    s.pdf *= p;
+    out.part = OpaquePart::Glossy;
+  } else {
+    const float p = wMirror / total;
+    s.wi = glm::vec3(-wo.x, -wo.y, wo.z);
+    s.weight = m.specularFresnel(wo.z) * (baseLayerWeight(m, wo) / p);
+    s.delta = true;
+    s.pdf = 0.0f;
+    out.part = OpaquePart::Mirror;
+  }
+  s.valid = s.wi.z > 0.0f && isFinite(s.weight) && (s.delta || s.pdf > 0.0f);
+  return out;
 }
 
 glm::vec3 sampleMicrofacetNormal(const ShadingMaterial& m, float u, float v) { return scene::ggxNormal(m.alpha, u, v); }

@@ -30,8 +30,8 @@ struct ShadingMaterial {
   glm::vec3 emission{0.0f};   // radiance (nits) leaving the emitting side
   bool doubleSided = false;
   // KHR_materials_anisotropy: strength in [0, 1] and the direction in the tangent plane, as
-  // (cos, sin) of its angle from the uv tangent (rotation and texture applied). The path tracer
-  // ignores them; the photon map's Ward lobe reads them.
+  // (cos, sin) of its angle from the uv tangent (rotation and texture applied), which
+  // ShadingFrame makes the local x axis of the anisotropic GGX lobe.
   float anisotropy = 0.0f;
   glm::vec2 anisotropyDirection{1.0f, 0.0f};
   // KHR_materials_specular: the dielectric Fresnel's F0 and F90 (0.04 and 1 without it).
@@ -80,6 +80,13 @@ struct ShadingMaterial {
   bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
   bool hasClearcoat() const { return clearcoat > 0.0f; }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }
+  // Whether the opaque part has a lobe that is not a perfect mirror - diffuse, a rough
+  // specular lobe, sheen or a clear coat (always sampled as a lobe): where photons are stored
+  // and the photon maps' estimates are read.
+  bool hasNonDeltaPart() const {
+    const glm::vec3 d = diffuseColor();
+    return d.x > 0.0f || d.y > 0.0f || d.z > 0.0f || (hasSpecular() && !deltaSpecular()) || hasSheen() || hasClearcoat();
+  }
   // Share of the smooth dielectric (refracting) part, and the probability with which the
   // samplers pick it over the opaque lobes.
   float dielectricWeight() const { return transmission * (1.0f - metallic); }
@@ -141,6 +148,32 @@ float microfacetWeight(const ShadingMaterial& m, const glm::vec3& wo, const glm:
 // GGX half-vector distribution with weight = f_s cos / pdf and its pdf.
 glm::vec3 evalGlossy(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi);
 BsdfSample sampleGlossy(const ShadingMaterial& m, const glm::vec3& wo, float u, float v);
+// The opaque part's lobes other than its Lambertian base - the rough specular lobe under the
+// layers, sheen and clear coat (evalOpaque less the layered diffuse term): what the photon
+// map's glossy rays carry at an eye point, where the base's light comes from the maps. Sampled
+// from the coat and specular lobes by their weights and the cosine hemisphere for sheen;
+// weight = f cos / pdf. hasNonLambertian: whether there is any such lobe.
+bool hasNonLambertian(const ShadingMaterial& m);
+glm::vec3 evalNonLambertian(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi);
+BsdfSample sampleNonLambertian(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// The opaque part sampled one component at a time, each weighted by its own BRDF alone
+// (weight = f_part cos / (P(part) pdf_part)), so the component a sample came from is the kind of
+// reflection it stands for: the layered Lambertian base, the non-Lambertian lobes above, or an
+// ideal mirror base (delta). The components' weights sum to the opaque BSDF's in expectation.
+// What photon tracing uses, whose paths are sorted by the kinds of reflection they took.
+enum class OpaquePart { Diffuse, Glossy, Mirror };
+struct PartSample {
+  BsdfSample sample;
+  OpaquePart part = OpaquePart::Diffuse;
+};
+PartSample sampleOpaquePart(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
+// What the clear coat leaves the layers under it towards wo (1 - its Fresnel weight).
+float baseLayerWeight(const ShadingMaterial& m, const glm::vec3& wo);
+// The share of the diffuse base left under the sheen and the clear coat towards wo for light
+// arriving alike from every direction (the sheen's loss depends on wi too; this is its
+// cosine-weighted mean): what turns irradiance known without directions (an irradiance-cache
+// record) into the layered diffuse radiance diffuseColor() / pi * E * scale. 1 without layers.
+float diffuseLayerScale(const ShadingMaterial& m, const glm::vec3& wo);
 // Probability that sampleOpaque picks the specular lobe (from Fresnel and diffuse luminance).
 float specularProbability(const ShadingMaterial& m, float cosO);
 // Probability that sampleOpaque picks the clear-coat lobe (its Fresnel weight towards wo).

@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include "photonmap/density_estimate.h"
@@ -113,22 +114,42 @@ TEST_CASE("DensityEstimate: photons behind a thin wall and back-face photons are
   CHECK(back.photons == 50);
 }
 
-TEST_CASE("DensityEstimate: too few photons give exactly zero") {
-  // 7 photons in the disc against the default minimum of 8: no light; an eighth: light.
+TEST_CASE("DensityEstimate: a sparse region keeps its photons over the maximum disc, unbiased") {
+  // 3 photons in the disc, fewer than k: their power over the whole maximum disc (the default
+  // keeps any count; a minimum of 8 would make the region black).
   std::vector<Photon> photons;
-  for (int i = 0; i < 7; ++i) photons.push_back(Photon::make({0.01f * i, 0, 0}, glm::vec3(1.0f), {0, 0, 1}));
+  for (int i = 0; i < 3; ++i) photons.push_back(Photon::make({0.01f * i, 0, 0}, glm::vec3(1.0f), {0, 0, 1}));
   DensityOptions options;
   options.k = 50;
   options.maxRadius = 0.1f;
-  REQUIRE(options.minPhotons == 8);
-  const auto seven = estimateIrradiance(KdTree::build(photons), {0, 0, 0}, {0, 0, 1}, options);
-  CHECK(seven.irradiance == glm::vec3(0.0f));
-  CHECK(seven.photons == 0);
-  photons.push_back(Photon::make({0, 0.01f, 0}, glm::vec3(1.0f), {0, 0, 1}));
-  const auto eight = estimateIrradiance(KdTree::build(photons), {0, 0, 0}, {0, 0, 1}, options);
-  CHECK(eight.photons == 8);
-  // Fewer than k found: the disc is the whole maximum radius, E = 8 / (pi 0.1^2).
-  CHECK(eight.irradiance.x == doctest::Approx(8.0f / (kPi * 0.01f)).epsilon(1e-5));
+  const auto three = estimateIrradiance(KdTree::build(photons), {0, 0, 0}, {0, 0, 1}, options);
+  CHECK(three.photons == 3);
+  CHECK(three.irradiance.x == doctest::Approx(3.0f / (kPi * 0.01f)).epsilon(1e-5));
+  options.minPhotons = 8;
+  CHECK(estimateIrradiance(KdTree::build(photons), {0, 0, 0}, {0, 0, 1}, options).irradiance == glm::vec3(0.0f));
+
+  // A faint field, 2 photons per maximum disc on average: the estimate's mean over many points
+  // is the field's irradiance (within 5 %), where a minimum of 8 photons would give almost none.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  const float power = 0.5f;
+  const int count = 2000;  // on the unit square: E = count * power
+  std::vector<Photon> field;
+  for (int i = 0; i < count; ++i) field.push_back(Photon::make({u(rng), u(rng), 0}, glm::vec3(power), {0, 0, 1}));
+  const KdTree map = KdTree::build(field);
+  options.maxRadius = std::sqrt(2.0f / (kPi * float(count)));
+  double sum = 0.0, trimmed = 0.0;
+  const int points = 4000;
+  for (int i = 0; i < points; ++i) {
+    const glm::vec3 x(0.1f + 0.8f * u(rng), 0.1f + 0.8f * u(rng), 0.0f);
+    options.minPhotons = 1;
+    sum += estimateIrradiance(map, x, {0, 0, 1}, options).irradiance.x;
+    options.minPhotons = 8;
+    trimmed += estimateIrradiance(map, x, {0, 0, 1}, options).irradiance.x;
+  }
+  const double expected = double(count) * power;
+  CHECK(sum / points == doctest::Approx(expected).epsilon(0.05));
+  CHECK(trimmed / points < 0.05 * expected);
 }
 
 TEST_CASE("DensityEstimate: radius zero, no photons, one photon and coincident photons are finite") {
@@ -145,6 +166,7 @@ TEST_CASE("DensityEstimate: radius zero, no photons, one photon and coincident p
   CHECK(zero(estimateIrradiance(one, x, n, options)));
   options.maxRadius = 0.1f;
   CHECK(zero(estimateIrradiance(KdTree::build({}), x, n, options)));  // no photons
+  options.minPhotons = 2;
   CHECK(zero(estimateIrradiance(one, x, n, options)));                  // one photon, below the minimum
   options.minPhotons = 1;
   const auto single = estimateIrradiance(one, x, n, options);           // one photon, allowed

@@ -153,6 +153,66 @@ TEST_CASE("PhotonMapIntegrator: the Cornell box is close to a long path-traced r
   CHECK(rmse(photon, reference) < 0.3 * mean);
 }
 
+TEST_CASE("PhotonMapIntegrator: a wall lit through a rough metal is within 3 % of a long path trace, block by block") {
+  // A diffuse wall and floor, a point light, and facing the wall a rough metal plate (roughness
+  // 0.3) that throws the light's glossy reflection onto it: an L G D path, about a tenth of the
+  // wall's light. The camera sees the wall and floor. Without glossy photons, gather rays found
+  // the metal black and the wall came out dark; read by gathering, the metal's highlight is
+  // sampled by few gather rays and the blocks scatter by +-7 %; as a glossy caustic read
+  // where it lands, the photon map at its default photon and gather counts is within 3 %
+  // (2.2 % measured). The reference's own noise is about 0.6 % per block at 8192 spp.
+  scene::Scene s;
+  const std::uint32_t wall = test::addMaterial(s, test::diffuse(0.7f));
+  scene::Material rough;
+  rough.baseColorFactor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
+  rough.metallicFactor = 1.0f;
+  rough.roughnessFactor = 0.3f;
+  const std::uint32_t metal = test::addMaterial(s, rough);
+  test::addGround(s, 2.0f, wall);
+  test::addTri(s, {-2, 0, -1}, {2, 0, -1}, {2, 2.5f, -1}, wall);  // facing +z
+  test::addTri(s, {-2, 0, -1}, {2, 2.5f, -1}, {-2, 2.5f, -1}, wall);
+  test::addTri(s, {-1.5f, 0, 1.2f}, {-1.5f, 2.5f, 1.2f}, {1.5f, 2.5f, 1.2f}, metal);  // facing -z
+  test::addTri(s, {-1.5f, 0, 1.2f}, {1.5f, 2.5f, 1.2f}, {1.5f, 0, 1.2f}, metal);
+  scene::PunctualLight light;
+  light.position = glm::vec3(0.0f, 2.0f, 0.2f);
+  light.intensity = 4.0f;
+  s.lights.push_back(light);
+  const scene::Camera cam = test::perspectiveAt({0.0f, 1.0f, 0.8f}, 1.2f);
+  constexpr int kN = 32;
+
+  rt::TraceOptions path;
+  path.integrator.kind = rt::IntegratorKind::Path;
+  path.integrator.spp = 8192;
+  path.integrator.maxDepth = 16;
+  par::Runtime runtime(2);
+  const image::Image reference = rt::renderRays(s, cam, kN, kN, path, "image-space", runtime).image;
+  rt::IntegratorOptions io;
+  io.spp = 4;
+  pm::PhotonMapSettings settings = smallSettings();
+  settings.globalPhotons = 200000;
+  settings.gatherRays = 256;
+  rt::TraceJob job{s, cam, kN, kN, {}};
+  job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kN, kN, io, settings);
+  const image::Image photon = rt::renderRays(job, "image-space", runtime).image;
+
+  double worst = 0.0;
+  for (int by = 0; by < kN; by += 8)
+    for (int bx = 0; bx < kN; bx += 8) {
+      double a = 0.0, b = 0.0;
+      for (int y = by; y < by + 8; ++y)
+        for (int x = bx; x < bx + 8; ++x) {
+          a += double(rt::luminance(photon.pixels[std::size_t(y * kN + x)]));
+          b += double(rt::luminance(reference.pixels[std::size_t(y * kN + x)]));
+        }
+      CAPTURE(bx);
+      CAPTURE(by);
+      REQUIRE(b > 0.0);
+      worst = std::max(worst, std::fabs(a / b - 1.0));
+      CHECK(a == doctest::Approx(b).epsilon(0.03));
+    }
+  MESSAGE("worst 8x8 block: " << worst * 100.0 << " %");
+}
+
 TEST_CASE("PhotonMapIntegrator: caustics off equals a render without caustic photons, and differs from one with") {
   const scene::Scene s = cornell();
   scene::EffectSet noCaustics = scene::EffectSet::all();

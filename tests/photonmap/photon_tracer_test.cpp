@@ -301,6 +301,36 @@ TEST_CASE("PhotonTracer: surfaces that are part diffuse, part specular still cas
   CHECK(smooth / white <= 0.6);
 }
 
+TEST_CASE("PhotonTracer: photons are stored on rough metal and not on a mirror, with their directions") {
+  // A metal floor under a point light: roughness 0.3 is a glossy lobe, which the estimates
+  // weigh by each photon's direction, so every first hit is stored, arriving from the light;
+  // roughness 0 is a perfect mirror, where no estimate is read and nothing is stored.
+  auto floorOf = [](float roughness) {
+    scene::Scene s;
+    scene::Material metal;
+    metal.baseColorFactor = glm::vec4(0.9f, 0.9f, 0.9f, 1.0f);
+    metal.metallicFactor = 1.0f;
+    metal.roughnessFactor = roughness;
+    test::addGround(s, 1.0f, test::addMaterial(s, metal));
+    scene::PunctualLight light;
+    light.position = glm::vec3(0.0f, 1.0f, 0.0f);
+    s.lights.push_back(light);
+    return s;
+  };
+  constexpr std::size_t kPhotons = 4000;
+  const pm::PhotonLists rough = traceLists(floorOf(0.3f), kPhotons, 0);
+  const pm::PhotonLists mirror = traceLists(floorOf(0.0f), kPhotons, 0);
+  CHECK(mirror.global.empty());
+  // Half the point light's photons go downwards; those within the floor's square are stored.
+  REQUIRE(rough.global.size() > kPhotons / 8);
+  double worst = 1.0;
+  for (const pm::Photon& p : rough.global) {
+    CHECK(p.bounces == 0);
+    worst = std::min(worst, double(glm::dot(p.incoming(), glm::normalize(glm::vec3(0, 1, 0) - p.position))));
+  }
+  CHECK(worst > std::cos(2.0 * kPi / 180.0));  // the stored direction points back at the light
+}
+
 TEST_CASE("PhotonTracer: the Cornell box's caustic map holds specular-path photons on diffuse surfaces") {
   const scene::Scene s = cornell();
   const rt::Bvh bvh(s);
