@@ -151,6 +151,9 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
     cache.gather.precomputed = &state_->irradiance;
     cache.gather.textures = ctx.simulates(scene::Effect::Textures);
     cache.gather.seed = options().seed;
+    // A mirror or refraction after the gathering point's diffuse bounce is a caustic path: with
+    // the plan's caustics off, gather rays end at ideal specular surfaces, as the path tracer's do.
+    if (!ctx.simulates(scene::Effect::Caustics)) cache.gather.specularBounces = 0;
     cache.accuracy = settings_.cacheAccuracy;
     cache.maxDepth = options().maxDepth;
     cache.camera = options();
@@ -196,6 +199,11 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     if (msg.depth >= options().maxDepth) return;
     glm::vec3 wi, factor;
     if (!idealSpecularBounce(m, si, sf, ctx.sample(msg, rt::Dim::kLobe), wi, factor)) return;
+    // After the diffuse or glossy bounce that made this ray: a caustic path (as in the cache pass).
+    if (!ctx.simulates(scene::Effect::Caustics)) {
+      ++out.stats().causticRaysSkipped;
+      return;
+    }
     RayMessage next = ctx.continuation(si, msg, wi, msg.throughput * factor, msg.kind == RayKind::Gather ? 0.0f : msg.bsdfPdf);
     next.kind = msg.kind;
     if (msg.kind == RayKind::Gather)
