@@ -79,7 +79,7 @@ fs::path generate(const std::string& scratch, const std::string& file, const std
 }  // namespace
 
 TEST_CASE("Generate: regenerating each committed scene reproduces it byte for byte") {
-  for (const char* name : {"cornell", "cornell-diffuse", "hotspot"}) {
+  for (const char* name : {"cornell", "cornell-diffuse", "cornell-glass", "hotspot"}) {
     CAPTURE(name);
     const fs::path committed = pr::test::sourceDir() / "scenes" / (std::string(name) + ".gltf");
     REQUIRE(fs::is_regular_file(committed));
@@ -161,6 +161,23 @@ TEST_CASE("Generate: cornell-diffuse has the same box with white diffuse spheres
     CHECK(mat.pbrMetallicRoughness.roughnessFactor == 1.0);
     CHECK(mat.pbrMetallicRoughness.baseColorFactor[0] == mat.pbrMetallicRoughness.baseColorFactor[2]);
   }
+  CHECK(findNode(m, "light") != nullptr);
+  CHECK(m.cameras.size() == 1);
+}
+
+TEST_CASE("Generate: cornell-glass has the box with the glass sphere in front and a white diffuse one behind") {
+  auto m = loadModel(generate("generate_cornell_glass", "cornell-glass.gltf", "cornell-glass"));
+  CHECK(findMaterial(m, "mirror") == nullptr);
+  const auto* glass = findNode(m, "glass sphere");
+  const auto* back = findNode(m, "back sphere");
+  REQUIRE(glass);
+  REQUIRE(back);
+  const auto& glassMaterial = m.materials.at(m.meshes.at(glass->mesh).primitives[0].material);
+  CHECK(glassMaterial.extensions.count("KHR_materials_transmission") == 1);
+  const auto& backMaterial = m.materials.at(m.meshes.at(back->mesh).primitives[0].material);
+  CHECK(backMaterial.extensions.count("KHR_materials_transmission") == 0);
+  CHECK(backMaterial.extensions.count("KHR_materials_specular") == 1);  // specularFactor 0: Lambertian
+  CHECK(backMaterial.pbrMetallicRoughness.metallicFactor == 0.0);
   CHECK(findNode(m, "light") != nullptr);
   CHECK(m.cameras.size() == 1);
 }

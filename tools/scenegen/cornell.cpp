@@ -1,7 +1,9 @@
 // The `cornell` and `cornell-diffuse` scenes: the classic Cornell box (dimensions of the
 // Cornell measurement, in units of 100 mm) with two spheres under a ceiling area light, the
 // test scene of Jensen 1996, figure 6 (glass sphere front right, mirror sphere back left).
-// `cornell` is the default scene; `cornell-diffuse` swaps both spheres for white diffuse.
+// `cornell` is the default scene; `cornell-diffuse` swaps both spheres for white diffuse;
+// `cornell-glass` keeps the glass sphere and makes the other white diffuse (the photon map's
+// accuracy benchmark: caustics through glass and colour bleeding, no mirror).
 #include <cmath>
 
 #include "tools/scenegen/scene_registry.h"
@@ -14,7 +16,10 @@ namespace {
 constexpr float kWidth = 5.56f, kHeight = 5.488f, kDepth = 5.592f;
 constexpr float kSphereRadius = 1.0f;
 
-void buildBox(GltfBuilder& b, const SceneParams& params, bool specularSpheres) {
+// What the two spheres are made of (back left, front right).
+enum class Spheres { MirrorAndGlass, Diffuse, DiffuseAndGlass };
+
+void buildBox(GltfBuilder& b, const SceneParams& params, Spheres spheres) {
   // Reflectances of the Cornell box paints (about 0.73 white, red and green as measured),
   // purely Lambertian as in Jensen's box: KHR_materials_specular 0, no Fresnel layer.
   const int white = b.addMaterial({.name = "white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}, .specular = 0.0f});
@@ -45,20 +50,24 @@ void buildBox(GltfBuilder& b, const SceneParams& params, bool specularSpheres) {
   // Spheres: one tessellation shared by both (instanced by node translation).
   const int segments = params.size;
   const MeshData sphere = makeUvSphere(kSphereRadius, segments, segments / 2);
-  int mirrorMaterial, glassMaterial;
-  if (specularSpheres) {
-    mirrorMaterial = b.addMaterial({.name = "mirror", .baseColor = glm::vec4(1.0f), .metallic = 1.0f, .roughness = 0.0f});
-    glassMaterial = b.addMaterial(
-        {.name = "glass", .baseColor = glm::vec4(1.0f), .roughness = 0.0f, .transmission = 1.0f, .ior = 1.5f});
-  } else {
-    mirrorMaterial = glassMaterial = b.addMaterial({.name = "sphere white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}, .specular = 0.0f});
-  }
-  const int mirrorMesh = b.addMesh(specularSpheres ? "mirror sphere" : "back sphere", sphere, mirrorMaterial);
-  const int glassMesh = specularSpheres ? b.addMeshSharingGeometry("glass sphere", mirrorMesh, glassMaterial) : mirrorMesh;
-  b.addMeshNode(specularSpheres ? "mirror sphere" : "back sphere", mirrorMesh,
-                {.translation = {1.6f, kSphereRadius, -3.6f}});
-  b.addMeshNode(specularSpheres ? "glass sphere" : "front sphere", glassMesh,
-                {.translation = {3.8f, kSphereRadius, -1.8f}});
+  const int diffuseSphere =
+      spheres == Spheres::MirrorAndGlass ? -1
+                                         : b.addMaterial({.name = "sphere white", .baseColor = {0.73f, 0.73f, 0.73f, 1.0f}, .specular = 0.0f});
+  const int backMaterial =
+      spheres == Spheres::MirrorAndGlass
+          ? b.addMaterial({.name = "mirror", .baseColor = glm::vec4(1.0f), .metallic = 1.0f, .roughness = 0.0f})
+          : diffuseSphere;
+  const int frontMaterial =
+      spheres == Spheres::Diffuse
+          ? diffuseSphere
+          : b.addMaterial({.name = "glass", .baseColor = glm::vec4(1.0f), .roughness = 0.0f, .transmission = 1.0f, .ior = 1.5f});
+  const bool specularBack = spheres == Spheres::MirrorAndGlass, glassFront = spheres != Spheres::Diffuse;
+  const int backMesh = b.addMesh(specularBack ? "mirror sphere" : "back sphere", sphere, backMaterial);
+  const int frontMesh = frontMaterial == backMaterial ? backMesh
+                                                      : b.addMeshSharingGeometry(glassFront ? "glass sphere" : "front sphere",
+                                                                                 backMesh, frontMaterial);
+  b.addMeshNode(specularBack ? "mirror sphere" : "back sphere", backMesh, {.translation = {1.6f, kSphereRadius, -3.6f}});
+  b.addMeshNode(glassFront ? "glass sphere" : "front sphere", frontMesh, {.translation = {3.8f, kSphereRadius, -1.8f}});
 
   // Camera of the Cornell data: 8 units in front of the opening on the box's axis, a 35 mm
   // lens on a 25 mm film: yfov = 2 atan(12.5 / 35) = 39.3 degrees, square image.
@@ -69,7 +78,8 @@ void buildBox(GltfBuilder& b, const SceneParams& params, bool specularSpheres) {
 
 }  // namespace
 
-void buildCornell(GltfBuilder& builder, const SceneParams& params) { buildBox(builder, params, true); }
-void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params) { buildBox(builder, params, false); }
+void buildCornell(GltfBuilder& builder, const SceneParams& params) { buildBox(builder, params, Spheres::MirrorAndGlass); }
+void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params) { buildBox(builder, params, Spheres::Diffuse); }
+void buildCornellGlass(GltfBuilder& builder, const SceneParams& params) { buildBox(builder, params, Spheres::DiffuseAndGlass); }
 
 }  // namespace pr::scenegen

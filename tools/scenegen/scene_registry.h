@@ -43,6 +43,7 @@ GltfBuilder generateScene(const SceneEntry& scene, const SceneParams& params);
 // The builders, one per file (cornell.cpp, landscape.cpp, hotspot.cpp).
 void buildCornell(GltfBuilder& builder, const SceneParams& params);
 void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params);
+void buildCornellGlass(GltfBuilder& builder, const SceneParams& params);
 void buildLandscape(GltfBuilder& builder, const SceneParams& params);
 void buildHotspot(GltfBuilder& builder, const SceneParams& params);
 // stress.cpp: the scenes that stress the numerics.
