@@ -53,7 +53,8 @@ glm::vec3 mapRadiance(const rt::ShadingMaterial& m, const rt::ShadingFrame& sf, 
     });
   }
   glm::vec3 radiance(0.0f);
-  const glm::vec3 diffuse = m.diffuseColor();
+  // The diffuse base under its Fresnel layer, for irradiance known without directions.
+  const glm::vec3 diffuse = m.diffuseColor() * rt::diffuseLayerScale(m, wo);
   if (rt::maxComponent(diffuse) > 0.0f) {
     const glm::vec3 irradiance = precomputed && !precomputed->empty()
                                      ? precomputed->irradiance(si.position, ng, density.maxRadius, scratch)

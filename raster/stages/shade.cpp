@@ -116,6 +116,14 @@ ShadingContext makeShadingContext(const scene::Scene& scene, const FrameView& vi
 
 namespace {
 
+float maxComponent(const glm::vec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
+
+// What the dielectric's Fresnel layer leaves the diffuse part under it (the glTF spec's
+// fresnel_mix): 1 - max(F), F the layer's Schlick term for the light's half-vector.
+inline float diffuseUnderLayer(glm::vec3 dielectricF0, float dielectricF90, float f5) {
+  return 1.0f - maxComponent(dielectricF0 + (glm::vec3(dielectricF90) - dielectricF0) * f5);
+}
+
 // evalBrdf's body, inlined into the per-pixel light loop.
 inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N, glm::vec3 V, glm::vec3 L,
                       glm::vec3 dielectricF0, float dielectricF90) {
@@ -148,8 +156,13 @@ inline glm::vec3 brdf(glm::vec3 base, float metallic, float roughness, glm::vec3
   float f = 1.0f - VdotH;
   float f5 = f * f * f * f * f;
   glm::vec3 F = F0 + (glm::vec3(F90) - F0) * f5;
-  glm::vec3 diffuse = ((1.0f - metallic) / kPi) * base;
+  glm::vec3 diffuse = ((1.0f - metallic) * diffuseUnderLayer(dielectricF0, dielectricF90, f5) / kPi) * base;
   return diffuse + F * specularScale;
+}
+
+// The headlight's diffuse term: brdf()'s at VdotH = 1, where the layer's Fresnel term is its F0.
+inline glm::vec3 headlightDiffuse(glm::vec3 base, float metallic, glm::vec3 dielectricF0) {
+  return ((1.0f - metallic) * (1.0f - maxComponent(dielectricF0)) / kPi) * base;
 }
 
 // brdf() for L = V (the headlight): then H = V, NdotH = NdotL = NdotV, VdotH = 1 and F = F0,
@@ -166,8 +179,7 @@ inline glm::vec3 headlightBrdf(glm::vec3 base, float metallic, float roughness, 
   float g = c * (1.0f - k) + k;
   float specularScale = alpha2 / (4.0f * kPi * denom * denom * g * g);
   glm::vec3 F0 = glm::mix(dielectricF0, base, metallic);
-  glm::vec3 diffuse = ((1.0f - metallic) / kPi) * base;
-  return diffuse + F0 * specularScale;
+  return headlightDiffuse(base, metallic, dielectricF0) + F0 * specularScale;
 }
 
 }  // namespace
@@ -178,8 +190,6 @@ glm::vec3 evalBrdf(glm::vec3 base, float metallic, float roughness, glm::vec3 N,
 }
 
 namespace {
-
-float maxComponent(const glm::vec3& c) { return std::max(c.x, std::max(c.y, c.z)); }
 
 // f_r cos for light arriving from L: the base BRDF, then sheen over it and the clear coat on
 // top (common/scene/material_layers.h), each layer with the cosine of its own normal.
@@ -227,7 +237,11 @@ glm::vec3 environmentLight(const ImageBasedLight& ibl, const scene::SurfaceMater
   const glm::vec3 F0 = glm::mix(r.dielectricF0(), r.baseColor, r.metallic);
   const float F90 = r.dielectricF90() + (1.0f - r.dielectricF90()) * r.metallic;
   const glm::vec3 R = 2.0f * glm::dot(N, V) * N - V;
-  const glm::vec3 diffuse = on.diffuse ? ((1.0f - r.metallic) / kPi) * r.baseColor * irradiance : glm::vec3(0.0f);
+  // The diffuse part less the dielectric layer's directional albedo (the split sum's), as the
+  // Fresnel layer takes it off under a light.
+  const float underLayer = 1.0f - maxComponent(r.dielectricF0() * ab.x + glm::vec3(r.dielectricF90() * ab.y));
+  const glm::vec3 diffuse =
+      on.diffuse ? ((1.0f - r.metallic) * underLayer / kPi) * r.baseColor * irradiance : glm::vec3(0.0f);
   glm::vec3 out = on.reflection ? diffuse + ibl.prefiltered(R, roughness) * (F0 * ab.x + F90 * ab.y) : diffuse;
   if (r.hasSheen()) {
     const float albedo = scene::sheenAlbedo(r.sheenRoughness, NdotV);
@@ -313,7 +327,7 @@ HeadlightMaterial headlightMaterial(const scene::Scene& scene, uint32_t id) {
   h.k = 0.5f * alpha;
   h.oneMinusK = 1.0f - h.k;
   h.f0 = glm::mix(r.dielectricF0(), r.baseColor, r.metallic);
-  h.diffuse = ((1.0f - r.metallic) / kPi) * r.baseColor;
+  h.diffuse = headlightDiffuse(r.baseColor, r.metallic, r.dielectricF0());
   h.emission = r.emission;
   return h;
 }

@@ -4,6 +4,7 @@
 #include "raytrace/integrators/bsdf.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "common/scene/material_layers.h"
@@ -168,6 +169,10 @@ glm::vec3 ShadingMaterial::specularFresnel(float cosTheta) const {
   return fresnelSchlick(specularF0(), cosTheta, specularF90());
 }
 
+float ShadingMaterial::diffuseFresnelScale(float cosH) const {
+  return 1.0f - maxComponent(fresnelSchlick(dielectricF0, cosH, dielectricF90));
+}
+
 float fresnelDielectric(float cosI, float eta) {
   cosI = std::clamp(cosI, 0.0f, 1.0f);
   const float sin2T = (1.0f - cosI * cosI) / (eta * eta);
@@ -231,10 +236,52 @@ float sheenScale(const ShadingMaterial& m, float cosO, float cosI) {
   return 1.0f - maxComponent(m.sheenColor) * std::max(scene::sheenAlbedo(r, cosO), scene::sheenAlbedo(r, cosI));
 }
 
-// The Lambertian base as the layers leave it: diffuse / pi, less the sheen's and the coat's share.
+// The Lambertian base under the dielectric's Fresnel layer: diffuse / pi less what the layer
+// reflects for the pair's half-vector.
+glm::vec3 fresnelDiffuse(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
+  return m.diffuseColor() * (kInvPi * m.diffuseFresnelScale(glm::dot(wo, glm::normalize(wo + wi))));
+}
+
+// The Lambertian base as the layers leave it: less the Fresnel layer's, the sheen's and the coat's share.
 glm::vec3 layeredDiffuse(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   const float sheen = m.hasSheen() ? sheenScale(m, wo.z, wi.z) : 1.0f;
-  return m.diffuseColor() * (kInvPi * sheen * (1.0f - coatWeight(m, wo)));
+  return fresnelDiffuse(m, wo, wi) * (sheen * (1.0f - coatWeight(m, wo)));
+}
+
+// The cosine-weighted mean over wi of (1 - cos(wo, h))^5, Schlick's weight for the pair's
+// half-vector, as a function of wo.z: tabulated once by quadrature (cos^2 theta_i and phi on
+// a 64 x 64 grid), linearly interpolated.
+float meanSchlickWeight(float cosO) {
+  constexpr int kEntries = 33, kGrid = 64;
+  static const std::array<float, kEntries> table = [] {
+    std::array<float, kEntries> t{};
+    for (int e = 0; e < kEntries; ++e) {
+      const float mu = float(e) / float(kEntries - 1);
+      const glm::vec3 wo(std::sqrt(std::max(0.0f, 1.0f - mu * mu)), 0.0f, std::max(mu, 1e-4f));
+      double sum = 0.0;
+      for (int i = 0; i < kGrid; ++i) {
+        const float c = std::sqrt((float(i) + 0.5f) / float(kGrid)), s = std::sqrt(1.0f - c * c);
+        for (int j = 0; j < kGrid; ++j) {
+          const float phi = 2.0f * kPi * (float(j) + 0.5f) / float(kGrid);
+          const glm::vec3 wi(s * std::cos(phi), s * std::sin(phi), c);
+          const float x = 1.0f - std::clamp(glm::dot(wo, glm::normalize(wo + wi)), 0.0f, 1.0f);
+          sum += double(x * x * x * x * x);
+        }
+      }
+      t[std::size_t(e)] = float(sum / double(kGrid * kGrid));
+    }
+    return t;
+  }();
+  const float x = std::clamp(cosO, 0.0f, 1.0f) * float(kEntries - 1);
+  const int i = std::min(int(x), kEntries - 2);
+  return table[std::size_t(i)] + (table[std::size_t(i) + 1] - table[std::size_t(i)]) * (x - float(i));
+}
+
+// The cosine-weighted mean over wi of diffuseFresnelScale: every channel's Schlick term is
+// linear in the same weight, so the largest F0 stays the largest and the mean is exact.
+float meanDiffuseFresnelScale(const ShadingMaterial& m, float cosO) {
+  const float f0 = maxComponent(m.dielectricF0), w = meanSchlickWeight(cosO);
+  return 1.0f - (f0 + (m.dielectricF90 - f0) * w);
 }
 
 glm::vec3 evalCoat(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
@@ -278,13 +325,13 @@ float coatProbability(const ShadingMaterial& m, const glm::vec3& wo) { return st
 
 glm::vec3 evalOpaque(const ShadingMaterial& m, const glm::vec3& wo, const glm::vec3& wi) {
   if (wo.z <= 0.0f || wi.z <= 0.0f) return glm::vec3(0.0f);
-  return overLayers(m, wo, wi, m.diffuseColor() * kInvPi + evalGlossy(m, wo, wi));
+  return overLayers(m, wo, wi, fresnelDiffuse(m, wo, wi) + evalGlossy(m, wo, wi));
 }
 
 float baseLayerWeight(const ShadingMaterial& m, const glm::vec3& wo) { return 1.0f - coatWeight(m, wo); }
 
 float diffuseLayerScale(const ShadingMaterial& m, const glm::vec3& wo) {
-  float scale = baseLayerWeight(m, wo);
+  const float scale = baseLayerWeight(m, wo) * meanDiffuseFresnelScale(m, wo.z);
   if (!m.hasSheen()) return scale;
   // The cosine-weighted mean over wi of the sheen's scale: cos^2 theta_i uniform in [0, 1).
   constexpr int kSteps = 16;

@@ -74,6 +74,11 @@ struct ShadingMaterial {
   }
   // The specular lobe's Fresnel term at cosine cosTheta (Schlick from F0 to F90).
   glm::vec3 specularFresnel(float cosTheta) const;
+  // What the dielectric's Fresnel layer leaves the diffuse part under it, for a pair of
+  // directions whose half-vector h has cos(wo, h) = cosH: the spec's fresnel_mix,
+  // 1 - max(F_dielectric(cosH)), which keeps a white diffuse surface under its layer from
+  // reflecting more than it receives. 1 without the layer (specularFactor 0).
+  float diffuseFresnelScale(float cosH) const;
   // The base-colour tint of a refraction through this interface: once per pass through a solid
   // (on entering it), at every crossing of a thin wall.
   glm::vec3 transmissionTint(bool frontFace) const { return thinWalled || frontFace ? baseColor : glm::vec3(1.0f); }
@@ -169,10 +174,11 @@ struct PartSample {
 PartSample sampleOpaquePart(const ShadingMaterial& m, const glm::vec3& wo, float lobe, float u, float v);
 // What the clear coat leaves the layers under it towards wo (1 - its Fresnel weight).
 float baseLayerWeight(const ShadingMaterial& m, const glm::vec3& wo);
-// The share of the diffuse base left under the sheen and the clear coat towards wo for light
-// arriving alike from every direction (the sheen's loss depends on wi too; this is its
-// cosine-weighted mean): what turns irradiance known without directions (an irradiance-cache
-// record) into the layered diffuse radiance diffuseColor() / pi * E * scale. 1 without layers.
+// The share of the diffuse base left under the dielectric's Fresnel layer, the sheen and the
+// clear coat towards wo for light arriving alike from every direction (the Fresnel and sheen
+// losses depend on wi too; this is the product of their cosine-weighted means): what turns
+// irradiance known without directions (an irradiance-cache record) into the layered diffuse
+// radiance diffuseColor() / pi * E * scale. 1 without layers.
 float diffuseLayerScale(const ShadingMaterial& m, const glm::vec3& wo);
 // Probability that sampleOpaque picks the specular lobe (from Fresnel and diffuse luminance).
 float specularProbability(const ShadingMaterial& m, float cosO);

@@ -73,12 +73,13 @@ TEST_CASE("Shade: BRDF at normal incidence matches the closed form") {
   glm::vec3 n(0.0f, 0.0f, 1.0f);
   glm::vec3 base(0.8f, 0.5f, 0.2f);
   // V = L = N: H = N, D = 1 / (pi alpha^2), G = 1, F = F0, so
-  // f = (1 - m) base / pi + F0 / (4 pi alpha^2), F0 = mix(0.04, base, m).
+  // f = (1 - m)(1 - 0.04) base / pi + F0 / (4 pi alpha^2), F0 = mix(0.04, base, m): the
+  // diffuse part loses what the dielectric's 4 % layer reflects (the spec's fresnel_mix).
   for (float metallic : {0.0f, 0.3f, 1.0f}) {
     for (float roughness : {1.0f, 0.5f, 0.2f}) {
       float alpha = roughness * roughness;
       glm::vec3 f0 = glm::mix(glm::vec3(0.04f), base, metallic);
-      glm::vec3 expected = (1.0f - metallic) * base / kPi + f0 / (4.0f * kPi * alpha * alpha);
+      glm::vec3 expected = (1.0f - metallic) * (1.0f - 0.04f) * base / kPi + f0 / (4.0f * kPi * alpha * alpha);
       CAPTURE(metallic);
       CAPTURE(roughness);
       CHECK(near(evalBrdf(base, metallic, roughness, n, n, n), expected, 1e-5f));
@@ -106,7 +107,7 @@ TEST_CASE("Shade: a lit plane renders the analytic radiance") {
   RegionFramebuffer fb = renderSequential(s, test::pixelOrthoCamera(16), 16, 16, {}, &stats);
   CHECK_FALSE(stats.usesHeadlight);
   glm::vec3 base(0.5f, 0.25f, 1.0f);
-  glm::vec3 expected = 3.0f * (base / kPi + glm::vec3(0.04f) / (4.0f * kPi));
+  glm::vec3 expected = 3.0f * (0.96f * base / kPi + glm::vec3(0.04f) / (4.0f * kPi));
   CHECK(fb.coveredPixels() == 16 * 16);
   CHECK(near(fb.colour(3, 5), expected, 1e-5f));
   CHECK(near(fb.colour(15, 0), expected, 1e-5f));
@@ -150,9 +151,9 @@ TEST_CASE("Shade: double-sided back faces are lit on the viewer's side, emission
   RasterStats stats;
   RegionFramebuffer fb = renderSequential(s, test::pixelOrthoCamera(16), 16, 16, {}, &stats);
   CHECK(stats.usesHeadlight);
-  // The headlight (pi lux down the view) on a white Lambertian + 4% glossy surface facing the
-  // camera after the normal flip: 1 + 0.01.
-  glm::vec3 lit(1.0f + 0.04f / 4.0f);
+  // The headlight (pi lux down the view) on a white diffuse surface under the 4% glossy layer,
+  // facing the camera after the normal flip: the diffuse part less the layer's 4 %, plus 0.01.
+  glm::vec3 lit(0.96f + 0.04f / 4.0f);
   CHECK(near(fb.colour(4, 10), lit, 1e-5f));
   CHECK(near(fb.colour(12, 12), lit + glm::vec3(2.0f, 1.0f, 0.0f), 1e-5f));
 }
@@ -195,19 +196,20 @@ TEST_CASE("Shade: base colour textures use the sampler's wrap mode and bilinear 
   SurfacePoint sp;
   sp.position = glm::vec3(0.0f);
   sp.normal = glm::vec3(0.0f, 0.0f, 1.0f);
-  // Headlight of pi lux, V = L = N: radiance = base + 0.01 (the 4% glossy term, white).
+  // Headlight of pi lux, V = L = N: radiance = 0.96 base + 0.01 (the diffuse part under the 4%
+  // glossy layer, which adds 0.01 white).
   // u = 1.25 is texel 2.5 -> texel 0 (red) when repeating, texel 1 (green) when clamped.
   sp.uv = glm::vec2(1.25f, 0.5f);
-  CHECK(near(shadeSurface(ctx, sp), glm::vec3(1.01f, 0.01f, 0.01f), 1e-5f));
+  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.97f, 0.01f, 0.01f), 1e-5f));
   s.textures[0].sampler.wrapS = scene::Wrap::ClampToEdge;
-  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.01f, 1.01f, 0.01f), 1e-5f));
+  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.01f, 0.97f, 0.01f), 1e-5f));
   // Bilinear halfway between the texel centres (u = 0.5): an equal mix of the decoded texels.
   s.textures[0].sampler.magFilter = scene::Filter::Linear;
   sp.uv = glm::vec2(0.5f, 0.5f);
-  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.51f, 0.51f, 0.01f), 1e-5f));
+  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.49f, 0.49f, 0.01f), 1e-5f));
   // The texture is multiplied by the base colour factor.
   s.materials[0].baseColorFactor = glm::vec4(0.5f, 1.0f, 1.0f, 1.0f);
-  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.26f, 0.51f, 0.01f), 1e-5f));
+  CHECK(near(shadeSurface(ctx, sp), glm::vec3(0.25f, 0.49f, 0.01f), 1e-5f));
 }
 
 // shadeRegion shades headlit, untextured pixels four (SSE2) or eight (AVX2) at a time; each
