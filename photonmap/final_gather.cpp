@@ -20,7 +20,7 @@ using rt::kPi;
 // Streams of sample1D(seed ^ kGatherSalt, record, ray, bounce, dim), apart from the camera
 // paths' (seed, pixel, sample, depth, dim).
 constexpr std::uint64_t kGatherSalt = 0x6761746865720000ull;  // "gather"
-constexpr std::uint32_t kThetaDim = 0, kPhiDim = 1, kBranchDim = 2, kGlossyDim = 3;
+constexpr std::uint32_t kThetaDim = 0, kPhiDim = 1, kBranchDim = 2, kGlossyDim = 3, kMicrofacetUDim = 4, kMicrofacetVDim = 5;
 constexpr std::uint32_t kDirectionDepth = 255;
 
 // The jittered (sin^2 theta, phi) of ray j.
@@ -101,9 +101,9 @@ GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& glo
   out.radiance = throughput * mapRadiance(m, sf, global, options.precomputed, si, options.global, scratch,
                                           MapRead::Secondary, glossyU);
   if (bounce >= options.specularBounces) return out;
-  const float u = rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), kBranchDim);
+  const auto dim = [&](std::uint32_t d) { return rt::sample1D(options.seed ^ kGatherSalt, id, j, std::uint32_t(bounce), d); };
   glm::vec3 wi, factor;
-  if (!idealSpecularBounce(m, si, sf, u, wi, factor)) return out;
+  if (!specularBounce(m, si, sf, dim(kBranchDim), dim(kMicrofacetUDim), dim(kMicrofacetVDim), wi, factor)) return out;
   out.throughput = throughput * factor;
   if (!(rt::maxComponent(out.throughput) > 0.0f)) return out;
   out.continues = true;
@@ -111,21 +111,14 @@ GatherInteraction gatherInteraction(const scene::Scene& scene, const KdTree& glo
   return out;
 }
 
-bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf,
-                         float u, glm::vec3& wi, glm::vec3& factor) {
+bool specularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, float u,
+                    float mu, float mv, glm::vec3& wi, glm::vec3& factor) {
   const float dielectric = m.dielectricWeight();
   if (u < dielectric) {
-    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-    const float cosI = glm::dot(sf.ns, si.wo);
-    glm::vec3 wt;
-    if (u / dielectric < rt::fresnelDielectric(cosI, eta) || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
-      wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
-      factor = glm::vec3(1.0f);
-    } else {
-      wi = wt;
-      factor = m.transmissionTint(si.frontFace);
-    }
-    return true;
+    const rt::DielectricSample d = rt::sampleDielectric(m, si, sf, u / dielectric, mu, mv);
+    wi = d.wi;
+    factor = d.weight;
+    return d.valid;
   }
   if (!m.hasSpecular() || !m.deltaSpecular()) return false;
   wi = sf.frame.toWorld(glm::vec3(-sf.woLocal.x, -sf.woLocal.y, sf.woLocal.z));

@@ -66,14 +66,15 @@ glm::vec3 mapRadiance(const rt::ShadingMaterial& m, const rt::ShadingFrame& sf, 
                       const PrecomputedIrradiance* precomputed, const rt::SurfaceInteraction& si,
                       const DensityOptions& density, NearestPhotons& scratch, MapRead read = MapRead::All,
                       float roulette = 0.0f);
-// How a gathering (or glossy) path goes on through an ideal specular surface at si to the
-// diffuse surface behind it, with u in [0, 1): a dielectric's reflection or refraction chosen
-// by its Fresnel term (which cancels the choice's weight; a refraction is tinted as eye paths
-// tint it), else an opaque mirror's reflection, its Fresnel weight over its selection
-// probability 1 - dielectric. wi and the factor that multiplies the path's throughput; false
-// when there is no ideal specular part to follow.
-bool idealSpecularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf,
-                         float u, glm::vec3& wi, glm::vec3& factor);
+// How a gathering (or glossy) path goes on through a specular surface at si to the diffuse
+// surface behind it, with u in [0, 1): through the dielectric part with probability its weight
+// (rt::sampleDielectric: Fresnel's choice, which cancels its weight; a refraction tinted as eye
+// paths tint it; frosted glass about a GGX microfacet normal drawn for (mu, mv)), else an
+// opaque ideal mirror's reflection, its Fresnel weight over its selection probability
+// 1 - dielectric. wi and the factor that multiplies the path's throughput; false when there
+// is no such part to follow or the sample is lost.
+bool specularBounce(const rt::ShadingMaterial& m, const rt::SurfaceInteraction& si, const rt::ShadingFrame& sf, float u,
+                    float mu, float mv, glm::vec3& wi, glm::vec3& factor);
 
 // The M x N (theta, phi) strata of a record's rays: M = round(sqrt(rays / pi)), N = round(rays / M).
 struct GatherStrata {

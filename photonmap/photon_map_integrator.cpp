@@ -28,10 +28,12 @@ using rt::RayMessage;
 // Rays weaker than this add nothing visible (below 1/4096 of a camera ray's weight).
 constexpr float kMinThroughput = 1.0f / 4096.0f;
 // Random dimensions of this integrator at a vertex: fallback gather rays, glossy rays, the
-// choice whether a secondary hit reads its map's glossy part (mapRadiance's roulette).
+// choice whether a secondary hit reads its map's glossy part (mapRadiance's roulette), rays
+// through frosted glass.
 constexpr std::uint32_t kGatherDim = rt::Dim::kIntegratorOwn;
 constexpr std::uint32_t kGlossyDim = rt::Dim::kIntegratorOwn + 512;
 constexpr std::uint32_t kMapReadDim = rt::Dim::kIntegratorOwn + 512 + 3 * 256;
+constexpr std::uint32_t kDielectricDim = kMapReadDim + 1;  // 3 per frosted-glass ray
 constexpr int kMaxRaysPerVertex = 256;
 // Photons per map at most (CLI range; the photon program's pixel index is 32 bits).
 constexpr std::size_t kMaxPhotons = 100000000;
@@ -198,7 +200,9 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
                                                             scratch, MapRead::Secondary, ctx.sample(msg, kMapReadDim)));
     if (msg.depth >= options().maxDepth) return;
     glm::vec3 wi, factor;
-    if (!idealSpecularBounce(m, si, sf, ctx.sample(msg, rt::Dim::kLobe), wi, factor)) return;
+    if (!specularBounce(m, si, sf, ctx.sample(msg, rt::Dim::kLobe), ctx.sample(msg, rt::Dim::kBsdfU),
+                        ctx.sample(msg, rt::Dim::kBsdfV), wi, factor))
+      return;
     // After the diffuse or glossy bounce that made this ray: a caustic path (as in the cache pass).
     if (!ctx.simulates(scene::Effect::Caustics)) {
       ++out.stats().causticRaysSkipped;
@@ -286,7 +290,20 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
   }
 
   // The smooth dielectric: Fresnel reflection and refraction, one ray each (as Whitted).
-  if (dielectric > 0.0f) {
+  // Frosted glass: eye paths through it about sampled microfacet normals (Fresnel choosing
+  // reflection or refraction), more the rougher it is, one below the first hit; they stay eye
+  // paths, lit at their next hit as the eye's own, since light sampling never covers this part.
+  if (dielectric > 0.0f && !m.deltaSpecular()) {
+    const int n = msg.depth == 0 ? std::max(1, int(std::ceil(float(settings_.maxGlossyRays) * m.roughness))) : 1;
+    for (int i = 0; i < n; ++i) {
+      const std::uint32_t dim = kDielectricDim + 3u * std::uint32_t(i);
+      const rt::DielectricSample d =
+          rt::sampleDielectric(m, si, sf, ctx.sample(msg, dim), ctx.sample(msg, dim + 1u), ctx.sample(msg, dim + 2u));
+      if (d.valid)
+        spawn(scene::Effect::Transmission, &rt::TraceStats::transmissionRaysSkipped,
+              ctx.continuation(si, msg, d.wi, msg.throughput * d.weight * (dielectric / float(n)), 0.0f), n);
+    }
+  } else if (dielectric > 0.0f) {
     const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
     const float cosI = glm::dot(sf.ns, si.wo);
     const float fr = rt::fresnelDielectric(cosI, eta);
@@ -295,7 +312,10 @@ void PhotonMapIntegrator::shade(const rt::SurfaceInteraction& si, const RayMessa
     glm::vec3 wt;
     if (fr < 1.0f && rt::refractDirection(si.wo, sf.ns, eta, wt))
       spawn(scene::Effect::Transmission, &rt::TraceStats::transmissionRaysSkipped,
-            ctx.continuation(si, msg, wt, msg.throughput * m.transmissionTint(si.frontFace) * (dielectric * (1.0f - fr)), 0.0f));
+            ctx.continuation(si, msg, wt,
+                             msg.throughput * m.transmissionTint(si.frontFace) *
+                                 (dielectric * (1.0f - fr) * m.refractedRadianceScale(si.frontFace)),
+                             0.0f));
   }
 }
 

@@ -73,14 +73,13 @@ struct Target {
   float radius;
 };
 
-// A material that can bend light into a caustic: a smooth dielectric part, or an opaque lobe
-// that may be an ideal mirror (conservative for textured roughness, as scene::EffectAnalysis).
+// A material that can bend light into a caustic: one that may be smooth, so that its
+// refracting part or its opaque lobe is ideal specular (conservative for textured roughness, as
+// scene::EffectAnalysis). Frosted glass scatters light as a glossy surface does: no caustic.
 bool canFocus(const scene::Material& m) {
   const bool textured = m.metallicRoughnessTexture.present();
   const float roughnessMin = textured ? 0.0f : std::clamp(m.roughnessFactor, 0.0f, 1.0f);
-  const float metallicMin = textured ? 0.0f : std::clamp(m.metallicFactor, 0.0f, 1.0f);
-  const bool dielectric = (m.transmissionFactor > 0.0f || m.transmissionTexture.present()) && metallicMin < 1.0f;
-  return dielectric || roughnessMin < scene::kIdealSpecularRoughness;
+  return roughnessMin < scene::kIdealSpecularRoughness;
 }
 
 std::vector<Target> specularTargets(const scene::Scene& scene) {
@@ -379,7 +378,8 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   }
 
   // Choose the part by Russian roulette over the whole BSDF: the dielectric with probability
-  // equal to its weight, reflection against refraction by the Fresnel term, else one
+  // equal to its weight, reflection against refraction by the Fresnel term (about a sampled
+  // microfacet normal when rough), else one
   // component of the opaque part (probability 1 - dielectric, divided out) - the Lambertian
   // base, the glossy lobes or an ideal mirror - weighted by its own BRDF, so the reflection the
   // photon takes is of that kind and its path's PhotonPath bits say so. Each choice's
@@ -393,18 +393,15 @@ PhotonInteraction interact(const Setup& s, int map, std::uint32_t index, int bou
   glm::vec3 wi, factor;
   bool specular;
   if (lobe < dielectric) {
-    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-    const float cosI = glm::dot(sf.ns, si.wo);
-    const float fr = rt::fresnelDielectric(cosI, eta);
-    glm::vec3 wt;
-    if (lobe / dielectric < fr || !rt::refractDirection(si.wo, sf.ns, eta, wt)) {
-      wi = glm::normalize(2.0f * cosI * sf.ns - si.wo);
-      factor = glm::vec3(1.0f);
-    } else {
-      wi = wt;
-      factor = m.transmissionTint(si.frontFace);  // flux is conserved through refraction: no eta^2 (that is radiance)
-    }
-    specular = true;
+    // Flux is conserved through refraction: no eta^2 (that is radiance). A rough (frosted)
+    // dielectric scatters about a microfacet normal: a glossy choice.
+    const rt::DielectricSample d =
+        rt::sampleDielectric(m, si, sf, lobe / dielectric, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV), rt::Transport::Flux);
+    if (!d.valid) return out;
+    wi = d.wi;
+    factor = d.weight;
+    specular = d.delta;
+    if (!d.delta) path |= PhotonPath::kGlossy;
   } else {
     const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, rt::kOneMinusEpsilon);
     const rt::PartSample part = rt::sampleOpaquePart(m, sf.woLocal, u, sample(rt::Dim::kBsdfU), sample(rt::Dim::kBsdfV));

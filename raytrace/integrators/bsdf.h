@@ -82,6 +82,15 @@ struct ShadingMaterial {
   // The base-colour tint of a refraction through this interface: once per pass through a solid
   // (on entering it), at every crossing of a thin wall.
   glm::vec3 transmissionTint(bool frontFace) const { return thinWalled || frontFace ? baseColor : glm::vec3(1.0f); }
+  // What a refraction does to the radiance an eye path carries back across this interface,
+  // eta = n_t / n_i along the path: radiance is flux per solid angle and refraction squeezes
+  // solid angle by eta^2, so light leaving glass into air loses it and light entering gains it
+  // (Veach 1997, 5.2). On a path that enters a solid and leaves it the two cancel; light
+  // reflected diffusely inside one keeps one. Photons carry flux, which crossing leaves as is.
+  float refractedRadianceScale(bool frontFace) const {
+    const float eta = frontFace ? ior : 1.0f / ior;
+    return 1.0f / (eta * eta);
+  }
   bool hasSheen() const { return sheenColor.x > 0.0f || sheenColor.y > 0.0f || sheenColor.z > 0.0f; }
   bool hasClearcoat() const { return clearcoat > 0.0f; }
   bool deltaSpecular() const { return alpha < kDeltaAlpha; }

@@ -62,6 +62,32 @@ ShadingFrame::ShadingFrame(const SurfaceInteraction& si, const glm::vec3& shadin
   woLocal.z = std::max(woLocal.z, 1.0e-6f);  // wo lies in the upper hemisphere by construction
 }
 
+DielectricSample sampleDielectric(const ShadingMaterial& m, const SurfaceInteraction& si, const ShadingFrame& sf, float choice,
+                                  float u, float v, Transport transport) {
+  DielectricSample s;
+  const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
+  s.delta = m.deltaSpecular();
+  glm::vec3 n = sf.ns;
+  if (!s.delta) {
+    n = sf.frame.toWorld(sampleMicrofacetNormal(m, u, v));
+    if (glm::dot(n, si.wo) <= 0.0f) return s;
+  }
+  const float cosI = glm::dot(n, si.wo);
+  glm::vec3 wt;
+  s.reflected = choice < fresnelDielectric(cosI, eta) || !refractDirection(si.wo, n, eta, wt);
+  s.wi = s.reflected ? glm::normalize(2.0f * cosI * n - si.wo) : wt;
+  float weight = 1.0f;
+  if (!s.delta) {
+    // Reflection stays on the side it came from, refraction crosses the geometric surface.
+    if ((glm::dot(s.wi, sf.ng) > 0.0f) != s.reflected) return s;
+    weight = microfacetWeight(m, sf.woLocal, sf.frame.toLocal(s.wi), sf.frame.toLocal(n));
+  }
+  if (!s.reflected && transport == Transport::Radiance) weight *= m.refractedRadianceScale(si.frontFace);
+  s.weight = s.reflected ? glm::vec3(weight) : weight * m.transmissionTint(si.frontFace);
+  s.valid = maxComponent(s.weight) > 0.0f && isFinite(s.weight);
+  return s;
+}
+
 ShadingMaterial IntegratorContext::material(const SurfaceInteraction& si, Emit& out) const {
   const bool textures = simulates(scene::Effect::Textures);
   if (!textures && usesTextures(scene_->materials[si.material])) ++out.stats().textureEvaluationsSkipped;

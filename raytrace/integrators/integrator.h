@@ -149,6 +149,25 @@ struct ShadingFrame {
   ShadingFrame(const SurfaceInteraction& si, const glm::vec3& shadingNormal);
 };
 
+// The dielectric (refracting) part's scattering, shared by every integrator and the photon
+// tracer: reflection with probability F, else refraction (the choice's probability cancels
+// the Fresnel weight), about the shading normal when the surface is smooth and about a GGX
+// microfacet normal drawn for (u, v) when it is rough (frosted glass; Walter et al. 2007).
+// choice in [0, 1). weight = the microfacet weight (1 when smooth) times the transmission tint
+// on refraction, and for eye paths (Transport::Radiance) refractedRadianceScale too. delta:
+// smooth. valid false when the sample is lost: a microfacet facing away, a rough reflection
+// that leaves below the surface or a refraction that stays above it.
+enum class Transport { Radiance, Flux };  // what a path carries: eye paths radiance, photons flux
+struct DielectricSample {
+  glm::vec3 wi{0.0f};
+  glm::vec3 weight{0.0f};
+  bool reflected = false;
+  bool delta = true;
+  bool valid = false;
+};
+DielectricSample sampleDielectric(const ShadingMaterial& m, const SurfaceInteraction& si, const ShadingFrame& sf, float choice,
+                                  float u, float v, Transport transport = Transport::Radiance);
+
 struct TraceStats;  // trace_stats.h
 class Bvh;          // raytrace/core/bvh.h
 class Integrator;

@@ -68,28 +68,11 @@ void PathIntegrator::shade(const SurfaceInteraction& si, const RayMessage& incom
   if (lobe < dielectric) {
     if (!ctx.simulates(scene::Effect::Transmission)) return skip(&TraceStats::transmissionRaysSkipped);
     if (afterRoughBounce && !ctx.simulates(scene::Effect::Caustics)) return skip(&TraceStats::causticRaysSkipped);
-    const float eta = si.frontFace ? m.ior : 1.0f / m.ior;
-    // Rough glass refracts and reflects about a GGX microfacet normal (Walter et al. 2007);
-    // smooth glass about the shading normal.
-    const bool rough = !m.deltaSpecular();
-    glm::vec3 n = sf.ns;
-    float weight = 1.0f;
-    if (rough) {
-      n = sf.frame.toWorld(sampleMicrofacetNormal(m, ctx.sample(msg, Dim::kBsdfU), ctx.sample(msg, Dim::kBsdfV)));
-      if (glm::dot(n, si.wo) <= 0.0f) return;
-    }
-    const float cosI = glm::dot(n, si.wo);
-    const float fr = fresnelDielectric(cosI, eta);
-    // Reflect or refract with probabilities F and 1 - F, which cancel the Fresnel weights.
-    const float choice = lobe / dielectric;
-    glm::vec3 wt;
-    const bool reflect = choice < fr || !refractDirection(si.wo, n, eta, wt);
-    wi = reflect ? glm::normalize(2.0f * cosI * n - si.wo) : wt;
-    // Reflection stays on the side it came from, refraction crosses the geometric surface.
-    if (rough && (glm::dot(wi, sf.ng) > 0.0f) != reflect) return;
-    if (rough) weight = microfacetWeight(m, sf.woLocal, sf.frame.toLocal(wi), sf.frame.toLocal(n));
-    throughput = msg.throughput * weight;
-    if (!reflect) throughput *= m.transmissionTint(si.frontFace);
+    const DielectricSample d =
+        sampleDielectric(m, si, sf, lobe / dielectric, ctx.sample(msg, Dim::kBsdfU), ctx.sample(msg, Dim::kBsdfV));
+    if (!d.valid) return;
+    wi = d.wi;
+    throughput = msg.throughput * d.weight;
   } else {
     const float u = std::min(dielectric > 0.0f ? (lobe - dielectric) / opaque : lobe, kOneMinusEpsilon);
     // The plan may skip the lobe sampleOpaque will take for u.

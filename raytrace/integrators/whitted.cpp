@@ -54,7 +54,8 @@ void WhittedIntegrator::shade(const SurfaceInteraction& si, const RayMessage& in
                 ctx.continuation(si, msg, glm::normalize(reflected), tr, 0.0f), out);
     glm::vec3 wt;
     if (fr < 1.0f && refractDirection(si.wo, sf.ns, eta, wt)) {
-      const glm::vec3 tt = msg.throughput * m.transmissionTint(si.frontFace) * (dielectric * (1.0f - fr));
+      const glm::vec3 tt =
+          msg.throughput * m.transmissionTint(si.frontFace) * (dielectric * (1.0f - fr) * m.refractedRadianceScale(si.frontFace));
       if (maxComponent(tt) > kMinThroughput)
         ctx.spawn(scene::Effect::Transmission, &TraceStats::transmissionRaysSkipped, ctx.continuation(si, msg, wt, tt, 0.0f), out);
     }

@@ -284,17 +284,19 @@ struct CausticStage {
   scene::Camera camera;
 };
 
-CausticStage causticStage(const scene::Material& material, float x) {
+CausticStage causticStage(const scene::Material& material, float x, bool screen = true) {
   CausticStage stage;
   scene::Scene& s = stage.scene;
   test::addGround(s, 3.0f, test::addMaterial(s, test::diffuse(0.8f)));
   test::addSphere(s, {0.0f, 1.0f, 0.0f}, 0.5f, 48, test::addMaterial(s, material));
+  // Without the screen, a light five times as wide (as bright in all).
+  const float half = screen ? 0.15f : 0.75f;
   scene::Material emitter = test::diffuse(0.0f);
   emitter.emissiveFactor = glm::vec3(1.0f);
-  emitter.emissiveStrength = 200.0f;
+  emitter.emissiveStrength = 200.0f * (0.15f / half) * (0.15f / half);
   const std::uint32_t light = test::addMaterial(s, emitter);
-  test::addTri(s, {-0.15f, 3, -0.15f}, {0.15f, 3, 0.15f}, {-0.15f, 3, 0.15f}, light);  // facing down
-  test::addTri(s, {-0.15f, 3, -0.15f}, {0.15f, 3, -0.15f}, {0.15f, 3, 0.15f}, light);
+  test::addTri(s, {-half, 3, -half}, {half, 3, half}, {-half, 3, half}, light);  // facing down
+  test::addTri(s, {-half, 3, -half}, {half, 3, -half}, {half, 3, half}, light);
   test::addAreaLights(s, light);
   // The screen at y = 2.5 facing up, with a hole 0.3 across: four quads around it.
   const std::uint32_t black = test::addMaterial(s, test::diffuse(0.0f));
@@ -303,10 +305,12 @@ CausticStage causticStage(const scene::Material& material, float x) {
     test::addTri(s, {x0, 2.5f, z0}, {x1, 2.5f, z1}, {x1, 2.5f, z0}, black);
   };
   const float e = 3.0f, hole = 0.15f;
-  quad(-e, -e, e, -hole);
-  quad(-e, hole, e, e);
-  quad(-e, -hole, -hole, hole);
-  quad(hole, -hole, e, hole);
+  if (screen) {
+    quad(-e, -e, e, -hole);
+    quad(-e, hole, e, e);
+    quad(-e, -hole, -hole, hole);
+    quad(hole, -hole, e, hole);
+  }
   scene::Camera& c = stage.camera;
   c.projection = scene::Projection::Orthographic;
   c.xmag = c.ymag = 0.4f;
@@ -396,6 +400,48 @@ TEST_CASE("PhotonMapIntegrator: the caustics of part glass and smooth plastic ma
                    << ", path tracer's " << reference << ", error " << error * 100.0 << " % (bound " << bound * 100.0 << " %)");
       CHECK(error <= bound);
     }
+  }
+}
+
+TEST_CASE("PhotonMapIntegrator: frosted, partly transmissive glass matches the path tracer, seen, from inside and in its light") {
+  // A sphere of frosted glass (roughness 0.3, transmission 0.8 over a white diffuse fifth) under
+  // a wide area light: the light it scatters onto the floor inside its shadow is a glossy path
+  // (L G D), carried by the global map's photons that passed through it and read where it
+  // lands; the sphere seen by the eye is refracted about sampled microfacet normals, as the path
+  // tracer refracts it (before, both passes refracted it as smooth glass); and seen from inside
+  // it, its diffuse fifth shows the light refracted into it, whose radiance the refraction
+  // raised by eta^2 (flux in the photons, radiance in the eye paths: before, eye paths left
+  // the factor out, so the photon map's light inside a solid seen from outside was 30 % bright
+  // and the path tracer's camera inside one saw it 2.25 times too dark).
+  scene::Material frosted = test::diffuse(0.9f);
+  frosted.specularFactor = 1.0f;
+  frosted.roughnessFactor = 0.3f;
+  frosted.transmissionFactor = 0.8f;
+  CausticStage floor = causticStage(frosted, 0.0f, false);
+  CausticStage sphere = floor, inside = floor;
+  sphere.camera = test::perspectiveAt({0.0f, 1.2f, 3.0f}, 0.4f);
+  inside.camera = test::perspectiveAt({0.0f, 1.0f, 0.0f}, 0.8f);
+  constexpr int kN = 24;
+  par::Runtime runtime(2);
+  for (const CausticStage* stage : {&floor, &sphere, &inside}) {
+    const std::string view = stage == &floor ? "the floor under it" : stage == &sphere ? "the sphere" : "inside the sphere";
+    CAPTURE(view);
+    rt::TraceOptions path;
+    path.integrator.kind = rt::IntegratorKind::Path;
+    path.integrator.spp = 2048;
+    path.integrator.maxDepth = 16;
+    const image::Image reference = rt::renderRays(stage->scene, stage->camera, kN, kN, path, "image-space", runtime).image;
+    pm::PhotonMapSettings settings = smallSettings();
+    settings.globalPhotons = 400000;
+    settings.globalRadius = 0.1f;
+    rt::IntegratorOptions io;
+    io.spp = 16;
+    rt::TraceJob job{stage->scene, stage->camera, kN, kN, {}};
+    job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(stage->scene, stage->camera, kN, kN, io, settings);
+    const double a = meanOf(rt::renderRays(job, "image-space", runtime).image), b = meanOf(reference);
+    MESSAGE(view << ": photon map " << a << ", path tracer " << b << ", " << (a / b - 1.0) * 100.0 << " %");
+    REQUIRE(b > 0.0);
+    CHECK(std::fabs(a / b - 1.0) <= 0.05);
   }
 }
 
