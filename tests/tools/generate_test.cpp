@@ -79,7 +79,7 @@ fs::path generate(const std::string& scratch, const std::string& file, const std
 }  // namespace
 
 TEST_CASE("Generate: regenerating each committed scene reproduces it byte for byte") {
-  for (const char* name : {"cornell", "cornell-diffuse", "cornell-glass", "hotspot"}) {
+  for (const char* name : {"cornell", "cornell-diffuse", "cornell-glass", "cornell-rough", "hotspot"}) {
     CAPTURE(name);
     const fs::path committed = pr::test::sourceDir() / "scenes" / (std::string(name) + ".gltf");
     REQUIRE(fs::is_regular_file(committed));
@@ -179,6 +179,28 @@ TEST_CASE("Generate: cornell-glass has the box with the glass sphere in front an
   CHECK(backMaterial.extensions.count("KHR_materials_specular") == 1);  // specularFactor 0: Lambertian
   CHECK(backMaterial.pbrMetallicRoughness.metallicFactor == 0.0);
   CHECK(findNode(m, "light") != nullptr);
+  CHECK(m.cameras.size() == 1);
+}
+
+TEST_CASE("Generate: cornell-rough has a rough metal block standing on the floor and a frosted, partly transmissive sphere") {
+  auto m = loadModel(generate("generate_cornell_rough", "cornell-rough.gltf", "cornell-rough"));
+  const auto* block = findNode(m, "metal block");
+  const auto* sphere = findNode(m, "frosted sphere");
+  REQUIRE(block);
+  REQUIRE(sphere);
+  const auto& metal = m.materials.at(m.meshes.at(block->mesh).primitives[0].material);
+  CHECK(metal.pbrMetallicRoughness.metallicFactor == 1.0);
+  CHECK(metal.pbrMetallicRoughness.roughnessFactor == doctest::Approx(0.3));
+  const auto& frosted = m.materials.at(m.meshes.at(sphere->mesh).primitives[0].material);
+  CHECK(frosted.pbrMetallicRoughness.roughnessFactor == doctest::Approx(0.3));
+  CHECK(extensionNumber(frosted, "KHR_materials_transmission", "transmissionFactor") == doctest::Approx(0.8));
+  // The block: 12 triangles, its base on the floor (y = 0) and its top 3.30 up, inside the box.
+  const auto& accessor = m.accessors.at(std::size_t(m.meshes.at(block->mesh).primitives[0].attributes.at("POSITION")));
+  REQUIRE(accessor.minValues.size() == 3);
+  CHECK(accessor.minValues[1] == doctest::Approx(0.0));
+  CHECK(accessor.maxValues[1] == doctest::Approx(3.30));
+  CHECK(m.accessors.at(std::size_t(m.meshes.at(block->mesh).primitives[0].indices)).count == 36);
+  CHECK(findMaterial(m, "mirror") == nullptr);
   CHECK(m.cameras.size() == 1);
 }
 

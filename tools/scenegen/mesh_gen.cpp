@@ -18,6 +18,23 @@ MeshData makeQuad(glm::vec3 corner, glm::vec3 u, glm::vec3 v) {
   return mesh;
 }
 
+MeshData makeBox(glm::vec3 size) {
+  const glm::vec3 x(size.x, 0, 0), y(0, size.y, 0), z(0, 0, size.z);
+  const glm::vec3 lo(-0.5f * size.x, 0.0f, -0.5f * size.z);
+  const glm::vec3 hi = lo + x + y + z;
+  // Each face as makeQuad builds it (facing cross(u, v)), outward.
+  const MeshData faces[] = {makeQuad(lo, x, z), makeQuad(lo + y, z, x), makeQuad(lo, y, x),
+                            makeQuad(hi, -x, -y), makeQuad(lo, z, y),    makeQuad(hi, -y, -z)};
+  MeshData box;
+  for (const MeshData& f : faces) {
+    const uint32_t base = uint32_t(box.positions.size());
+    box.positions.insert(box.positions.end(), f.positions.begin(), f.positions.end());
+    box.normals.insert(box.normals.end(), f.normals.begin(), f.normals.end());
+    for (uint32_t i : f.indices) box.indices.push_back(base + i);
+  }
+  return box;
+}
+
 MeshData makeEllipsoid(glm::vec3 center, glm::vec3 radii, int segments, int rings) {
   PR_CHECK(segments >= 3 && rings >= 2, "sphere needs at least 3 segments and 2 rings");
   MeshData mesh;

@@ -22,6 +22,10 @@ struct MeshData {
 // normalize(cross(u, v)).
 MeshData makeQuad(glm::vec3 corner, glm::vec3 u, glm::vec3 v);
 
+// An axis-aligned box of `size` standing on the origin: x and z centred, y from 0 to size.y.
+// Six faces of two triangles each with flat outward normals (4 vertices per face).
+MeshData makeBox(glm::vec3 size);
+
 // A UV sphere around the origin: `segments` around the y axis, `rings` from pole to pole
 // (>= 3 and >= 2). 2 * segments * (rings - 1) triangles: the pole rows are single triangles.
 MeshData makeUvSphere(float radius, int segments, int rings);

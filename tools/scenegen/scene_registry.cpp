@@ -20,6 +20,8 @@ const SceneRegistry& sceneRegistry() {
            {"sphere segments around (rings = half)", 64, 8, 256, false, 0}},
           {"cornell-glass", "the same box with the glass sphere and a white diffuse one (the photon map's accuracy benchmark)",
            buildCornellGlass, {"sphere segments around (rings = half)", 64, 8, 256, false, 0}},
+          {"cornell-rough", "the same box with a rough metal block and a frosted, partly transmissive sphere (glossy light)",
+           buildCornellRough, {"sphere segments around (rings = half)", 64, 8, 256, false, 0}},
           {"landscape", "fBm Perlin terrain lit by a spherical light directly and through a glass lens (Jensen 1996, fig. 4)",
            buildLandscape, {"terrain grid cells per side (2 * size^2 triangles)", 708, 1, 2048, true, 1}},
           {"hotspot", "load-balancing study: a dense cluster of spheres in the top-left corner of a plain room",

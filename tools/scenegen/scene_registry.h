@@ -44,6 +44,7 @@ GltfBuilder generateScene(const SceneEntry& scene, const SceneParams& params);
 void buildCornell(GltfBuilder& builder, const SceneParams& params);
 void buildCornellDiffuse(GltfBuilder& builder, const SceneParams& params);
 void buildCornellGlass(GltfBuilder& builder, const SceneParams& params);
+void buildCornellRough(GltfBuilder& builder, const SceneParams& params);
 void buildLandscape(GltfBuilder& builder, const SceneParams& params);
 void buildHotspot(GltfBuilder& builder, const SceneParams& params);
 // stress.cpp: the scenes that stress the numerics.

@@ -49,6 +49,26 @@ TEST_CASE("MeshGen: UV sphere has 2 s (r-1) outward, non-degenerate triangles an
   }
 }
 
+TEST_CASE("MeshGen: a box has 12 outward triangles on its six faces, standing on the origin") {
+  const glm::vec3 size(2.0f, 3.0f, 4.0f);
+  MeshData b = makeBox(size);
+  REQUIRE(b.triangleCount() == 12);
+  const glm::vec3 centre(0.0f, 1.5f, 0.0f);
+  for (size_t t = 0; t < 12; ++t) {
+    const glm::vec3 n = faceNormal(b, t), c = centroid(b, t);
+    CHECK(glm::dot(n, c - centre) > 0.0f);  // counter-clockwise seen from outside
+    // The vertex normal is the face's, and the face lies on the box's side it points to.
+    const glm::vec3 vn = b.normals[b.indices[3 * t]];
+    CHECK(glm::length(glm::normalize(n) - vn) < 1e-6f);
+    CHECK(glm::dot(c - centre, vn) == doctest::Approx(0.5f * glm::dot(glm::abs(vn), size)));
+  }
+  for (const glm::vec3& p : b.positions) {
+    CHECK(std::fabs(p.x) == doctest::Approx(1.0f));
+    CHECK((p.y == 0.0f || p.y == 3.0f));
+    CHECK(std::fabs(p.z) == doctest::Approx(2.0f));
+  }
+}
+
 TEST_CASE("MeshGen: ellipsoid normals are the surface gradient, not the scaled sphere's") {
   const glm::vec3 c(1, 2, 3), r(1.5f, 0.5f, 1.5f);
   MeshData e = makeEllipsoid(c, r, 24, 12);
