@@ -90,7 +90,7 @@ std::string defaultOutput(const std::string& scene, const std::string& method) {
 void run(RenderArgs& a) {
   const RenderMethod& method = findRenderMethod(a.method);
   checkFamilyOptions(method, a.family);
-  checkRenderMemory(method, a.width, a.height, a.threads, a.settings.ray.spp);
+  checkRenderMemory(method, a.width, a.height, a.threads, samplesPerPixel(a.settings.ray));
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
   if (a.output.empty()) a.output = defaultOutput(a.scene, a.method);
   const std::string ext = std::filesystem::path(a.output).extension().string();

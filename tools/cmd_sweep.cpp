@@ -1,4 +1,4 @@
-// `parrender sweep SCENE --vary photons|gather|spp|k|radius [--values LIST] --integrator LIST`:
+// `parrender sweep SCENE --vary photons|gather|spp|k|radius|cache-accuracy|irradiance-stride [--values LIST] --integrator LIST`:
 // what accuracy costs in time. Renders a series of images, the photon-map integrator over the
 // varied setting and the path tracer over its samples per pixel, compares each with a
 // reference (a long path-traced render, cached on disk with its settings: sweep/reference_cache.h)
@@ -89,8 +89,9 @@ void addSweepCommand(CLI::App& app) {
   auto a = std::make_shared<SweepArgs>();
   CLI::App* cmd = app.add_subcommand("sweep", "accuracy against time: render a series, compare each image with a path-traced reference");
   cmd->add_option("scene", a->scene, "glTF 2.0 scene (.gltf or .glb)")->required()->check(CLI::ExistingFile);
-  cmd->add_option("--vary", a->vary, "the photon map's setting to vary: photons | gather | spp | k | radius")
-      ->check(CLI::IsMember({"photons", "gather", "spp", "k", "radius"}))
+  cmd->add_option("--vary", a->vary,
+                  "the photon map's setting to vary: photons | gather | spp | k | radius | cache-accuracy | irradiance-stride")
+      ->check(CLI::IsMember({"photons", "gather", "spp", "k", "radius", "cache-accuracy", "irradiance-stride"}))
       ->capture_default_str();
   cmd->add_option("--values", a->values, "the varied setting's values, comma-separated (default: a series per setting)")->delimiter(',');
   cmd->add_option("--integrator", a->integrators, "integrators to compare, comma-separated (path is swept over --path-spp unless --vary spp)")
@@ -127,6 +128,11 @@ void addSweepCommand(CLI::App& app) {
   cmd->add_option("--gather", p.gatherRays, "photonmap: final-gather rays per record")->check(CLI::Range(1, 65536))->capture_default_str();
   cmd->add_option("--k", p.globalK, "photonmap: photons per global-map estimate")->check(CLI::Range(1, 10000))->capture_default_str();
   cmd->add_option("--radius", p.globalRadius, "photonmap: global-map radius (0 = automatic)")->check(CLI::NonNegativeNumber)->capture_default_str();
+  cmd->add_option("--cache-accuracy", p.cacheAccuracy, "photonmap: irradiance-cache accuracy a (smaller = more records)")
+      ->check(CLI::Range(0.001f, 1.0f))->capture_default_str();
+  cmd->add_option("--irradiance-stride", p.irradianceStride,
+                  "photonmap: every n-th global photon carries a precomputed irradiance that gathers read (0 = none)")
+      ->check(CLI::Range(0, 1024))->capture_default_str();
   par::addScheduleOptions(*cmd, a->schedule);
   addLightingOptions(*cmd, a->lighting);
   cmd->callback([a, pathSpp] {

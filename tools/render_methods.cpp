@@ -30,7 +30,7 @@ std::string notSimulated(const scene::RenderPlan& plan, scene::EffectSet simulat
 RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   rt::TraceOptions options;
   options.integrator.effects = r.plan.enabled();
-  options.integrator.spp = r.settings.ray.spp;
+  options.integrator.spp = samplesPerPixel(r.settings.ray);
   options.integrator.maxDepth = r.settings.ray.maxDepth;
   options.integrator.seed = r.settings.ray.seed;
   options.tileSizePx = r.settings.ray.tileSizePx;
@@ -216,15 +216,23 @@ std::string describeRenderMethods() {
   return out;
 }
 
+int samplesPerPixel(const RayOptions& ray) {
+  if (ray.sppOption && ray.sppOption->count() == 0 && ray.integrator == "photonmap") return kPhotonMapDefaultSpp;
+  return ray.spp;
+}
+
 void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& family) {
   RayOptions& ray = settings.ray;
   family.emplace_back(command.add_option("--integrator", ray.integrator, "ray tracing: the integrator (default " + ray.integrator + "):\n" + integrators().describe())
                           ->check(CLI::Validator([](std::string& v) { return integrators().problem(v); }, "INTEGRATOR")),
                       MethodFamily::Ray);
-  family.emplace_back(command.add_option("--spp", ray.spp, "ray tracing: stratified samples per pixel")
-                          ->check(CLI::Range(1, rt::kMaxSpp))
-                          ->capture_default_str(),
-                      MethodFamily::Ray);
+  CLI::Option* spp = command.add_option("--spp", ray.spp,
+                                     "ray tracing: stratified samples per pixel (default " + std::to_string(kDefaultSpp) + ", " +
+                                         std::to_string(kPhotonMapDefaultSpp) +
+                                         " for the photon map, whose fixed pre-pass fewer samples would leave noisier than it needs)")
+                      ->check(CLI::Range(1, rt::kMaxSpp));
+  ray.sppOption = spp;
+  family.emplace_back(spp, MethodFamily::Ray);
   family.emplace_back(command.add_option("--max-depth", ray.maxDepth, "ray tracing: surface interactions shaded per path")
                           ->check(CLI::Range(1, rt::kMaxDepthLimit))
                           ->capture_default_str(),
@@ -276,6 +284,9 @@ void addRayOptions(CLI::App& command, RenderSettings& settings, FamilyOptions& f
              ->check(CLI::Range(1, 65536))->capture_default_str());
   photon(command.add_option("--cache-accuracy", pm.cacheAccuracy, "photonmap: irradiance-cache accuracy a (smaller = more records)")
              ->check(CLI::Range(0.001f, 1.0f))->capture_default_str());
+  photon(command.add_option("--irradiance-stride", pm.irradianceStride,
+                            "photonmap: every n-th global photon carries a precomputed irradiance estimate that gathers read (0 = none: every gather hit estimates its own)")
+             ->check(CLI::Range(0, 1024))->capture_default_str());
   photon(command.add_option("--view", ray.view, "photonmap: full | global-map | caustic-map (a map's estimate at the first hit)")
              ->check(CLI::IsMember({"full", "global-map", "caustic-map"}))->capture_default_str());
 }

@@ -47,7 +47,14 @@ struct RayOptions {
   pm::PhotonMapSettings photonmap;
   std::string view = "full";
   std::vector<const CLI::Option*> photonOptions;
+  const CLI::Option* sppOption = nullptr;  // --spp where the command has it (see samplesPerPixel)
 };
+
+// The samples per pixel a render takes: spp when set (by --spp, or by a command that has no
+// such option), else the integrator's default: 16 for the photon map, whose pre-pass is a fixed
+// cost that fewer samples leave noisier than it makes necessary, 4 for the others.
+inline constexpr int kDefaultSpp = 4, kPhotonMapDefaultSpp = 16;
+int samplesPerPixel(const RayOptions& ray);
 
 // Options of the rasterization family (raster/sort/sort_point.h SortOptions, plus frames).
 struct RasterOptions {

@@ -89,6 +89,23 @@ TEST_CASE("Render: --integrator photonmap renders and reports its maps and cache
   CHECK(std::filesystem::exists(dir / "pm_object.png"));
 }
 
+TEST_CASE("Render: the photon map takes 16 samples per pixel unless --spp says otherwise, the other integrators 4") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_default_spp");
+  auto summary = [&](const std::string& options) {
+    const auto r = runParrender(join({"render ", cornell(), " --threads 2 --width 8 --height 8 --photons 2000 --caustic-photons 1000",
+                                      " --gather 16 ", options, " -o \"", (dir / "x.png").string(), "\""}));
+    INFO(r.output);
+    CHECK(r.exitStatus == 0);
+    return r.output;
+  };
+  CHECK(summary("--integrator photonmap").find("integrator photonmap, spp 16,") != std::string::npos);
+  CHECK(summary("--integrator photonmap --spp 4").find("integrator photonmap, spp 4,") != std::string::npos);
+  const auto path = runParrender(join({"render ", cornell(), " --threads 2 --width 8 --height 8 --integrator path -o \"",
+                                       (dir / "y.png").string(), "\""}));
+  INFO(path.output);
+  CHECK(path.output.find("integrator path, spp 4,") != std::string::npos);
+}
+
 TEST_CASE("Render: --help lists every integrator and compositor of their registries") {
   const auto r = runParrender("render --help");
   INFO(r.output);

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -70,6 +71,32 @@ TEST_CASE("Sweep: a small sweep prints both curves, writes CSV and JSON, and reu
   INFO(second.output);
   CHECK(second.exitStatus == 0);
   CHECK(second.output.find("reference: cached") != std::string::npos);
+}
+
+TEST_CASE("Sweep: the cache's accuracy and the precomputed-irradiance stride are settings it varies, stride 0 included") {
+  const std::filesystem::path dir = pr::test::scratchDir("sweep_cache");
+  const std::string common = join({"sweep ", cornell(), " --width 12 --height 12 --threads 2 --integrator photonmap --photons 3000",
+                                   " --caustic-photons 1000 --gather 16 --spp 1 --reference-spp 8 --no-cache"});
+  const auto stride = runParrender(join({common, " --vary irradiance-stride --values 0,8 --csv \"", (dir / "s.csv").string(), "\""}));
+  INFO(stride.output);
+  REQUIRE(stride.exitStatus == 0);
+  std::ifstream csv(dir / "s.csv");
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(csv, line)) rows.push_back(line);
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[1].rfind("photonmap,irradiance-stride,0,", 0) == 0);
+  CHECK(rows[2].rfind("photonmap,irradiance-stride,8,", 0) == 0);
+  const auto accuracy = runParrender(join({common, " --vary cache-accuracy --values 0.5,0.2"}));
+  INFO(accuracy.output);
+  CHECK(accuracy.exitStatus == 0);
+  for (const char* bad : {" --vary cache-accuracy --values 0", " --vary cache-accuracy --values 2", " --vary irradiance-stride --values -1",
+                          " --vary irradiance-stride --values 1.5"}) {
+    const auto r = runParrender(join({common, bad}));
+    CAPTURE(bad);
+    CHECK(r.exitStatus == 2);
+    CHECK(r.output.find("--values") != std::string::npos);
+  }
 }
 
 TEST_CASE("Sweep: varying a photon-map setting without the photon map is an input error") {

@@ -144,7 +144,9 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
             std::string reason = whyInvalid(c, spec);
             if (reason.empty()) {
               try {
-                checkRenderMemory(method, input.width, input.height, p, spec.settings.ray.spp);
+                RayOptions rayOptions = spec.settings.ray;
+                if (integrator != kNotApplicable) rayOptions.integrator = integrator;
+                checkRenderMemory(method, input.width, input.height, p, samplesPerPixel(rayOptions));
               } catch (const InputError& e) {
                 reason = e.what();
               }

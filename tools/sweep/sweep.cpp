@@ -61,7 +61,29 @@ void applyVaried(const std::string& vary, double value, RenderSettings& s) {
     p.globalK = int(value);
   } else if (vary == "radius") {
     p.globalRadius = float(value);
+  } else if (vary == "cache-accuracy") {
+    p.cacheAccuracy = float(value);
+  } else if (vary == "irradiance-stride") {
+    p.irradianceStride = int(value);
   }
+}
+
+// The values a varied setting takes: (least, most], or [least, most] where least is allowed.
+struct VariedRange {
+  double least = 0.0;
+  bool leastAllowed = false;
+  double most = 1e30;
+  bool integral = true;
+};
+
+VariedRange variedRange(const std::string& vary) {
+  if (vary == "photons") return {0.0, false, 1e8, true};
+  if (vary == "gather") return {0.0, false, 65536.0, true};
+  if (vary == "spp") return {0.0, false, double(rt::kMaxSpp), true};
+  if (vary == "k") return {0.0, false, 10000.0, true};
+  if (vary == "cache-accuracy") return {0.001, true, 1.0, false};
+  if (vary == "irradiance-stride") return {0.0, true, 1024.0, true};  // 0: no precomputed irradiance
+  return {0.0, false, 1e30, false};                                   // radius
 }
 
 std::vector<double> defaultValues(const std::string& vary, const scene::Scene& scene) {
@@ -69,6 +91,8 @@ std::vector<double> defaultValues(const std::string& vary, const scene::Scene& s
   if (vary == "gather") return {32, 64, 128, 256, 512};
   if (vary == "spp") return {1, 2, 4, 8, 16};
   if (vary == "k") return {25, 50, 100, 200};
+  if (vary == "cache-accuracy") return {0.5, 0.25, 0.125, 0.0625};
+  if (vary == "irradiance-stride") return {16, 4, 1, 0};
   const float diagonal = glm::length(scene.bounds.extent());
   return {0.02 * diagonal, 0.05 * diagonal, 0.1 * diagonal};
 }
@@ -108,13 +132,13 @@ SweepResult runSweep(SweepSpec& a) {
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
   if (a.values.empty()) a.values = defaultValues(a.vary, scene);
   // Each value must make sense for the setting it sets, checked before any cast.
-  const double most = a.vary == "photons" ? 1e8 : a.vary == "gather" ? 65536.0 : a.vary == "spp" ? double(rt::kMaxSpp)
-                    : a.vary == "k" ? 10000.0 : 1e30;
-  const bool integral = a.vary != "radius";
+  const VariedRange range = variedRange(a.vary);
   for (double v : a.values)
-    if (!(v > 0.0) || !std::isfinite(v) || v > most || (integral && v != std::floor(v)))
-      throw InputError("--values: " + formatValue(v) + " is not a valid " + a.vary + " (" + (integral ? "an integer " : "a number ") +
-                       "in (0, " + formatValue(most) + "])");
+    if (!std::isfinite(v) || (range.leastAllowed ? v < range.least : !(v > range.least)) || v > range.most ||
+        (range.integral && v != std::floor(v)))
+      throw InputError("--values: " + formatValue(v) + " is not a valid " + a.vary + " (" +
+                       (range.integral ? "an integer " : "a number ") + "in " + (range.leastAllowed ? "[" : "(") +
+                       formatValue(range.least) + ", " + formatValue(range.most) + "])");
   const Context ctx{a, RenderInput{scene, camera, plan, a.width, a.height}};
   if (!a.images.empty()) std::filesystem::create_directories(a.images);
 

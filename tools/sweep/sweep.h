@@ -33,7 +33,7 @@ struct SweepSpec {
   std::vector<double> values;
   std::vector<std::string> integrators = {"photonmap", "path"};
   std::vector<int> pathSpp = {1, 4, 16, 64, 256};
-  int spp = 4;
+  int spp = 16;  // the photon map's samples per pixel (its render default, kPhotonMapDefaultSpp)
   int maxDepth = 8;
   std::uint64_t seed = 1;
   int referenceSpp = 1024;

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# The photon map's accuracy target (issue-level benchmark, not part of the test suite): on the
+# bundled Cornell box with a glass and a diffuse sphere (scenes/cornell-glass.gltf), 256x256,
+# P = 2, against a 4096-spp path-traced reference rendered in the same run (cached), the CPU
+# time the photon map needs to reach the RMSE of the path tracer's 64-spp image, as a fraction
+# of the path tracer's own CPU time for that image (target: at most 1/3). Both curves come from
+# one `parrender sweep`, the path tracer's 64-spp row being the baseline measured in the run.
+# Usage: tools/bench/photonmap_accuracy.sh [build-dir] [extra sweep options...]
+# The reference (about 5 CPU minutes) is cached in <build-dir>/bench-references.
+set -euo pipefail
+
+root="$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)"
+build="${1:-$root/build}"
+shift || true
+parrender="$build/tools/parrender"
+scene="$root/scenes/cornell-glass.gltf"
+out="$build/bench-photonmap-accuracy"
+mkdir -p "$out"
+[ -x "$parrender" ] || { echo "photonmap_accuracy: build parrender first ($parrender not found)" >&2; exit 2; }
+
+"$parrender" sweep "$scene" --width 256 --height 256 --threads 2 --integrator photonmap,path --vary spp \
+  --values 4,8,16,32 --path-spp 16,64,256 --reference-spp 4096 --reference-dir "$build/bench-references" \
+  --images "$out/images" --json "$out/sweep.json" --csv "$out/sweep.csv" "$@"
+python3 - "$out/sweep.json" <<'PY'
+import json, math, sys
+j = json.load(open(sys.argv[1]))
+rows = j["rows"]
+def curve(integrator):
+    return sorted((r["cpuSeconds"], r["rmse"], r["value"]) for r in rows if r["integrator"] == integrator)
+def cpu_to(points, target):
+    # log-log interpolation between the two renders around the target RMSE
+    if points and points[0][1] <= target:
+        return points[0][0]
+    for (t0, e0, _), (t1, e1, _) in zip(points, points[1:]):
+        if e0 > target >= e1:
+            f = (math.log(target) - math.log(e0)) / (math.log(e1) - math.log(e0))
+            return math.exp(math.log(t0) + f * (math.log(t1) - math.log(t0)))
+    return None
+path64 = next(r for r in rows if r["integrator"] == "path" and r["value"] == 64)
+pm = curve("photonmap")
+for t, e, v in pm:
+    print(f"photonmap {int(v):>3} spp: {t:6.2f} CPU s, RMSE {e:.4f}")
+print(f"path       64 spp: {path64['cpuSeconds']:6.2f} CPU s, RMSE {path64['rmse']:.4f} (the baseline)")
+t = cpu_to(pm, path64["rmse"])
+if t is None:
+    print("the photon map never reached the path tracer's 64-spp RMSE: FAIL")
+    sys.exit(1)
+ratio = t / path64["cpuSeconds"]
+print(f"photon map to the path tracer's 64-spp RMSE: {t:.2f} CPU s, {ratio:.2f} of the path tracer's time "
+      f"(target at most 0.33): {'PASS' if ratio <= 1 / 3 else 'FAIL'}")
+PY
