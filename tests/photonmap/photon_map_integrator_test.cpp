@@ -156,6 +156,28 @@ TEST_CASE("PhotonMapIntegrator: the Cornell box is close to a long path-traced r
 
 namespace {
 
+// A square n x n path-traced reference of (s, cam) at `spp`, depth 16, image-space.
+image::Image pathTraced(const scene::Scene& s, const scene::Camera& cam, int n, int spp, par::Runtime& runtime,
+                        scene::EffectSet effects = scene::EffectSet::all()) {
+  rt::TraceOptions path;
+  path.integrator.kind = rt::IntegratorKind::Path;
+  path.integrator.spp = spp;
+  path.integrator.maxDepth = 16;
+  path.integrator.effects = effects;
+  return rt::renderRays(s, cam, n, n, path, "image-space", runtime).image;
+}
+
+// The photon map's n x n image of (s, cam) with `settings` at `spp`, image-space.
+image::Image photonMapped(const scene::Scene& s, const scene::Camera& cam, int n, const pm::PhotonMapSettings& settings, int spp,
+                          par::Runtime& runtime, scene::EffectSet effects = scene::EffectSet::all()) {
+  rt::IntegratorOptions io;
+  io.spp = spp;
+  io.effects = effects;
+  rt::TraceJob job{s, cam, n, n, {}};
+  job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, n, n, io, settings);
+  return rt::renderRays(job, "image-space", runtime).image;
+}
+
 // Every 8x8 block of `image` within `tolerance` (relative) of the reference's; reports the worst.
 void checkBlocks(const image::Image& image, const image::Image& reference, double tolerance) {
   const int w = reference.width, h = reference.height;
@@ -206,20 +228,12 @@ TEST_CASE("PhotonMapIntegrator: a wall lit through a rough metal is within 3 % o
   const scene::Camera cam = test::perspectiveAt({0.0f, 1.0f, 0.8f}, 1.2f);
   constexpr int kN = 32;
 
-  rt::TraceOptions path;
-  path.integrator.kind = rt::IntegratorKind::Path;
-  path.integrator.spp = 8192;
-  path.integrator.maxDepth = 16;
   par::Runtime runtime(2);
-  const image::Image reference = rt::renderRays(s, cam, kN, kN, path, "image-space", runtime).image;
-  rt::IntegratorOptions io;
-  io.spp = 4;
+  const image::Image reference = pathTraced(s, cam, kN, 8192, runtime);
   pm::PhotonMapSettings settings = smallSettings();
   settings.globalPhotons = 200000;
   settings.gatherRays = 256;
-  rt::TraceJob job{s, cam, kN, kN, {}};
-  job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kN, kN, io, settings);
-  const image::Image photon = rt::renderRays(job, "image-space", runtime).image;
+  const image::Image photon = photonMapped(s, cam, kN, settings, 4, runtime);
 
   checkBlocks(photon, reference, 0.03);
 }
@@ -251,20 +265,12 @@ TEST_CASE("PhotonMapIntegrator: a floor under the default 4 % dielectric layer, 
   const scene::Camera cam = test::perspectiveAt({0.0f, 0.3f, 1.9f}, 0.5f);
   constexpr int kN = 32;
 
-  rt::TraceOptions path;
-  path.integrator.kind = rt::IntegratorKind::Path;
-  path.integrator.spp = 8192;
-  path.integrator.maxDepth = 16;
   par::Runtime runtime(2);
-  const image::Image reference = rt::renderRays(s, cam, kN, kN, path, "image-space", runtime).image;
-  rt::IntegratorOptions io;
-  io.spp = 4;
+  const image::Image reference = pathTraced(s, cam, kN, 8192, runtime);
   pm::PhotonMapSettings settings = smallSettings();
   settings.globalPhotons = 200000;
   settings.gatherRays = 256;
-  rt::TraceJob job{s, cam, kN, kN, {}};
-  job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(s, cam, kN, kN, io, settings);
-  const image::Image photon = rt::renderRays(job, "image-space", runtime).image;
+  const image::Image photon = photonMapped(s, cam, kN, settings, 4, runtime);
   checkBlocks(photon, reference, 0.08);
 }
 
@@ -359,27 +365,17 @@ TEST_CASE("PhotonMapIntegrator: the caustics of part glass and smooth plastic ma
     CAPTURE(name);
     const CausticStage stage = causticStage(c.material, c.x);
     par::Runtime runtime(2);
-    auto pathTraced = [&](scene::EffectSet effects) {
-      rt::TraceOptions path;
-      path.integrator.kind = rt::IntegratorKind::Path;
-      path.integrator.spp = 4096;
-      path.integrator.maxDepth = 16;
-      path.integrator.effects = effects;
-      return meanOf(rt::renderRays(stage.scene, stage.camera, kN, kN, path, "image-space", runtime).image);
+    auto pathMean = [&](scene::EffectSet effects) {
+      return meanOf(pathTraced(stage.scene, stage.camera, kN, 4096, runtime, effects));
     };
-    auto photonMapped = [&](std::size_t photons, scene::EffectSet effects) {
+    auto photonMean = [&](std::size_t photons, scene::EffectSet effects) {
       pm::PhotonMapSettings settings = smallSettings();
       settings.causticPhotons = photons;
       settings.globalRadius = 0.1f;
-      rt::IntegratorOptions io;
-      io.spp = 4;
-      io.effects = effects;
-      rt::TraceJob job{stage.scene, stage.camera, kN, kN, {}};
-      job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(stage.scene, stage.camera, kN, kN, io, settings);
-      return meanOf(rt::renderRays(job, "image-space", runtime).image);
+      return meanOf(photonMapped(stage.scene, stage.camera, kN, settings, 4, runtime, effects));
     };
-    const double reference = pathTraced(scene::EffectSet::all()) - pathTraced(noCaustics);
-    const double withoutCaustics = photonMapped(0, noCaustics);
+    const double reference = pathMean(scene::EffectSet::all()) - pathMean(noCaustics);
+    const double withoutCaustics = photonMean(0, noCaustics);
     REQUIRE(reference > 0.0);
     const rt::Bvh bvh(stage.scene);
     for (std::size_t photons : {c.photons, 4 * c.photons, 16 * c.photons}) {
@@ -393,7 +389,7 @@ TEST_CASE("PhotonMapIntegrator: the caustics of part glass and smooth plastic ma
       for (const pm::Photon& p : pm::tracePhotonLists(stage.scene, bvh, options, tracing).caustic)
         inWindow += std::fabs(p.position.y) < 1.0e-3f && std::fabs(p.position.x - c.x) <= 0.4f * std::sqrt(2.0f) &&
                     std::fabs(p.position.z) <= 0.4f;
-      const double caustic = photonMapped(photons, scene::EffectSet::all()) - withoutCaustics;
+      const double caustic = photonMean(photons, scene::EffectSet::all()) - withoutCaustics;
       const double error = std::fabs(caustic / reference - 1.0);
       const double bound = 0.04 + 3.0 / std::sqrt(double(std::max<std::size_t>(inWindow, 1)));
       MESSAGE(name << ", " << photons << " caustic photons (" << inWindow << " in the window): caustic " << caustic
@@ -426,19 +422,11 @@ TEST_CASE("PhotonMapIntegrator: frosted, partly transmissive glass matches the p
   for (const CausticStage* stage : {&floor, &sphere, &inside}) {
     const std::string view = stage == &floor ? "the floor under it" : stage == &sphere ? "the sphere" : "inside the sphere";
     CAPTURE(view);
-    rt::TraceOptions path;
-    path.integrator.kind = rt::IntegratorKind::Path;
-    path.integrator.spp = 2048;
-    path.integrator.maxDepth = 16;
-    const image::Image reference = rt::renderRays(stage->scene, stage->camera, kN, kN, path, "image-space", runtime).image;
     pm::PhotonMapSettings settings = smallSettings();
     settings.globalPhotons = 400000;
     settings.globalRadius = 0.1f;
-    rt::IntegratorOptions io;
-    io.spp = 16;
-    rt::TraceJob job{stage->scene, stage->camera, kN, kN, {}};
-    job.integrator = std::make_shared<const pm::PhotonMapIntegrator>(stage->scene, stage->camera, kN, kN, io, settings);
-    const double a = meanOf(rt::renderRays(job, "image-space", runtime).image), b = meanOf(reference);
+    const double a = meanOf(photonMapped(stage->scene, stage->camera, kN, settings, 16, runtime));
+    const double b = meanOf(pathTraced(stage->scene, stage->camera, kN, 2048, runtime));
     MESSAGE(view << ": photon map " << a << ", path tracer " << b << ", " << (a / b - 1.0) * 100.0 << " %");
     REQUIRE(b > 0.0);
     CHECK(std::fabs(a / b - 1.0) <= 0.05);
