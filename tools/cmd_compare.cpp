@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/image/codec_loader.h"
 #include "common/image/image_io.h"
 #include "common/parallel/run_options.h"
 #include "common/scene/camera_select.h"
@@ -105,7 +106,10 @@ void run(CompareArgs& a) {
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
-  if (!a.images.empty()) std::filesystem::create_directories(a.images);
+  if (!a.images.empty()) {
+    std::filesystem::create_directories(a.images);
+    image::preloadImageCodec();
+  }
 
   const Comparison c = runComparison(spec, RenderInput{scene, camera, plan, a.width, a.height});
 

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/image/codec_loader.h"
 #include "common/image/image_io.h"
 #include "common/parallel/runtime.h"
 #include "common/scene/camera_select.h"
@@ -109,6 +110,7 @@ void run(const GalleryArgs& a) {
   if (!fs::is_directory(a.dir)) throw InputError(a.dir + ": not a directory");
   const std::vector<fs::path> models = findModels(a.dir);
   if (models.empty()) throw InputError(a.dir + ": no .gltf or .glb files under it");
+  image::preloadImageCodec();
   // Written to a new folder first, so an interrupted run leaves an earlier gallery intact.
   const fs::path out(a.output), temp = fs::path(a.output + ".partial");
   fs::remove_all(temp);

@@ -13,6 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/image/codec_loader.h"
 #include "common/image/image_io.h"
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_options.h"
@@ -96,6 +97,7 @@ void run(RenderArgs& a) {
   const std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr")
     throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
+  image::preloadImageCodec();  // opened while the scene loads and renders, not after
 
   scene::Scene scene = loadScene(a.scene, a.lighting);
   const std::string lighting = applyLighting(scene, a.lighting);

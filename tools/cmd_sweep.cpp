@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "common/image/codec_loader.h"
 #include "common/parallel/run_options.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
@@ -34,6 +35,7 @@ struct SweepArgs : SweepSpec {
 };
 
 void run(SweepArgs& a) {
+  image::preloadImageCodec();  // the cached reference and the images
   const SweepResult result = runSweep(a);
   const std::vector<SweepRow>& rows = result.rows;
   const double target = result.targetRmse;

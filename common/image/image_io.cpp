@@ -1,10 +1,10 @@
-// Image files through OpenImageIO (see image_io.h): EXR for linear radiance, PNG for viewing.
+// Image files (see image_io.h): EXR for linear radiance, PNG for viewing. The pixels are
+// encoded and decoded by the image codec module (OpenImageIO, image_codec.h), opened on first use.
 // Called once per render on the main thread after the PEs have finished, and by `compare`.
 #include "common/image/image_io.h"
 
+#include "common/image/codec_loader.h"
 #include "common/util/atomic_file.h"
-
-#include <OpenImageIO/imageio.h>
 
 #include <algorithm>
 #include <cctype>
@@ -47,34 +47,20 @@ void writeImage(const fs::path& path, const Image& image, const WriteOptions& op
   // format is named explicitly below rather than guessed from the file name.
   TempFile temp(path, "image file");
 
-  const char* formatName = format == Format::Exr ? "openexr" : "png";
-  auto out = OIIO::ImageOutput::create(formatName);
-  PR_CHECK(out != nullptr, std::string("OpenImageIO has no writer for ") + formatName);
-
+  const ImageCodec& codec = imageCodec();
   const size_t count = image.pixels.size();
-  bool ok = false;
+  std::string why;
   if (format == Format::Exr) {
-    OIIO::ImageSpec spec(image.width, image.height, 3, options.exrHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-    spec.attribute("compression", "zip");
     // glm::vec3 is three packed floats, so the pixel array is the interleaved RGB buffer.
     static_assert(sizeof(glm::vec3) == 3 * sizeof(float));
-    ok = out->open(temp.path().string(), spec) &&
-         out->write_image(OIIO::TypeDesc::FLOAT, image.pixels.data()) && out->close();
+    why = codec.writeExr(temp.path().string(), image.width, image.height, &image.pixels.data()->x, options.exrHalf);
   } else {
     std::vector<uint8_t> bytes(count * 3);
     for (size_t i = 0; i < count; ++i)
       for (int c = 0; c < 3; ++c) bytes[3 * i + c] = toDisplay8(image.pixels[i][c], options.display);
-    OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
-    spec.attribute("oiio:ColorSpace", "sRGB");
-    ok = out->open(temp.path().string(), spec) && out->write_image(OIIO::TypeDesc::UINT8, bytes.data()) &&
-         out->close();
+    why = codec.writePng(temp.path().string(), image.width, image.height, bytes.data());
   }
-  if (!ok) {
-    std::string why = out->geterror();
-    out.reset();  // closes the file before the temporary is removed
-    throw InputError("cannot write image file '" + path.string() + "'" + (why.empty() ? "" : ": " + why));
-  }
-  out.reset();
+  if (!why.empty()) throw InputError("cannot write image file '" + path.string() + "': " + why);
 
   temp.commit();
 }
@@ -86,19 +72,15 @@ Image readImage(const fs::path& path) {
   const Format format = ext == ".hdr" ? Format::Exr : ext == ".jpg" || ext == ".jpeg" ? Format::Png : formatOf(path);
   if (!fs::is_regular_file(path)) throw InputError("image file '" + path.string() + "' does not exist");
 
-  auto in = OIIO::ImageInput::open(path.string());
-  if (!in) throw InputError("cannot read image file '" + path.string() + "': " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  const int channels = spec.nchannels;
-  if (spec.width <= 0 || spec.height <= 0 || channels < 1)
+  DecodedPixels decoded;
+  if (const std::string why = imageCodec().read(path.string(), decoded); !why.empty())
+    throw InputError("cannot read image file '" + path.string() + "': " + why);
+  const int channels = decoded.channels;
+  if (decoded.width <= 0 || decoded.height <= 0 || channels < 1)
     throw InputError("image file '" + path.string() + "' has no pixels");
+  const std::vector<float>& data = decoded.data;
 
-  std::vector<float> data(static_cast<size_t>(spec.width) * spec.height * channels);
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
-    throw InputError("cannot read image file '" + path.string() + "': " + in->geterror());
-  in->close();
-
-  Image image(spec.width, spec.height);
+  Image image(decoded.width, decoded.height);
   // Channels: 1 or 2 (grey, grey+alpha) replicate the first; 3+ take R, G, B and drop the rest.
   const bool grey = channels < 3;
   for (size_t i = 0; i < image.size(); ++i) {

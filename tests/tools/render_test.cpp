@@ -128,3 +128,24 @@ RENDER_BAD_INPUT("an unknown photon-map view", join({"render ", cornell(), " --i
 RENDER_BAD_INPUT("an unknown compositor, listing the registry's",
                  join({"render ", cornell(), " -m sort-last --compositor foo", out}),
                  "unknown compositor 'foo' (expected one of: direct-send, binary-swap)")
+
+TEST_CASE("Render: the image codec is opened only by commands that read or write an image") {
+  // With the codec module pointed at a path that does not exist, commands that touch no image
+  // run as usual (they never open it: start-up without OpenImageIO's libraries), and one that
+  // writes an image fails with one message naming the module, leaving no output behind.
+  const auto dir = pr::test::scratchDir("render_no_codec");
+  const std::string missing = "PARRENDER_IMAGE_CODEC=" + quoted(dir / "absent.so") + " ";
+  auto run = [&](const std::string& args) { return pr::test::runCommand(missing + "\"" + PARRENDER_EXE + "\" " + args); };
+  CHECK(run("--help").exitStatus == 0);
+  const auto info = run("info " + cornell());
+  INFO(info.output);
+  CHECK(info.exitStatus == 0);
+  CHECK(run("generate cornell -o " + quoted(dir / "c.gltf")).exitStatus == 0);
+  const auto out = dir / "c.png";
+  const auto r = run(join({"render ", cornell(), " -m sort-middle -o ", quoted(out), " --width 16 --height 16 --threads 1"}));
+  INFO(r.output);
+  CHECK(r.exitStatus == 1);
+  CHECK(r.output.find("image codec") != std::string::npos);
+  CHECK(r.output.find("absent.so") != std::string::npos);
+  CHECK(!std::filesystem::exists(out));
+}
