@@ -112,10 +112,10 @@ void Runtime::runOnOnePe(std::string_view name, int pe, const std::function<void
   runPinned(name, TaskSet::uniform(1), {pe}, [&](Pe& p, TaskId) { work(p); });
 }
 
-void Runtime::recordBroadcast(std::size_t bytesPerPe) {
+void Runtime::recordBroadcast(std::size_t bytes, int root) {
   PR_CHECK(!inStage_, "recordBroadcast is called between stages");
-  pendingBroadcasts_ += 1;
-  pendingBroadcastBytes_ += bytesPerPe;
+  PR_CHECK(root >= 0 && root < options_.pes, "broadcast root out of range");
+  pendingBroadcasts_.push_back({bytes, root});
 }
 
 void Runtime::addCounter(std::string_view name, int pe, double value) {
@@ -396,8 +396,11 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.bytesReceived = c.bytesReceived.load();
     r.schedulingMessages = c.schedulingMessages.load();
     r.schedulingBytes = c.schedulingBytes.load();
-    r.broadcastsReceived = pendingBroadcasts_;
-    r.broadcastBytesReceived = pendingBroadcastBytes_;
+    for (const PendingBroadcast& b : pendingBroadcasts_)
+      if (b.root != p) {
+        r.broadcastsReceived += 1;
+        r.broadcastBytesReceived += b.bytes;
+      }
     r.cacheHits = c.cacheHits.load();
     r.cacheMisses = c.cacheMisses.load();
     r.prefetches = c.prefetches.load();
@@ -413,7 +416,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
       if (messages > 0) sr.channels.push_back({channel->name(), std::string(toString(channel->kind())), messages, bytes});
     }
   }
-  pendingBroadcasts_ = pendingBroadcastBytes_ = 0;
+  pendingBroadcasts_.clear();
   record_.stages.push_back(std::move(sr));
   for (auto& s : spans_) record_.timeline.insert(record_.timeline.end(), s.begin(), s.end());
   record_.wallSeconds = end - record_.stages.front().startSeconds;

@@ -13,7 +13,7 @@
 //
 //   par::Runtime rt(8, "spiral", scheduleOptions.params);   // or from --schedule/--grain
 //   par::Channel<RayBatch> rays(rt, "rays", par::MessageKind::Rays, [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
-//   rt.recordBroadcast(sceneBytes);                         // the scene, replicated on every PE
+//   rt.recordBroadcast(sceneBytes);                         // the scene, from PE 0 to every other PE
 //   rt.runStage("trace", par::TaskSet::grid(tilesX, tilesY), [&](par::Pe& pe, par::TaskId t) {
 //     for (RayBatch& b : primaryRays(t)) rays.send(pe, ownerOf(b), std::move(b), b.bytes());
 //   });
@@ -135,9 +135,10 @@ class Runtime {
   // which the simulator keeps on one PE at any P.
   void runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work);
 
-  // Replicated read-only data (scene, photon map) of bytesPerPe, sent once to every PE:
-  // counted as one broadcast message per receiving PE in the next stage run.
-  void recordBroadcast(std::size_t bytesPerPe);
+  // Replicated read-only data (scene, photon map) of `bytes`, held by PE `root` and sent once
+  // to every other PE: counted as one broadcast message per receiving PE in the next stage run
+  // (root receives nothing, so a P = 1 run has no broadcast traffic).
+  void recordBroadcast(std::size_t bytes, int root = 0);
 
   // Adds value to the named per-PE counter (created at zero for every PE on first use).
   // Thread-safe: callable from tasks, handlers or the controlling thread.
@@ -202,7 +203,11 @@ class Runtime {
   OutstandingWork outstanding_;
   std::atomic<bool> abort_{false};
   bool inStage_ = false;
-  std::size_t pendingBroadcastBytes_ = 0, pendingBroadcasts_ = 0;
+  struct PendingBroadcast {
+    std::size_t bytes;
+    int root;
+  };
+  std::vector<PendingBroadcast> pendingBroadcasts_;
 
   // The PE threads and the stage hand-over: the controlling thread publishes job_ and bumps
   // generation_; each worker runs it once and the last one to finish wakes the controller.

@@ -255,8 +255,10 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
     for (int p = 0; p < pes; ++p) {
       const double arrival = net.broadcastArrival(p, stage.broadcasts, stage.broadcastBytes);
       PeStageRecord& r = sr.pes[p];
-      r.broadcastsReceived = stage.broadcasts;
-      r.broadcastBytesReceived = stage.broadcastBytes;
+      if (p != 0) {  // PE 0 holds the data it broadcasts
+        r.broadcastsReceived = stage.broadcasts;
+        r.broadcastBytesReceived = stage.broadcastBytes;
+      }
       r.messageWaitSeconds += arrival;
       double t = stageStart + arrival;
       const SetupLoad& setup = plan.setups[p];

@@ -45,13 +45,18 @@ double analyticCompositeBytes(int width, int height, int pes) {
   return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1);
 }
 
+// A broadcast total over its receivers: every PE but the root that holds the data.
+std::uint64_t perReceivingPe(const ComparisonRow& r, std::uint64_t total) {
+  return r.what.pes > 1 ? total / std::uint64_t(r.what.pes - 1) : 0;
+}
+
 // The figure that shows the method's class, measured on this scene.
 std::string measuredFigure(const ComparisonRow& r, int width, int height) {
   const std::string& m = r.what.method;
   const int p = r.what.pes;
   if (m == "sequential") return "Ts = " + fmt(r.wall, "%.3f") + " s";
   if (m == "image-space")
-    return "broadcast " + formatBytes(kindBytes(r, "broadcasts") / std::uint64_t(p)) + " per PE, " +
+    return "broadcast " + formatBytes(perReceivingPe(r, kindBytes(r, "broadcasts"))) + " per receiving PE, " +
            std::to_string(kindBytes(r, "rays", true)) + " ray messages (P=" + std::to_string(p) + ")";
   if (m == "image-space-cached")
     return (r.cacheHitRatio >= 0.0 ? "hit ratio " + fmt(r.cacheHitRatio, "%.3f") : std::string("no cache used")) + ", " + std::to_string(kindBytes(r, "requests", true)) +
@@ -462,8 +467,8 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
       const PredictedPoint* bestPoint = &s.predicted.front();
       for (const PredictedPoint& q : s.predicted)
         if (q.pes == s.bestPredictedPes) bestPoint = &q;
-      const std::uint64_t perPeBytes = kindBytes(r, "broadcasts") / std::uint64_t(r.what.pes);
-      const std::uint64_t perPeMessages = kindBytes(r, "broadcasts", true) / std::uint64_t(r.what.pes);
+      const std::uint64_t perPeBytes = perReceivingPe(r, kindBytes(r, "broadcasts"));
+      const std::uint64_t perPeMessages = perReceivingPe(r, kindBytes(r, "broadcasts", true));
       const std::uint64_t dataBytes = allTraffic(r).bytes - kindBytes(r, "broadcasts") - kindBytes(r, "tasks");
       html += "<li>" + escape(method) + ": " + fmt(last.seconds, "%.4f") + " s at " + std::to_string(topP) +
               " PEs (speed-up " + fmt(last.speedup, "%.3g") + ", efficiency " + fmt(last.efficiency, "%.3f") + ", imbalance " +

@@ -84,18 +84,26 @@ TEST_CASE("Runtime: bad options are input errors") {
   CHECK_THROWS_AS(Runtime(2, "demand", params), pr::InputError);
 }
 
-TEST_CASE("Runtime: an empty stage and a broadcast are recorded") {
+TEST_CASE("Runtime: an empty stage and a broadcast are recorded, for every PE but the one that holds the data") {
   Runtime rt(3);
   rt.recordBroadcast(1000);
+  rt.recordBroadcast(500, 2);
   rt.runStage("empty", TaskSet{}, [](Pe&, TaskId) {});
   rt.runStage("next", TaskSet::uniform(3), [](Pe&, TaskId) {});
   const RunRecord& r = rt.record();
   REQUIRE(r.stages.size() == 2);
-  for (const PeStageRecord& pe : r.stages[0].pes) {
-    CHECK(pe.broadcastsReceived == 1);
-    CHECK(pe.broadcastBytesReceived == 1000);
+  const std::uint64_t broadcasts[3] = {1, 2, 1}, bytes[3] = {500, 1500, 1000};
+  for (int p = 0; p < 3; ++p) {
+    const PeStageRecord& pe = r.stages[0].pes[std::size_t(p)];
+    CHECK(pe.broadcastsReceived == broadcasts[p]);
+    CHECK(pe.broadcastBytesReceived == bytes[p]);
     CHECK(pe.messagesReceived == 0);
   }
+  // One PE holds everything: nothing to send.
+  Runtime one(1);
+  one.recordBroadcast(1000);
+  one.runStage("alone", TaskSet::uniform(1), [](Pe&, TaskId) {});
+  CHECK(one.record().stages[0].pes[0].broadcastsReceived == 0);
   for (const PeStageRecord& pe : r.stages[1].pes) CHECK(pe.broadcastsReceived == 0);
 }
 
