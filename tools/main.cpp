@@ -2,9 +2,11 @@
 // Exit status: 0 success, 2 bad input (option, file, scene content), 1 any other failure.
 #include <cstdio>
 #include <exception>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
+#include "common/parallel/process_group.h"
 #include "common/util/allocator.h"
 #include "common/util/error.h"
 #include "common/util/interrupt.h"
@@ -14,6 +16,17 @@
 int main(int argc, char** argv) {
   pr::retainFreedMemory();
   pr::installInterruptHandler();
+  // The ranks of this run: one, or those mpirun started (common/parallel/process_group.h).
+  pr::par::ProcessGroup* group = nullptr;
+  try {
+    group = &pr::par::ProcessGroup::start(&argc, &argv);
+  } catch (const pr::InputError& e) {
+    std::fprintf(stderr, "parrender: error: %s\n", e.what());
+    return pr::kExitBadInput;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "parrender: failed: %s\n", e.what());
+    return 1;
+  }
   CLI::App app{"parrender: a parallel software renderer (sort-first/middle/last rasterizers, "
                "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};
   app.require_subcommand(1);
@@ -47,7 +60,14 @@ int main(int argc, char** argv) {
   pr::cli::addSimulateCommand(app);
   pr::cli::addSweepCommand(app);
 
+  int status = 0;
+  std::string error;
   try {
+    group->checkSameCommandLine(argc, argv);
+    if (group->ranks() > 1)
+      throw pr::InputError("launched as " + std::to_string(group->ranks()) +
+                           " ranks by mpirun, but parrender's methods do not run across processes yet: its runtime "
+                           "runs P PEs as threads of one process (run it without mpirun, with --threads P)");
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
@@ -59,11 +79,12 @@ int main(int argc, char** argv) {
     app.exit(e);  // prints the message and usage hint
     return pr::kExitBadInput;
   } catch (const pr::InputError& e) {
-    std::fprintf(stderr, "parrender: error: %s\n", e.what());
-    return pr::kExitBadInput;
+    status = pr::kExitBadInput;
+    error = e.what();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "parrender: failed: %s\n", e.what());
-    return 1;
+    status = 1;
+    error = e.what();
   }
-  return 0;
+  // Every rank ends with the run's status; rank 0 prints the failure, once.
+  return group->finish(status, error);
 }

@@ -26,6 +26,7 @@ packages=(
   libopenimageio-dev                             # EXR / PNG images
   libcli11-dev                                   # command-line parsing
   doctest-dev                                    # unit tests
+  libopenmpi-dev openmpi-bin                     # running across processes (mpirun)
   chromium                                       # the report's test opens it headless
 )
 # npm installs the report's plotting libraries; the Debian package only where no node is present

@@ -1,0 +1,116 @@
+// The MPI transport module (see transport.h): point-to-point messages as nonblocking MPI sends
+// (the bytes kept until MPI_Test says they have left) and matched probes (MPI_Improbe, safe
+// when several threads receive), on a duplicate of MPI_COMM_WORLD. The only code that includes
+// mpi.h; loaded by process_group.cpp when mpirun launched the program.
+#include <mpi.h>
+
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <mutex>
+#include <thread>
+
+#include "common/parallel/transport.h"
+
+namespace pr::par {
+namespace {
+
+class MpiTransport final : public Transport {
+ public:
+  explicit MpiTransport(MPI_Comm comm) : comm_(comm) {
+    MPI_Comm_rank(comm_, &rank_);
+    MPI_Comm_size(comm_, &ranks_);
+  }
+
+  int rank() const override { return rank_; }
+  int ranks() const override { return ranks_; }
+
+  void send(int to, int tag, Bytes bytes) override {
+    std::lock_guard lock(mutex_);
+    completeSends();
+    Pending& p = pending_.emplace_back();
+    p.bytes = std::move(bytes);
+    MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE, to, tag, comm_, &p.request);
+  }
+
+  std::optional<Envelope> poll(int tag) override {
+    std::lock_guard lock(mutex_);
+    completeSends();
+    int found = 0;
+    MPI_Message message;
+    MPI_Status status;
+    MPI_Improbe(MPI_ANY_SOURCE, tag, comm_, &found, &message, &status);
+    if (!found) return std::nullopt;
+    int count = 0;
+    MPI_Get_count(&status, MPI_BYTE, &count);
+    Envelope e;
+    e.source = status.MPI_SOURCE;
+    e.tag = tag;
+    e.bytes.resize(std::size_t(count));
+    MPI_Mrecv(e.bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
+    return e;
+  }
+
+  bool flush(double seconds) override {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+    for (;;) {
+      {
+        std::lock_guard lock(mutex_);
+        completeSends();
+        if (pending_.empty()) return true;
+      }
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+  }
+
+  void finalize() override {
+    MPI_Comm_free(&comm_);
+    MPI_Finalize();
+  }
+
+  [[noreturn]] void abortAll(int status) override {
+    MPI_Abort(comm_, status);
+    std::_Exit(status);  // MPI_Abort does not return; should it, the rank still ends
+  }
+
+ private:
+  struct Pending {
+    Bytes bytes;
+    MPI_Request request = MPI_REQUEST_NULL;
+  };
+
+  // With mutex_ held: drops the sends MPI has finished with, oldest first.
+  void completeSends() {
+    while (!pending_.empty()) {
+      int done = 0;
+      MPI_Test(&pending_.front().request, &done, MPI_STATUS_IGNORE);
+      if (!done) return;
+      pending_.pop_front();
+    }
+  }
+
+  MPI_Comm comm_;
+  int rank_ = 0, ranks_ = 1;
+  std::mutex mutex_;
+  std::deque<Pending> pending_;  // a deque: buffers never move while MPI reads them
+};
+
+}  // namespace
+}  // namespace pr::par
+
+extern "C" pr::par::Transport* parrender_mpi_transport(int* argc, char*** argv, char* error, int errorSize) {
+  int provided = 0;
+  if (MPI_Init_thread(argc, argv, MPI_THREAD_MULTIPLE, &provided) != MPI_SUCCESS) {
+    std::snprintf(error, std::size_t(errorSize), "MPI_Init_thread failed");
+    return nullptr;
+  }
+  if (provided < MPI_THREAD_MULTIPLE) {
+    std::snprintf(error, std::size_t(errorSize), "this MPI library gives thread level %d, not MPI_THREAD_MULTIPLE", provided);
+    MPI_Finalize();
+    return nullptr;
+  }
+  MPI_Comm comm;
+  MPI_Comm_dup(MPI_COMM_WORLD, &comm);
+  return new pr::par::MpiTransport(comm);
+}

@@ -1,0 +1,170 @@
+// See process_group.h.
+#include "common/parallel/process_group.h"
+
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <memory>
+#include <stdexcept>
+#include <thread>
+
+#include "common/util/error.h"
+#include "common/util/module_loader.h"
+
+namespace pr::par {
+namespace {
+
+std::unique_ptr<ProcessGroup> group;
+
+// A status message: the exit status (4 bytes) and the failure's text.
+Bytes encodeStatus(int status, const std::string& text) {
+  Bytes b(sizeof(std::int32_t) + text.size());
+  const std::int32_t s = status;
+  std::memcpy(b.data(), &s, sizeof s);
+  std::memcpy(b.data() + sizeof s, text.data(), text.size());
+  return b;
+}
+
+int decodeStatus(const Bytes& b, std::string& text) {
+  std::int32_t s = 1;
+  if (b.size() >= sizeof s) std::memcpy(&s, b.data(), sizeof s);
+  text.assign(reinterpret_cast<const char*>(b.data()) + std::min(b.size(), sizeof s), b.size() - std::min(b.size(), sizeof s));
+  return s;
+}
+
+// FNV-1a over the arguments after the program name, each ended by a zero byte.
+std::uint64_t commandLineHash(int argc, char** argv) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (int i = 1; i < argc; ++i)
+    for (const char* c = argv[i];; ++c) {
+      h = (h ^ std::uint8_t(*c)) * 1099511628211ull;
+      if (!*c) break;
+    }
+  return h;
+}
+
+int launchedRanks() {
+  const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
+  return size ? std::max(1, std::atoi(size)) : 1;
+}
+
+// One line; a run of one rank prints it as parrender always has.
+void printFailure(int status, int rank, int ranks, const std::string& text) {
+  const char* kind = status == kExitBadInput ? "error" : "failed";
+  if (ranks == 1)
+    std::fprintf(stderr, "parrender: %s: %s\n", kind, text.c_str());
+  else
+    std::fprintf(stderr, "parrender: %s (rank %d of %d): %s\n", kind, rank, ranks, text.c_str());
+}
+
+}  // namespace
+
+ProcessGroup& ProcessGroup::start(int* argc, char*** argv) {
+  PR_CHECK(!group, "ProcessGroup::start is called once");
+  group.reset(new ProcessGroup());
+  if (const char* t = std::getenv("PARRENDER_RANK_TIMEOUT"); t && *t) {
+    char* end = nullptr;
+    const double seconds = std::strtod(t, &end);
+    if (end == t || *end || !(seconds > 0.0)) throw InputError("PARRENDER_RANK_TIMEOUT must be a positive number of seconds");
+    group->timeout_ = seconds;
+  }
+  // One rank (no mpirun, or mpirun -np 1): today's single process, MPI never initialised.
+  if (launchedRanks() <= 1) return *group;
+  using Entry = Transport* (*)(int*, char***, char*, int);
+  const auto entry = reinterpret_cast<Entry>(openModuleEntry("libparrender_mpi.so", "PARRENDER_MPI_MODULE", "parrender_mpi_transport"));
+  char error[256] = {};
+  group->transport_ = entry(argc, argv, error, int(sizeof error));
+  if (!group->transport_) throw std::runtime_error(std::string("cannot start MPI: ") + error);
+  group->rank_ = group->transport_->rank();
+  group->ranks_ = group->transport_->ranks();
+  return *group;
+}
+
+ProcessGroup& ProcessGroup::get() {
+  PR_CHECK(group != nullptr, "ProcessGroup::start has not been called");
+  return *group;
+}
+
+Transport& ProcessGroup::transport() {
+  PR_CHECK(transport_ != nullptr, "a group of one rank has no transport");
+  return *transport_;
+}
+
+Envelope ProcessGroup::receive(int tag, std::string_view what) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_);
+  // Poll, yielding the core, for the first few thousand tries (a reply usually comes within
+  // microseconds), then sleep between polls, so a rank that waits long costs its core nothing.
+  for (int tries = 0;; ++tries) {
+    if (std::optional<Envelope> e = transport().poll(tag)) return std::move(*e);
+    if (tries < 4096) {
+      std::this_thread::yield();
+      continue;
+    }
+    if (std::chrono::steady_clock::now() > deadline) {
+      std::fprintf(stderr, "parrender: failed (rank %d of %d): no answer within %.0f s while waiting for %.*s; ending every rank\n",
+                   rank_, ranks_, timeout_, int(what.size()), what.data());
+      transport_->abortAll(1);
+    }
+    std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+}
+
+void ProcessGroup::checkSameCommandLine(int argc, char** argv) {
+  if (ranks_ == 1) return;
+  const std::uint64_t mine = commandLineHash(argc, argv);
+  Bytes hash(sizeof mine);
+  std::memcpy(hash.data(), &mine, sizeof mine);
+  if (rank_ != 0) {
+    transport_->send(0, kCommandLineTag, std::move(hash));
+    std::string text;
+    if (decodeStatus(receive(kVerdictTag, "rank 0's check of the command line").bytes, text) != 0) throw InputError("");
+    return;
+  }
+  int differs = -1;
+  for (int got = 1; got < ranks_; ++got) {
+    const Envelope e = receive(kCommandLineTag, "every rank's command line");
+    std::uint64_t theirs = 0;
+    if (e.bytes.size() == sizeof theirs) std::memcpy(&theirs, e.bytes.data(), sizeof theirs);
+    if (theirs != mine && (differs < 0 || e.source < differs)) differs = e.source;
+  }
+  for (int r = 1; r < ranks_; ++r) transport_->send(r, kVerdictTag, encodeStatus(differs < 0 ? 0 : kExitBadInput, ""));
+  if (differs >= 0)
+    throw InputError("rank " + std::to_string(differs) +
+                     " was started with a different command line from rank 0's: every rank must get the same options");
+}
+
+int ProcessGroup::finish(int status, const std::string& error) {
+  if (ranks_ == 1) {
+    if (status != 0 && !error.empty()) printFailure(status, 0, 1, error);
+    return status;
+  }
+  int run = status;
+  if (rank_ != 0) {
+    transport_->send(0, kStatusTag, encodeStatus(status, error));
+    std::string ignored;
+    run = decodeStatus(receive(kFinishTag, "rank 0 to end the run").bytes, ignored);
+  } else {
+    // The first failure to report: rank 0's own, else the lowest failing rank's.
+    int failedRank = status != 0 ? 0 : -1;
+    std::string text = error;
+    for (int got = 1; got < ranks_; ++got) {
+      const Envelope e = receive(kStatusTag, "every rank's status at the end of the run");
+      std::string theirs;
+      const int s = decodeStatus(e.bytes, theirs);
+      if (s != 0 && (failedRank < 0 || (failedRank != 0 && e.source < failedRank))) {
+        failedRank = e.source;
+        run = s;
+        text = theirs;
+      }
+    }
+    if (failedRank >= 0 && !text.empty()) printFailure(run, failedRank, ranks_, text);
+    for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, ""));
+  }
+  if (!transport_->flush(timeout_)) transport_->abortAll(run != 0 ? run : 1);
+  transport_->finalize();
+  return run;
+}
+
+}  // namespace pr::par

@@ -1,0 +1,56 @@
+// ProcessGroup: the ranks of this run - one when parrender runs on its own, R when mpirun
+// launched R copies of it - and the bounded protocol by which they start and end together.
+// Under mpirun (OMPI_COMM_WORLD_SIZE set) the MPI transport module is opened and MPI
+// initialised; otherwise the group has one rank and MPI is never touched. Every wait for
+// another rank is bounded by timeoutSeconds(): a rank that does not answer in time ends every
+// rank, so a failure can never hang the run.
+#pragma once
+
+#include <string>
+#include <string_view>
+
+#include "common/parallel/transport.h"
+
+namespace pr::par {
+
+class ProcessGroup {
+ public:
+  // Tags of the group's own messages; others use tags from kFirstUserTag on.
+  static constexpr int kCommandLineTag = 101, kVerdictTag = 102, kStatusTag = 103, kFinishTag = 104;
+  static constexpr int kFirstUserTag = 1000;
+
+  // Creates this process's group (once, first thing in main). Throws std::runtime_error when
+  // launched by mpirun and MPI cannot be started.
+  static ProcessGroup& start(int* argc, char*** argv);
+  static ProcessGroup& get();  // the group start() made
+
+  int rank() const { return rank_; }
+  int ranks() const { return ranks_; }
+  Transport& transport();  // ranks() > 1 only
+  // How long any wait for another rank may last: $PARRENDER_RANK_TIMEOUT seconds, default 300.
+  double timeoutSeconds() const { return timeout_; }
+
+  // A message with `tag` (from any rank), waiting at most timeoutSeconds(); past that, ends
+  // every rank with a message naming `what` (abortAll), since a rank that stopped answering
+  // cannot take part in a clean ending.
+  Envelope receive(int tag, std::string_view what);
+
+  // Whether every rank was started with this command line: each rank's hash goes to rank 0,
+  // which compares it with its own and answers. Throws pr::InputError on every rank when one
+  // differs (rank 0's message names the first such rank; the others' is empty).
+  void checkSameCommandLine(int argc, char** argv);
+
+  // Ends the run on this rank with `status` (0, or a failure's exit status with its message)
+  // and returns the status the process exits with: the same on every rank. Rank 0 collects
+  // every rank's status (bounded), prints the first failure - its own before another's - once,
+  // naming the rank, and tells every rank the run's status; then every rank leaves MPI.
+  int finish(int status, const std::string& error);
+
+ private:
+  ProcessGroup() = default;
+  int rank_ = 0, ranks_ = 1;
+  double timeout_ = 300.0;
+  Transport* transport_ = nullptr;
+};
+
+}  // namespace pr::par

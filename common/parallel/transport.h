@@ -1,0 +1,47 @@
+// Transport: moves the bytes of messages between the ranks (processes) of one run, under the
+// runtime (shared/DESIGN.md, "Transports"). PEs of one rank exchange messages in shared memory;
+// only what leaves a rank becomes bytes on a Transport. The MPI transport is a module of its
+// own (common/parallel/mpi/mpi_transport.cpp), opened only when mpirun launched the program,
+// so a process started without mpirun never initialises MPI. Every wait on a transport is
+// bounded (process_group.h).
+#pragma once
+
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+namespace pr::par {
+
+using Bytes = std::vector<std::byte>;
+
+// A message as it arrives: who sent it, its tag and its bytes.
+struct Envelope {
+  int source = -1;
+  int tag = 0;
+  Bytes bytes;
+};
+
+class Transport {
+ public:
+  virtual ~Transport() = default;
+  virtual int rank() const = 0;
+  virtual int ranks() const = 0;
+  // Sends `bytes` to rank `to` under `tag` and returns at once; the transport keeps the bytes
+  // until they have left. Callable from any thread.
+  virtual void send(int to, int tag, Bytes bytes) = 0;
+  // A message with `tag` from any rank, if one has arrived; never blocks. Any thread.
+  virtual std::optional<Envelope> poll(int tag) = 0;
+  // Waits (bounded by `seconds`) for every send to have left; false if some had not.
+  virtual bool flush(double seconds) = 0;
+  // Ends the transport on this rank (after flush); the last call made on it.
+  virtual void finalize() = 0;
+  // Ends every rank of the run at once with `status` (a rank that cannot finish cleanly).
+  [[noreturn]] virtual void abortAll(int status) = 0;
+};
+
+}  // namespace pr::par
+
+// The MPI module's one entry point (C linkage, found by dlsym): initialises MPI (thread level
+// MPI_THREAD_MULTIPLE) and returns the transport over MPI_COMM_WORLD, or nullptr with a reason
+// in `error` (a buffer of errorSize bytes).
+extern "C" pr::par::Transport* parrender_mpi_transport(int* argc, char*** argv, char* error, int errorSize);

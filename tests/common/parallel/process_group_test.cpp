@@ -1,0 +1,88 @@
+// The process group across real processes: mpirun on loopback (--oversubscribe, root allowed
+// as in CI), every command bounded by `timeout` so a failure can never hang the suite.
+#include <chrono>
+#include <string>
+
+#include <doctest/doctest.h>
+
+#include "test_support.h"
+
+namespace {
+
+using pr::test::CommandResult;
+using pr::test::quoted;
+
+// What every mpirun here is started with: root allowed (CI runs as root), and, in the ASan job,
+// no leak check in the ranks: Open MPI unloads its components before exit and leaves
+// allocations LeakSanitizer cannot attribute (frames in no loaded module); address and UB
+// checks stay on.
+const std::string kMpiEnv = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" ";
+
+// mpirun -np N PROGRAM ARGS, ended after `limit` seconds at most (timeout's status 124).
+CommandResult mpirun(int ranks, const std::string& program, const std::string& args, int limit = 60,
+                     const std::string& env = "") {
+  return pr::test::runCommand(kMpiEnv + env + " timeout " + std::to_string(limit) + " mpirun --oversubscribe -np " +
+                              std::to_string(ranks) + " " + program + " " + args);
+}
+
+std::string check() { return quoted(pr::test::binaryDir() / "tests" / "parrender_transport_check"); }
+std::string parrender() { return quoted(PARRENDER_EXE); }
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("ProcessGroup: 2 and 3 ranks exchange messages of 0 B to 1 MiB through MPI, every byte as sent") {
+  for (int ranks : {2, 3}) {
+    CAPTURE(ranks);
+    const CommandResult r = mpirun(ranks, check(), "exchange");
+    INFO(r.output);
+    CHECK(r.exitStatus == 0);
+    CHECK(r.output.find("exchange: " + std::to_string(ranks) + " ranks") != std::string::npos);
+  }
+}
+
+TEST_CASE("ProcessGroup: a rank that fails ends every rank, with one message from rank 0 naming it") {
+  const CommandResult r = mpirun(3, check(), "fail 1");
+  INFO(r.output);
+  CHECK(r.exitStatus == 1);
+  CHECK(count(r.output, "parrender: failed (rank 1 of 3): an injected failure") == 1);
+}
+
+TEST_CASE("ProcessGroup: a rank that stops answering ends every rank after the bounded wait, no hang") {
+  const auto t0 = std::chrono::steady_clock::now();
+  const CommandResult r = mpirun(2, check(), "hang 1", 60, "PARRENDER_RANK_TIMEOUT=2");
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  INFO(r.output);
+  CHECK(r.exitStatus != 0);
+  CHECK(r.exitStatus != 124);  // ended by the group, not by the test's timeout
+  CHECK(r.output.find("no answer within 2 s") != std::string::npos);
+  CHECK(seconds < 30.0);
+}
+
+TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the same options, then says it cannot run across ranks yet") {
+  const std::string cornell = quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf");
+  const std::string glass = quoted(pr::test::sourceDir() / "scenes" / "cornell-glass.gltf");
+  const CommandResult differ = pr::test::runCommand(
+      kMpiEnv + "timeout 60 mpirun --oversubscribe -np 1 " + parrender() +
+      " info " + cornell + " : -np 1 " + parrender() + " info " + glass);
+  INFO(differ.output);
+  CHECK(differ.exitStatus == 2);
+  CHECK(count(differ.output, "parrender: error") == 1);
+  CHECK(differ.output.find("rank 1 was started with a different command line") != std::string::npos);
+
+  const CommandResult same = mpirun(2, parrender(), "info " + cornell);
+  INFO(same.output);
+  CHECK(same.exitStatus == 2);
+  CHECK(count(same.output, "parrender: error (rank 0 of 2)") == 1);
+  CHECK(same.output.find("do not run across processes yet") != std::string::npos);
+
+  // One rank is today's program.
+  const CommandResult one = mpirun(1, parrender(), "info " + cornell);
+  INFO(one.output);
+  CHECK(one.exitStatus == 0);
+  CHECK(one.output.find("triangles") != std::string::npos);
+}
