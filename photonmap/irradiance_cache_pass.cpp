@@ -4,7 +4,6 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,8 +32,9 @@ constexpr int kProbeTilePx = 32;
 // Probes or records per task of the coverage and combine stages.
 constexpr std::size_t kPerTask = 256;
 
-// A probe: the first surface with a diffuse part pixel `pixel`'s camera ray reaches, and how
-// far the ray travelled to it (for the pixel's footprint there).
+// A probe: a surface with a diffuse part pixel `pixel`'s camera ray reaches (the first, and
+// those beyond mostly transmissive ones), and how far the ray travelled to it (for the
+// pixel's footprint there).
 struct ProbeHit {
   std::uint32_t pixel = 0;
   rt::SurfaceInteraction si;
@@ -78,9 +78,12 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
     const scene::Scene& scene = context().scene();
     const float travelled = msg.bsdfPdf + si.t * glm::length(msg.ray.direction);
     rt::ShadingMaterial m = rt::evalMaterial(scene, si, textures_);
+    // A surface with a diffuse part gets a probe; one that is mostly glass (a frosted, partly
+    // diffuse sphere) also passes the probe on, so the surfaces seen through it - where the
+    // eye paths that refract into it arrive - get records too instead of gathering per hit.
     if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
       perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, si, travelled});
-      return;
+      if (m.dielectricWeight() < 0.5f) return;
     }
     if (msg.depth + 1 >= maxDepth_) return;
     // Through ideal mirrors and glass along the dominant branch.
@@ -201,9 +204,14 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
   for (int p = 0; p < pes; ++p) probesPerPe[std::size_t(p)] = double(probes->perPe()[std::size_t(p)].items.size());
   std::vector<std::vector<ProbeHit>> found =
       par::gatherToRoot(rt, "irradiance-cache probe merge", "probes", par::MessageKind::Data, takeAll(probes->perPe()), sizeof(ProbeHit));
-  std::vector<std::optional<ProbeHit>> byPixel(std::size_t(width) * std::size_t(height));
+  // A pixel's probes in the order its ray met them (one, or more through partly diffuse glass):
+  // an order that does not depend on which PE found which.
+  std::vector<std::vector<ProbeHit>> byPixel(std::size_t(width) * std::size_t(height));
   for (std::vector<ProbeHit>& list : found)
-    for (ProbeHit& h : list) byPixel[h.pixel] = std::move(h);
+    for (ProbeHit& h : list) byPixel[h.pixel].push_back(std::move(h));
+  for (std::vector<ProbeHit>& hits : byPixel)
+    if (hits.size() > 1)
+      std::sort(hits.begin(), hits.end(), [](const ProbeHit& a, const ProbeHit& b) { return a.travelled < b.travelled; });
 
   std::vector<double> gatherHitsPerPe(std::size_t(pes), 0.0);
   double records = 0.0;
@@ -215,8 +223,8 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     for (int y = 0; y < height; y += stride)
       for (int x = 0; x < width; x += stride) {
         const bool coarser = stride < kCoarsestStride && x % (2 * stride) == 0 && y % (2 * stride) == 0;
-        const std::optional<ProbeHit>& p = byPixel[std::size_t(y) * std::size_t(width) + std::size_t(x)];
-        if (!coarser && p) candidates.push_back(&*p);
+        if (!coarser)
+          for (const ProbeHit& p : byPixel[std::size_t(y) * std::size_t(width) + std::size_t(x)]) candidates.push_back(&p);
       }
     // Which of them no record of the coarser levels covers (read-only cache, every PE).
     std::vector<char> uncovered(candidates.size(), 0);
