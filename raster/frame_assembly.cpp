@@ -58,7 +58,7 @@ void FrameAssembly::deliver(par::Pe& pe, RegionFramebuffer&& region) {
     return;
   }
   const size_t bytes = regionMessageBytes(region.rect());
-  regions_.send(pe, kAssemblerPe, std::move(region), bytes);
+  regions_.sendDeclared(pe, kAssemblerPe, std::move(region), bytes);
 }
 
 void FrameAssembly::deliver(par::Pe& pe, const RegionFramebuffer& src, const Rect& within) {

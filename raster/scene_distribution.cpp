@@ -48,7 +48,7 @@ void distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view 
     if (pe.id() != 0) return;
     for (int p = 1; p < rt.pes(); ++p) {
       const auto [first, end] = primitiveShare(total, p, rt.pes());
-      if (end > first) shares.send(pe, p, Share{first, end}, size_t(end - first) * kPrimitiveBytes);
+      if (end > first) shares.sendDeclared(pe, p, Share{first, end}, size_t(end - first) * kPrimitiveBytes);
     }
   });
   for (int p = 0; p < rt.pes(); ++p) {

@@ -3,8 +3,8 @@
 // message when it holds `batchSize` items, and every partial outbox is sent when the PE runs
 // dry (flushIfDry). One message per batch instead of per item is what makes the partitioned
 // tracers pay off: the lock, the doorbell and the handler's fixed cost are paid once per batch.
-// Counting is the Channel's: one message per batch, its bytes the sum of its items' bytes plus
-// a small header, as a distributed implementation would send it.
+// Counting is the Channel's: one message per batch, its bytes its items' encodings (the
+// batch's length travels in the envelope, its sender is the message's source).
 #pragma once
 
 #include <cstddef>
@@ -17,9 +17,6 @@
 #include "common/util/error.h"
 
 namespace pr::par {
-
-// Bytes of a batch's header on a wire: item count and sender.
-inline constexpr std::size_t kBatchHeaderBytes = 8;
 
 template <class T>
 class BatchedChannel {
@@ -40,14 +37,13 @@ class BatchedChannel {
     for (PeOutboxes& o : out_) o.boxes.resize(size_t(runtime.pes()));
   }
 
-  // On PE `from`: queues the item for `to` (bytes: its size on a wire) and sends the batch
-  // when it is full.
-  void send(Pe& from, int to, T item, std::size_t bytes = sizeof(T)) {
+  // On PE `from`: queues the item for `to` and sends the batch when it is full.
+  void send(Pe& from, int to, T item) {
     PeOutboxes& mine = out_[size_t(from.id())];
     Outbox& box = mine.boxes[size_t(to)];
     if (box.items.capacity() == 0) box.items = mine.storage(batchSize_);
+    box.bytes += Wire<T>::size(item);
     box.items.push_back(std::move(item));
-    box.bytes += bytes;
     if (box.items.size() >= batchSize_) sendBox(from, to, box);
   }
 
@@ -86,9 +82,10 @@ class BatchedChannel {
     }
   };
 
+  // The items' sizes were summed as they were queued: Wire<Batch>'s size, without a second pass.
   void sendBox(Pe& from, int to, Outbox& box) {
-    const std::size_t bytes = box.bytes + kBatchHeaderBytes;
-    channel_.send(from, to, std::move(box.items), bytes);
+    const std::size_t bytes = box.bytes;
+    channel_.sendEncoded(from, to, std::move(box.items), bytes);
     box.items = Batch();
     box.bytes = 0;
   }

@@ -1,6 +1,6 @@
 // Channel<T>: typed message passing between PEs (one mailbox per PE), the only path for a PDI
 // or result to move between PEs. Every send is counted at the sender — messages and bytes per
-// sender->receiver pair and per stage — so the counts are the communication volume
+// sender->receiver pair and per stage, as its encoding's size (wire.h) — so the counts are the communication volume
 // (shared/DESIGN.md rule 1). With a handler the channel drives a message-driven phase: the
 // runtime runs the handler on the receiving PE and detects termination (termination.h).
 #pragma once
@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
 #include "common/util/error.h"
 
 namespace pr::par {
@@ -36,9 +37,23 @@ class Channel : public ChannelBase {
   Channel(const Channel&) = delete;
   Channel& operator=(const Channel&) = delete;
 
-  // Called by PE `from` inside a task or handler. bytes is the message's size on a wire
-  // (defaults to sizeof(T); pass the real payload size for variable-length messages).
-  void send(Pe& from, int to, T message, std::size_t bytes = sizeof(T)) {
+  // Called by PE `from` inside a task or handler: counted as its encoding's size (wire.h).
+  void send(Pe& from, int to, T message) {
+    const std::size_t bytes = Wire<T>::size(message);
+    sendDeclared(from, to, std::move(message), bytes);
+  }
+
+  // The same as send, with the encoding's size already known (summed as the message was built).
+  void sendEncoded(Pe& from, int to, T message, std::size_t encodedBytes) {
+    PR_DCHECK(encodedBytes == Wire<T>::size(message), "Channel '" + name() + "': stated size is not the encoding's");
+    sendDeclared(from, to, std::move(message), encodedBytes);
+  }
+
+  // A message whose counted size the sender states instead of its encoding: for the messages
+  // that do not yet carry what they are counted as (sort-first's primitive ids counted as the
+  // primitives' data, the data manager's items, the compositors' pixels without their
+  // rectangles, region buffers, a share's range counted as its primitives).
+  void sendDeclared(Pe& from, int to, T message, std::size_t bytes) {
     PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name() + "': destination PE out of range");
     const SendReceiveTimer timer(from);
     runtime_.countMessage(from.id(), to, bytes);
@@ -53,9 +68,9 @@ class Channel : public ChannelBase {
   }
 
   // One copy to every other PE, counted once per receiving PE.
-  void broadcast(Pe& from, const T& message, std::size_t bytes = sizeof(T)) {
+  void broadcast(Pe& from, const T& message) {
     for (int p = 0; p < runtime_.pes(); ++p)
-      if (p != from.id()) send(from, p, message, bytes);
+      if (p != from.id()) send(from, p, message);
   }
 
   // Inside a task on PE `me`: takes one waiting message, if any.

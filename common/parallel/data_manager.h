@@ -169,7 +169,7 @@ class DataManager {
     }
     ++pe_[pe.id()].misses;
     pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
-    requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
+    requests_.sendDeclared(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
     Reply reply = awaitReply(pe);
     PR_CHECK(reply.item == item, "DataManager: a reply for another item");
     waitUntilReady(pe, reply);
@@ -186,7 +186,7 @@ class DataManager {
       const int owner = owners_.owner(item);
       if (owner == pe.id() || pe_[pe.id()].cache.contains(item)) continue;
       pe.counters().prefetches.fetch_add(1, std::memory_order_relaxed);
-      requests_.send(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
+      requests_.sendDeclared(pe, owner, Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
       ++asked;
     }
     for (; asked > 0; --asked) {
@@ -215,7 +215,7 @@ class DataManager {
     if (a.outstanding.insert(item).second) {
       ++pe_[pe.id()].misses;
       pe.counters().cacheMisses.fetch_add(1, std::memory_order_relaxed);
-      requests_.send(pe, owners_.owner(item), Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
+      requests_.sendDeclared(pe, owners_.owner(item), Request{item, pe.id(), pe.runtime().now()}, kItemRequestBytes);
     } else {
       ++a.joined;  // a miss whose item is already on its way: no second request
     }
@@ -287,7 +287,7 @@ class DataManager {
     const double now = owner.runtime().now();
     Reply reply{r.item, load_(owner, r.item), std::max(now, r.sentAt + latency_) + latency_};
     const std::size_t bytes = bytes_ ? bytes_(reply.value) : sizeof(T);
-    items_.send(owner, r.requester, std::move(reply), bytes);
+    items_.sendDeclared(owner, r.requester, std::move(reply), bytes);
   }
 
   inline static const std::string kWhat = "a data item";

@@ -33,7 +33,7 @@ std::vector<std::vector<T>> gatherToRoot(Runtime& rt, std::string_view stage, st
       out[std::size_t(root)] = std::move(mine);
     } else if (!mine.empty()) {
       const std::size_t bytes = mine.size() * bytesPerItem;
-      ch.send(pe, root, Batch{pe.id(), std::move(mine)}, bytes);
+      ch.sendDeclared(pe, root, Batch{pe.id(), std::move(mine)}, bytes);
     }
   });
   return out;

@@ -15,7 +15,7 @@
 //   par::Channel<RayBatch> rays(rt, "rays", par::MessageKind::Rays, [&](par::Pe& pe, RayBatch&& b) { trace(pe, b); });
 //   rt.recordBroadcast(sceneBytes);                         // the scene, from PE 0 to every other PE
 //   rt.runStage("trace", par::TaskSet::grid(tilesX, tilesY), [&](par::Pe& pe, par::TaskId t) {
-//     for (RayBatch& b : primaryRays(t)) rays.send(pe, ownerOf(b), std::move(b), b.bytes());
+//     for (RayBatch& b : primaryRays(t)) rays.send(pe, ownerOf(b), std::move(b));  // counted as its encoding
 //   });
 //   par::writeRunRecord(rt.record(), "run.json");           // per-PE busy/idle, traffic, timeline
 //

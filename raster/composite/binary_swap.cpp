@@ -54,7 +54,7 @@ class BinarySwap : public Compositor {
                     if (sparse && m.pixels() == 0) return;  // nothing drawn there: no message
                     const size_t bytes = m.bytes();
                     counters[p].count(m, bytes);
-                    pixels.send(pe, p ^ (1 << k), std::move(m), bytes);
+                    pixels.sendDeclared(pe, p ^ (1 << k), std::move(m), bytes);
                   });
       for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
     }

@@ -79,7 +79,7 @@ class DirectSend : public Compositor {
         if (sparse && m.pixels() == 0) continue;  // nothing drawn there: no message
         const size_t bytes = m.bytes();
         c.count(m, bytes);
-        pixels.send(pe, o, std::move(m), bytes);
+        pixels.sendDeclared(pe, o, std::move(m), bytes);
       }
     });
 

@@ -191,7 +191,7 @@ class SortFirst : public SortPoint {
       for (int o = 0; o < pes; ++o) {
         if (out[o].empty()) continue;
         const size_t bytes = out[o].size() * kPrimitiveBytes;  // the primitives' data (see the top)
-        primitives.send(pe, o, std::move(out[o]), bytes);
+        primitives.sendDeclared(pe, o, std::move(out[o]), bytes);
       }
     });
 

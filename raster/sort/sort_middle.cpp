@@ -83,8 +83,7 @@ class SortMiddle : public SortPoint {
       if (tris.empty()) return;
       if (single && owner[0] < pes) {
         if (owner[0] != pe.id()) c.sent += tris.size();
-        const size_t bytes = tris.size() * sizeof(ScreenTriangle);
-        triangles.send(pe, owner[0], std::move(tris), bytes);
+        triangles.send(pe, owner[0], std::move(tris));
         return;
       }
       std::vector<std::vector<ScreenTriangle>> out(pes);
@@ -100,8 +99,7 @@ class SortMiddle : public SortPoint {
       for (int o = 0; o < pes; ++o) {
         if (out[o].empty()) continue;
         if (o != pe.id()) c.sent += out[o].size();
-        const size_t bytes = out[o].size() * sizeof(ScreenTriangle);
-        triangles.send(pe, o, std::move(out[o]), bytes);
+        triangles.send(pe, o, std::move(out[o]));
       }
     });
 

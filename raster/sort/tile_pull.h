@@ -19,21 +19,24 @@ template <class Item>
 class TilePull {
  public:
   // bins[pe][tile]: what PE pe binned for each tile; a PE reads and moves out its own only.
-  // itemBytes: what one item costs in a reply (sort-first counts a primitive id as the
-  // primitive's data, kPrimitiveBytes).
+  // declaredItemBytes: 0 to count a reply as its encoding, else what one item is counted as
+  // (sort-first counts a primitive id as the primitive's data, kPrimitiveBytes).
   TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins,
-           size_t itemBytes = sizeof(Item))
+           size_t declaredItemBytes = 0)
       : runtime_(runtime),
         bins_(bins),
         name_(name),
-        itemBytes_(itemBytes),
+        declaredItemBytes_(declaredItemBytes),
         sent_(runtime.pes(), 0),
         replies_(runtime, name + " replies", par::MessageKind::Primitives),
         requests_(runtime, name + " requests", par::MessageKind::Requests, [this](par::Pe& pe, Request&& r) {
           std::vector<Item>& bin = bins_[pe.id()][r.tile];
-          const size_t bytes = bin.size() * itemBytes_;
           sent_[pe.id()] += bin.size();
-          replies_.send(pe, r.pe, std::move(bin), bytes);
+          const size_t declared = bin.size() * declaredItemBytes_;
+          if (declaredItemBytes_ > 0)
+            replies_.sendDeclared(pe, r.pe, std::move(bin), declared);
+          else
+            replies_.send(pe, r.pe, std::move(bin));
         }) {}
 
   // Inside the task for `tile` on pe: its own bin plus every other PE's, in PE order. While it
@@ -46,7 +49,7 @@ class TilePull {
     std::vector<std::vector<Item>> parts(pes);
     parts[pe.id()] = std::move(bins_[pe.id()][tile]);
     for (int p = 0; p < pes; ++p)
-      if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()}, sizeof(Request));
+      if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()});
     const std::string what = "'" + name_ + "': the bins of tile " + std::to_string(tile);
     for (int got = 0; got < pes - 1; ++got)
       for (Item& item : par::awaitReply(pe, replies_, requests_, what)) parts[pe.id()].push_back(std::move(item));
@@ -65,7 +68,7 @@ class TilePull {
   par::Runtime& runtime_;
   std::vector<std::vector<std::vector<Item>>>& bins_;
   std::string name_;
-  size_t itemBytes_;
+  size_t declaredItemBytes_;
   std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
   par::Channel<std::vector<Item>> replies_;
   par::Channel<Request> requests_;

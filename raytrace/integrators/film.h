@@ -12,6 +12,7 @@
 #include <glm/glm.hpp>
 
 #include "common/image/image.h"
+#include "common/parallel/wire.h"
 
 namespace pr::rt {
 
@@ -29,6 +30,28 @@ struct FilmBlock {
   static constexpr size_t kHeaderBytes = sizeof(PixelRect);
   size_t bytes() const { return kHeaderBytes + sums.size() * sizeof(int64_t); }
 };
+
+}  // namespace pr::rt
+
+// A film block on the wire: its rectangle, then its sums (their count follows from the
+// message's length).
+template <>
+struct pr::par::Wire<pr::rt::FilmBlock> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const rt::FilmBlock& b) { return b.bytes(); }
+  static void encode(const rt::FilmBlock& b, WireWriter& w) {
+    w.value(b.rect);
+    w.elements(std::span<const int64_t>(b.sums));
+  }
+  static rt::FilmBlock decode(WireReader& r) {
+    rt::FilmBlock b;
+    b.rect = r.value<rt::PixelRect>();
+    b.sums = r.elements<int64_t>();
+    return b;
+  }
+};
+
+namespace pr::rt {
 
 class Film {
  public:

@@ -34,8 +34,7 @@ class FilmAssembly {
       image_.addBlock(block);
       return;
     }
-    const size_t bytes = block.bytes();
-    blocks_.send(pe, kAssemblerPe, std::move(block), bytes);
+    blocks_.send(pe, kAssemblerPe, std::move(block));
   }
 
   // In a stage of its own, on every PE but the assembler: its whole film, tile by tile.

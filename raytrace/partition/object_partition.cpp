@@ -41,17 +41,57 @@ struct RayQuery {
   bool shadow = false;
 };
 
-// Back to the originator. A miss or a shadow answer is only the header (slot and flag); a hit
+// Back to the originator. A miss or a shadow answer is only the header (slot and flags); a hit
 // carries the hit record and the interaction made by the owner of the hit triangle.
 struct HitReply {
   uint32_t slot = 0;
-  bool found = false;  // a hit (closest-hit query) or an occluder (shadow query)
+  bool found = false;       // a hit (closest-hit query) or an occluder (shadow query)
+  bool carriesHit = false;  // a closest hit: hit and si follow the header
   Hit hit;
   SurfaceInteraction si;
 };
-constexpr size_t kReplyHeaderBytes = 8;
 using QueryBatch = std::vector<RayQuery>;
 using ReplyBatch = std::vector<HitReply>;
+
+}  // namespace
+}  // namespace pr::rt
+
+// A reply on the wire: slot (4 bytes), the two flags (1 each, 2 padding), then the hit and its
+// interaction when it carries them.
+template <>
+struct pr::par::Wire<pr::rt::HitReply> {
+  static_assert(std::is_trivially_copyable_v<rt::Hit> && std::is_trivially_copyable_v<rt::SurfaceInteraction>);
+  static constexpr bool kBytewise = false;
+  static constexpr std::size_t kHeaderBytes = 8;
+  static std::size_t size(const rt::HitReply& r) {
+    return kHeaderBytes + (r.carriesHit ? sizeof(rt::Hit) + sizeof(rt::SurfaceInteraction) : 0);
+  }
+  static void encode(const rt::HitReply& r, WireWriter& w) {
+    const std::uint8_t header[kHeaderBytes] = {std::uint8_t(r.slot), std::uint8_t(r.slot >> 8), std::uint8_t(r.slot >> 16),
+                                               std::uint8_t(r.slot >> 24), r.found, r.carriesHit, 0, 0};
+    w.raw(header, sizeof header);
+    if (r.carriesHit) {
+      w.value(r.hit);
+      w.value(r.si);
+    }
+  }
+  static rt::HitReply decode(WireReader& r) {
+    std::uint8_t header[kHeaderBytes];
+    r.raw(header, sizeof header);
+    rt::HitReply out;
+    out.slot = std::uint32_t(header[0]) | std::uint32_t(header[1]) << 8 | std::uint32_t(header[2]) << 16 | std::uint32_t(header[3]) << 24;
+    out.found = header[4] != 0;
+    out.carriesHit = header[5] != 0;
+    if (out.carriesHit) {
+      out.hit = r.value<rt::Hit>();
+      out.si = r.value<rt::SurfaceInteraction>();
+    }
+    return out;
+  }
+};
+
+namespace pr::rt {
+namespace {
 
 class ObjectFrame {
  public:
@@ -258,7 +298,7 @@ class ObjectFrame {
     if (shadow) {
       r.found = bvh.occluded(ray);
     } else if (bvh.intersect(ray, r.hit)) {
-      r.found = true;
+      r.found = r.carriesHit = true;
       r.si = makeInteraction(views_.of(pe), ray, r.hit);
     }
     return r;
@@ -267,8 +307,7 @@ class ObjectFrame {
   void answerRemote(par::Pe& pe, const RayQuery& q) {
     PeState& st = state_[pe.id()];
     HitReply r = answer(pe.id(), bvhs_[pe.id()], q.ray, q.slot, q.shadow);
-    const size_t bytes = r.found && !q.shadow ? sizeof(HitReply) : kReplyHeaderBytes;
-    hits_->send(pe, q.origin, std::move(r), bytes);
+    hits_->send(pe, q.origin, std::move(r));
     ++st.repliesSent;
   }
 

@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <numeric>
+#include <vector>
 
 #include "common/parallel/channel.h"
 #include "common/parallel/metrics.h"
@@ -21,7 +22,7 @@ TEST_CASE("Channel: counts are exact for a synthetic all-to-all exchange") {
   rt.runStage("exchange", TaskSet::uniform(pes), [&](Pe& pe, TaskId) {
     for (int q = 0; q < pes; ++q) {
       const int copies = q == pe.id() ? 1 : pe.id() + 1;
-      for (int k = 0; k < copies; ++k) results.send(pe, q, pe.id() * 100 + k, 10 * (q + 1));
+      for (int k = 0; k < copies; ++k) results.sendDeclared(pe, q, pe.id() * 100 + k, 10 * (q + 1));
     }
   });
   const StageRecord& s = rt.record().stages[0];
@@ -64,11 +65,11 @@ TEST_CASE("Channel: at P = 1 nothing moves between PEs") {
   CHECK(ch.drain(0).size() == 5);
 }
 
-TEST_CASE("Channel: broadcast is counted once per receiving PE") {
+TEST_CASE("Channel: broadcast is counted once per receiving PE, each copy its encoding") {
   Runtime rt(5, "balanced");
-  Channel<int> ch(rt, "map", MessageKind::Data);
+  Channel<std::vector<int>> ch(rt, "map", MessageKind::Data);
   rt.runStage("b", TaskSet::uniform(5), [&](Pe& pe, TaskId id) {
-    if (id == 2) ch.broadcast(pe, 7, 1000);
+    if (id == 2) ch.broadcast(pe, std::vector<int>(250, 7));
   });
   const StageRecord& s = rt.record().stages[0];
   CHECK(s.pes[2].messagesSent == 4);
@@ -121,8 +122,8 @@ TEST_CASE("Channel: the record books each channel's traffic by name and kind, ap
   // PE p sends 2 rays of 40 bytes to PE (p + 1) mod 3 and one 64-byte tile to PE 0 (PE 0's
   // own tile is no transfer); nothing goes through "idle".
   rt.runOnEachPe("send", [&](Pe& pe) {
-    for (int k = 0; k < 2; ++k) rays.send(pe, (pe.id() + 1) % 3, k, 40);
-    tiles.send(pe, 0, pe.id(), 64);
+    for (int k = 0; k < 2; ++k) rays.sendDeclared(pe, (pe.id() + 1) % 3, k, 40);
+    tiles.sendDeclared(pe, 0, pe.id(), 64);
   });
   const StageRecord& s = rt.record().stages[0];
   REQUIRE(s.channels.size() == 2);

@@ -16,7 +16,7 @@ namespace {
 RunRecord sampleRecord() {
   Runtime rt(3, "spiral");
   Channel<int> ch(rt, "c", MessageKind::Data);
-  rt.runStage("tiles", TaskSet::grid(3, 2), [&](Pe& pe, TaskId id) { ch.send(pe, (pe.id() + 1) % 3, int(id), 24); });
+  rt.runStage("tiles", TaskSet::grid(3, 2), [&](Pe& pe, TaskId id) { ch.sendDeclared(pe, (pe.id() + 1) % 3, int(id), 24); });
   return rt.record();
 }
 
@@ -54,7 +54,7 @@ TEST_CASE("RunRecord: JSON round trip keeps every measured field") {
 TEST_CASE("RunRecord: JSON round trip keeps the channels, owners and communication times") {
   Runtime rt(2, "demand");
   Channel<int> ch(rt, "pixels", MessageKind::Pixels);
-  rt.runPinned("pinned", TaskSet::uniform(3), {1, 0, 1}, [&](Pe& pe, TaskId) { ch.send(pe, 1 - pe.id(), 0, 100); });
+  rt.runPinned("pinned", TaskSet::uniform(3), {1, 0, 1}, [&](Pe& pe, TaskId) { ch.sendDeclared(pe, 1 - pe.id(), 0, 100); });
   const RunRecord a = rt.record();
   const RunRecord b = runRecordFromJsonText(toJsonText(a), "test");
   REQUIRE(b.stages.size() == 1);

@@ -137,16 +137,17 @@ TEST_CASE("ObjectPartition: two walls, one tile: exactly one query and one hit m
       REQUIRE(st.traffic.size() == 2);  // the query one way, the hit the other
       CHECK(st.traffic[0].messages == 1);
       CHECK(st.traffic[1].messages == 1);
-      // The query carries a ray (32 bytes) and its return address in a batch (8-byte header);
-      // the hit reply also the hit record and the surface interaction, so it is the larger.
+      // The query carries a ray (32 bytes) and its return address (a batch of one, counted as
+      // its one query's encoding); the hit reply an 8-byte header, the hit record and the
+      // surface interaction, so it is the larger.
       // Which PE originates depends on which PE took the tile, so tell them apart by size.
       CHECK(st.traffic[0].from == st.traffic[1].to);
       const bool firstIsQuery = st.traffic[0].bytes < st.traffic[1].bytes;
       const auto& query = firstIsQuery ? st.traffic[0] : st.traffic[1];
       const auto& hit = firstIsQuery ? st.traffic[1] : st.traffic[0];
-      CHECK(query.bytes >= sizeof(rt::Ray) + par::kBatchHeaderBytes);
-      CHECK(query.bytes <= sizeof(rt::Ray) + 8 + par::kBatchHeaderBytes);
-      CHECK(hit.bytes > sizeof(rt::Hit));
+      CHECK(query.bytes >= sizeof(rt::Ray));
+      CHECK(query.bytes <= sizeof(rt::Ray) + 8);
+      CHECK(hit.bytes == 8 + sizeof(rt::Hit) + sizeof(rt::SurfaceInteraction));
     }
   }
 }
