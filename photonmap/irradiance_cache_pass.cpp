@@ -37,6 +37,7 @@ constexpr std::size_t kPerTask = 256;
 // pixel's footprint there).
 struct ProbeHit {
   std::uint32_t pixel = 0;
+  std::uint8_t depth = 0;  // surfaces the ray passed before this one: orders a pixel's probes
   rt::SurfaceInteraction si;
   float travelled = 0.0f;
 };
@@ -50,6 +51,10 @@ struct GatherDeposit {
   glm::vec3 radiance{0.0f};
   float distance = 0.0f;
 };
+
+// The random stream of a probe's gather rays: its pixel's, apart for each probe along the
+// pixel's ray (a record seen through glass does not repeat the directions of the one in front).
+std::uint32_t gatherStream(const ProbeHit& p) { return p.pixel ^ (std::uint32_t(p.depth) << 27); }
 
 template <class T>
 struct alignas(64) PerPe {
@@ -82,7 +87,7 @@ class ProbeProgram final : public rt::IntegratorBase<ProbeProgram> {
     // diffuse sphere) also passes the probe on, so the surfaces seen through it - where the
     // eye paths that refract into it arrive - get records too instead of gathering per hit.
     if (rt::maxComponent(m.diffuseColor()) > 0.0f) {
-      perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, si, travelled});
+      perPe_[std::size_t(out.pe())].items.push_back({msg.pixel, msg.depth, si, travelled});
       if (m.dielectricWeight() < 0.5f) return;
     }
     if (msg.depth + 1 >= maxDepth_) return;
@@ -140,7 +145,7 @@ class GatherProgram final : public rt::IntegratorBase<GatherProgram> {
         const rt::ShadingFrame sf(p.si);
         for (int j = 0; j < strata_.cells(); ++j) {
           RayMessage m;
-          if (!gatherRay(p.si, sf, strata_, p.pixel, std::uint32_t(j), options_, m.ray)) continue;
+          if (!gatherRay(p.si, sf, strata_, gatherStream(p), std::uint32_t(j), options_, m.ray)) continue;
           m.pixel = std::uint32_t(r);
           m.sample = std::uint16_t(j);
           m.depth = 0;
@@ -152,7 +157,7 @@ class GatherProgram final : public rt::IntegratorBase<GatherProgram> {
 
   void shade(const rt::SurfaceInteraction& si, const RayMessage& msg, rt::Emit& out) const override {
     thread_local NearestPhotons scratch;
-    const std::uint32_t id = records_[msg.pixel]->pixel;
+    const std::uint32_t id = gatherStream(*records_[msg.pixel]);
     const GatherInteraction step =
         gatherInteraction(context().scene(), global_, si, msg.ray, msg.throughput, id, msg.sample, msg.depth, options_, scratch);
     const float distance = msg.depth == 0 ? si.t * glm::length(msg.ray.direction) : std::nanf("");
@@ -211,7 +216,7 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     for (ProbeHit& h : list) byPixel[h.pixel].push_back(std::move(h));
   for (std::vector<ProbeHit>& hits : byPixel)
     if (hits.size() > 1)
-      std::sort(hits.begin(), hits.end(), [](const ProbeHit& a, const ProbeHit& b) { return a.travelled < b.travelled; });
+      std::sort(hits.begin(), hits.end(), [](const ProbeHit& a, const ProbeHit& b) { return a.depth < b.depth; });
 
   std::vector<double> gatherHitsPerPe(std::size_t(pes), 0.0);
   double records = 0.0;
@@ -272,7 +277,7 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
         const ProbeHit& p = *chosen[i];
         const rt::ShadingFrame sf(p.si);
         IrradianceRecord r = combineGather(
-            p.si, sf, strata, p.pixel, options.gather,
+            p.si, sf, strata, gatherStream(p), options.gather,
             std::span<const GatherCell>(cells.data() + i * std::size_t(strata.cells()), std::size_t(strata.cells())));
         // The translation-gradient limit (Krivanek et al. 2006): the extrapolation by the
         // gradient may not halve the irradiance within the radius; then the screen clamps.

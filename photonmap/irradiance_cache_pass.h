@@ -1,13 +1,14 @@
 // The irradiance cache's pre-pass, run through the render's own tracer (rt::PrePassTracer) as
 // two programs: a probe program (one pixel per image pixel: its camera ray followed through
-// ideal mirrors and glass to the first surface with a diffuse part) and, per level, a gather
+// ideal mirrors and glass to the first surface with a diffuse part, and on through that surface
+// when it is mostly glass, each such surface a probe) and, per level, a gather
 // program (one pixel per new record: its final-gather rays, final_gather.h, whose hits read the
 // global map where the tracer shades them). Record placement is deterministic: the probes are
 // taken on grids of stride 16, 8, 4, 2 and 1 pixels; at each level the probes no record of the
 // earlier levels covers gather a new record, in parallel, and the records are inserted in pixel
 // order on the controlling thread - a record's placement depends only on coarser levels.
 // Probe hits and gather samples travel to PE 0 as counted messages; each level's chosen probes
-// and new records are broadcast to every PE.
+// and new records are broadcast to every other PE.
 #pragma once
 
 #include <cstdint>

@@ -110,7 +110,7 @@ void run(const GalleryArgs& a) {
   if (!fs::is_directory(a.dir)) throw InputError(a.dir + ": not a directory");
   const std::vector<fs::path> models = findModels(a.dir);
   if (models.empty()) throw InputError(a.dir + ": no .gltf or .glb files under it");
-  image::preloadImageCodec();
+  image::imageCodec();  // opened before the first timed render, never beside it
   // Written to a new folder first, so an interrupted run leaves an earlier gallery intact.
   const fs::path out(a.output), temp = fs::path(a.output + ".partial");
   fs::remove_all(temp);

@@ -97,9 +97,12 @@ void run(RenderArgs& a) {
   const std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr")
     throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
-  image::preloadImageCodec();  // opened while the scene loads and renders, not after
+  image::preloadImageCodec();  // opened while the scene loads
 
   scene::Scene scene = loadScene(a.scene, a.lighting);
+  // Loaded by now, or nearly: a missing codec fails before the render, and its loading never
+  // runs beside the timed stages.
+  image::imageCodec();
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);

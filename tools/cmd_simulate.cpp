@@ -162,8 +162,8 @@ void runSimulate(const SimulateArgs& args) {
                 (unsigned long long)(total.messages + total.schedulingMessages),
                 (unsigned long long)(total.bytes + total.schedulingBytes), broadcasts[i]);
   }
-  std::printf("\nbroadcast s: until the last PE has its copy of the replicated data (the controller sends the P "
-              "copies one after another)\n");
+  std::printf("\nbroadcast s: until the last PE has its copy of the replicated data (PE 0, which holds it, sends "
+              "the P - 1 copies one after another)\n");
   std::printf("best P: %d (makespan %.6f s); adding PEs beyond P = %d gains less than %.0f%%\n", table.bestPes,
               points[std::find(all.begin(), all.end(), table.bestPes) - all.begin()].seconds, table.saturationPes,
               par::kSaturationTolerance * 100.0);

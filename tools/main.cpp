@@ -20,12 +20,11 @@ int main(int argc, char** argv) {
   pr::par::ProcessGroup* group = nullptr;
   try {
     group = &pr::par::ProcessGroup::start(&argc, &argv);
-  } catch (const pr::InputError& e) {
-    std::fprintf(stderr, "parrender: error: %s\n", e.what());
-    return pr::kExitBadInput;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "parrender: failed: %s\n", e.what());
-    return 1;
+    // Every rank fails here alike: rank 0 says why.
+    const int status = dynamic_cast<const pr::InputError*>(&e) ? pr::kExitBadInput : 1;
+    if (pr::par::launchedRank() == 0) pr::par::printFailure(status, 0, 1, e.what());
+    return status;
   }
   CLI::App app{"parrender: a parallel software renderer (sort-first/middle/last rasterizers, "
                "image-space/object-space/object ray tracers, photon maps) on one measured thread runtime"};

@@ -1,7 +1,7 @@
 // Opens the image codec module (image_codec.h) once per process: on first use, or ahead of it
 // on a thread of its own, so a command that will write an image loads the library while it
-// reads the scene and renders instead of after, and a command that touches no image
-// (--help, info, simulate, generate) never loads it.
+// reads the scene instead of after it, and a command that touches no image (--help, info
+// without --env, simulate, generate) never loads it.
 #pragma once
 
 #include "common/image/image_codec.h"

@@ -4,7 +4,7 @@
 // its own (libparrender_image_codec.so, oiio_codec.cpp) that codec_loader.h opens on first use
 // - or ahead of it, beside the scene load - and a command that touches no image never pays.
 // Both sides are built by one build with one compiler: the interface is plain C++, errors are
-// returned as text (the loader turns them into pr::InputError on this side).
+// returned as text (image_io.cpp turns them into pr::InputError naming the file).
 #pragma once
 
 #include <cstdint>

@@ -34,14 +34,20 @@ class OiioCodec final : public ImageCodec {
 
   std::string read(const std::string& path, DecodedPixels& out) const override {
     auto in = OIIO::ImageInput::open(path);
-    if (!in) return OIIO::geterror();
+    if (!in) {
+      const std::string why = OIIO::geterror();
+      return why.empty() ? "the reader failed" : why;
+    }
     const OIIO::ImageSpec& spec = in->spec();
     out.width = spec.width;
     out.height = spec.height;
     out.channels = spec.nchannels;
     if (spec.width <= 0 || spec.height <= 0 || spec.nchannels < 1) return "";  // the caller names an empty image
     out.data.assign(std::size_t(spec.width) * std::size_t(spec.height) * std::size_t(spec.nchannels), 0.0f);
-    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out.data.data())) return in->geterror();
+    if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, out.data.data())) {
+      const std::string why = in->geterror();
+      return why.empty() ? "the reader failed" : why;
+    }
     in->close();
     return "";
   }

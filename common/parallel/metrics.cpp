@@ -47,7 +47,7 @@ const std::vector<PeFigure>& peFigures() {
       {"schedulingBytes", [](const PeStageRecord& r) { return double(r.schedulingBytes); },
        "modelled: 16-byte requests, 16-byte packet headers and 8 bytes per task id"},
       {"broadcastBytesReceived", [](const PeStageRecord& r) { return double(r.broadcastBytesReceived); },
-       "measured: bytes of the replicated data each PE reads"},
+       "measured: bytes of the replicated data each PE receives (every PE but the one that holds it)"},
       {"cacheHits", [](const PeStageRecord& r) { return double(r.cacheHits); }, kMeasured},
       {"cacheMisses", [](const PeStageRecord& r) { return double(r.cacheMisses); }, kMeasured},
       {"prefetches", [](const PeStageRecord& r) { return double(r.prefetches); }, kMeasured},

@@ -1,6 +1,7 @@
 // See process_group.h.
 #include "common/parallel/process_group.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
@@ -45,12 +46,18 @@ std::uint64_t commandLineHash(int argc, char** argv) {
   return h;
 }
 
+}  // namespace
+
 int launchedRanks() {
   const char* size = std::getenv("OMPI_COMM_WORLD_SIZE");
   return size ? std::max(1, std::atoi(size)) : 1;
 }
 
-// One line; a run of one rank prints it as parrender always has.
+int launchedRank() {
+  const char* rank = std::getenv("OMPI_COMM_WORLD_RANK");
+  return rank ? std::max(0, std::atoi(rank)) : 0;
+}
+
 void printFailure(int status, int rank, int ranks, const std::string& text) {
   const char* kind = status == kExitBadInput ? "error" : "failed";
   if (ranks == 1)
@@ -59,19 +66,17 @@ void printFailure(int status, int rank, int ranks, const std::string& text) {
     std::fprintf(stderr, "parrender: %s (rank %d of %d): %s\n", kind, rank, ranks, text.c_str());
 }
 
-}  // namespace
-
 ProcessGroup& ProcessGroup::start(int* argc, char*** argv) {
   PR_CHECK(!group, "ProcessGroup::start is called once");
   group.reset(new ProcessGroup());
+  // One rank (no mpirun, or mpirun -np 1): today's single process, MPI never initialised.
+  if (launchedRanks() <= 1) return *group;
   if (const char* t = std::getenv("PARRENDER_RANK_TIMEOUT"); t && *t) {
     char* end = nullptr;
     const double seconds = std::strtod(t, &end);
     if (end == t || *end || !(seconds > 0.0)) throw InputError("PARRENDER_RANK_TIMEOUT must be a positive number of seconds");
     group->timeout_ = seconds;
   }
-  // One rank (no mpirun, or mpirun -np 1): today's single process, MPI never initialised.
-  if (launchedRanks() <= 1) return *group;
   using Entry = Transport* (*)(int*, char***, char*, int);
   const auto entry = reinterpret_cast<Entry>(openModuleEntry("libparrender_mpi.so", "PARRENDER_MPI_MODULE", "parrender_mpi_transport"));
   char error[256] = {};
@@ -146,20 +151,23 @@ int ProcessGroup::finish(int status, const std::string& error) {
     std::string ignored;
     run = decodeStatus(receive(kFinishTag, "rank 0 to end the run").bytes, ignored);
   } else {
-    // The first failure to report: rank 0's own, else the lowest failing rank's.
-    int failedRank = status != 0 ? 0 : -1;
-    std::string text = error;
+    // The failure to report, printed as soon as it is known (so a later rank that never
+    // answers cannot hide it): rank 0's own, else the first to arrive.
+    bool reported = false;
+    if (status != 0) {
+      if (!error.empty()) printFailure(status, 0, ranks_, error);
+      reported = true;
+    }
     for (int got = 1; got < ranks_; ++got) {
       const Envelope e = receive(kStatusTag, "every rank's status at the end of the run");
       std::string theirs;
       const int s = decodeStatus(e.bytes, theirs);
-      if (s != 0 && (failedRank < 0 || (failedRank != 0 && e.source < failedRank))) {
-        failedRank = e.source;
+      if (s != 0 && !reported) {
         run = s;
-        text = theirs;
+        if (!theirs.empty()) printFailure(s, e.source, ranks_, theirs);
+        reported = true;
       }
     }
-    if (failedRank >= 0 && !text.empty()) printFailure(run, failedRank, ranks_, text);
     for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, ""));
   }
   if (!transport_->flush(timeout_)) transport_->abortAll(run != 0 ? run : 1);

@@ -19,8 +19,9 @@ class ProcessGroup {
   static constexpr int kCommandLineTag = 101, kVerdictTag = 102, kStatusTag = 103, kFinishTag = 104;
   static constexpr int kFirstUserTag = 1000;
 
-  // Creates this process's group (once, first thing in main). Throws std::runtime_error when
-  // launched by mpirun and MPI cannot be started.
+  // Creates this process's group (once, first thing in main). Under mpirun, throws
+  // pr::InputError for a bad PARRENDER_RANK_TIMEOUT and std::runtime_error when MPI cannot be
+  // started.
   static ProcessGroup& start(int* argc, char*** argv);
   static ProcessGroup& get();  // the group start() made
 
@@ -42,8 +43,9 @@ class ProcessGroup {
 
   // Ends the run on this rank with `status` (0, or a failure's exit status with its message)
   // and returns the status the process exits with: the same on every rank. Rank 0 collects
-  // every rank's status (bounded), prints the first failure - its own before another's - once,
-  // naming the rank, and tells every rank the run's status; then every rank leaves MPI.
+  // every rank's status (bounded), prints one failure as soon as it knows it - its own, else
+  // the first to arrive - naming the rank, and tells every rank the run's status; then every
+  // rank leaves MPI.
   int finish(int status, const std::string& error);
 
  private:
@@ -52,5 +54,14 @@ class ProcessGroup {
   double timeout_ = 300.0;
   Transport* transport_ = nullptr;
 };
+
+// The ranks mpirun started and this process's rank among them, from the environment (before
+// MPI is initialised); 1 and 0 without mpirun. Open MPI's mpirun only (OMPI_COMM_WORLD_*).
+int launchedRanks();
+int launchedRank();
+
+// One failure line on stderr: "parrender: error: ..." (status 2) or "parrender: failed: ...",
+// naming the rank when there are several.
+void printFailure(int status, int rank, int ranks, const std::string& text);
 
 }  // namespace pr::par

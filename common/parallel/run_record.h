@@ -57,6 +57,10 @@ struct StageRecord {
   double startSeconds = 0.0;  // since the runtime started
   double wallSeconds = 0.0;
   std::vector<PeStageRecord> pes;
+  // The replicated data broadcast before the stage, whatever P: how many broadcasts and their
+  // bytes (one copy's). The PEs' broadcastsReceived say who received them at this P (every PE
+  // but each broadcast's root), so a P = 1 record still says what another P would receive.
+  std::uint64_t broadcasts = 0, broadcastBytes = 0;
   std::vector<Traffic> traffic;
   std::vector<ChannelTraffic> channels;  // the same messages, by channel (only non-zero ones)
   std::vector<TaskInfo> tasks;  // the stage's TaskSet (cost estimates, positions)

@@ -93,6 +93,8 @@ json toJson(const RunRecord& record) {
                {"grain", s.grain},
                {"startSeconds", s.startSeconds},
                {"wallSeconds", s.wallSeconds},
+               {"broadcasts", s.broadcasts},
+               {"broadcastBytes", s.broadcastBytes},
                {"summary", summaryJson(summary.stages[i])}};
     json pes = json::array();
     for (const PeStageRecord& r : s.pes) pes.push_back(peJson(r));
@@ -235,6 +237,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     s.grain = optionalField(js, "grain", 1, origin, where);
     s.startSeconds = optionalField(js, "startSeconds", 0.0, origin, where);
     s.wallSeconds = field<double>(js, "wallSeconds", origin, where);
+    s.broadcasts = optionalField(js, "broadcasts", std::uint64_t{0}, origin, where);
+    s.broadcastBytes = optionalField(js, "broadcastBytes", std::uint64_t{0}, origin, where);
     for (const json& jp : js.value("pes", json::array())) {
       const std::string pe = where + " PE " + std::to_string(s.pes.size());
       const auto seconds = [&](const char* key) { return optionalField(jp, key, 0.0, origin, pe); };

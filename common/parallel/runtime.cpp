@@ -416,6 +416,10 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
       if (messages > 0) sr.channels.push_back({channel->name(), std::string(toString(channel->kind())), messages, bytes});
     }
   }
+  for (const PendingBroadcast& b : pendingBroadcasts_) {
+    sr.broadcasts += 1;
+    sr.broadcastBytes += b.bytes;
+  }
   pendingBroadcasts_.clear();
   record_.stages.push_back(std::move(sr));
   for (auto& s : spans_) record_.timeline.insert(record_.timeline.end(), s.begin(), s.end());

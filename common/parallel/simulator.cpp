@@ -58,6 +58,9 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     stage.schedule = sr.schedule;
     stage.runtimeSchedule = sr.schedule == record.schedule;
     stage.owners = sr.owners;
+    // The stage's own figures; a record written before it had them: what any PE received.
+    stage.broadcasts = sr.broadcasts;
+    stage.broadcastBytes = sr.broadcastBytes;
     for (const PeStageRecord& pe : sr.pes) {
       stage.broadcasts = std::max(stage.broadcasts, pe.broadcastsReceived);
       stage.broadcastBytes = std::max(stage.broadcastBytes, pe.broadcastBytesReceived);

@@ -30,15 +30,15 @@ struct NetworkModel {
     return messages * latencySeconds + (bytesPerSecond > 0.0 ? bytes / bytesPerSecond : 0.0);
   }
   // Replicated data (the scene, a photon map: `messages` messages of `bytes` in all per PE)
-  // reaches PE pe this long after the stage could start: the controller sends the P copies one
-  // after another, PE 0's first, each paying latency + bytes/bandwidth. One sender on a shared
+  // reaches PE pe this long after the stage could start: PE 0, which holds it, sends the P - 1
+  // copies one after another, PE 1's first, each paying latency + bytes/bandwidth. One sender on a shared
   // medium is the seed's setting (PVM over one Ethernet segment, where a tree would not help:
   // the segment carries one copy at a time); on a switched network a binomial tree would take
   // ceil(log2 P) steps instead of P, so there this is an upper bound. Task packets are not held
   // up by the copies (the scheduler is taken to have a link of its own), and a stage lasts until
   // every PE has its copy, work or not: the data is replicated on all of them.
   double broadcastArrival(int pe, std::uint64_t messages, std::uint64_t bytes) const {
-    return messages == 0 && bytes == 0 ? 0.0 : (pe + 1) * seconds(messages, bytes);
+    return messages == 0 && bytes == 0 ? 0.0 : pe * seconds(messages, bytes);
   }
 };
 // Presets: zero, shared-memory, 10gbe, 1gbe, 100mbit (a 1990s workstation farm).

@@ -135,7 +135,7 @@ TEST_CASE("PhotonMapIntegrator: the Cornell box is close to a long path-traced r
   rt::TraceOptions path;
   path.integrator.kind = rt::IntegratorKind::Path;
   path.integrator.spp = 1024;
-  path.integrator.maxDepth = 16;
+  path.integrator.maxDepth = rt::IntegratorOptions{}.maxDepth;  // the photon map's (render below)
   par::Runtime runtime(2);
   const image::Image reference = rt::renderRays(s, cam, kW, kH, path, "image-space", runtime).image;
   pm::PhotonMapSettings settings = smallSettings();

@@ -16,7 +16,7 @@ MethodClass classifyMethod(std::string_view method) {
       {"image-space",
        {"screen space: image tiles are the tasks, rays never leave their PE", "-",
         "world model: the scene and its BVH replicated on every PE (§4.1); photon maps replicated",
-        "broadcast bytes per PE (the replicated scene) and no ray messages", "§5.1.2"}},
+        "broadcast bytes to each PE but PE 0 (the replicated scene) and no ray messages", "§5.1.2"}},
       {"image-space-cached",
        {"screen space: image tiles are the tasks", "-",
         "data manager: geometry items owned by PEs, fetched on demand into a local LRU cache, prefetched by profile, "

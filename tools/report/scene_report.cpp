@@ -45,9 +45,12 @@ double analyticCompositeBytes(int width, int height, int pes) {
   return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1);
 }
 
-// A broadcast total over its receivers: every PE but the root that holds the data.
-std::uint64_t perReceivingPe(const ComparisonRow& r, std::uint64_t total) {
-  return r.what.pes > 1 ? total / std::uint64_t(r.what.pes - 1) : 0;
+// What one copy of a run's broadcasts is, whatever P (the record's stages say it even at P = 1):
+// messages, or bytes.
+std::uint64_t broadcastCopy(const ComparisonRow& r, bool messages = false) {
+  std::uint64_t n = 0;
+  for (const par::StageRecord& s : r.record.stages) n += messages ? s.broadcasts : s.broadcastBytes;
+  return n;
 }
 
 // The figure that shows the method's class, measured on this scene.
@@ -56,7 +59,7 @@ std::string measuredFigure(const ComparisonRow& r, int width, int height) {
   const int p = r.what.pes;
   if (m == "sequential") return "Ts = " + fmt(r.wall, "%.3f") + " s";
   if (m == "image-space")
-    return "broadcast " + formatBytes(perReceivingPe(r, kindBytes(r, "broadcasts"))) + " per receiving PE, " +
+    return "broadcast " + formatBytes(broadcastCopy(r)) + " to each PE but PE 0, " +
            std::to_string(kindBytes(r, "rays", true)) + " ray messages (P=" + std::to_string(p) + ")";
   if (m == "image-space-cached")
     return (r.cacheHitRatio >= 0.0 ? "hit ratio " + fmt(r.cacheHitRatio, "%.3f") : std::string("no cache used")) + ", " + std::to_string(kindBytes(r, "requests", true)) +
@@ -467,13 +470,13 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
       const PredictedPoint* bestPoint = &s.predicted.front();
       for (const PredictedPoint& q : s.predicted)
         if (q.pes == s.bestPredictedPes) bestPoint = &q;
-      const std::uint64_t perPeBytes = perReceivingPe(r, kindBytes(r, "broadcasts"));
-      const std::uint64_t perPeMessages = perReceivingPe(r, kindBytes(r, "broadcasts", true));
+      const std::uint64_t perPeBytes = broadcastCopy(r);
+      const std::uint64_t perPeMessages = broadcastCopy(r, true);
       const std::uint64_t dataBytes = allTraffic(r).bytes - kindBytes(r, "broadcasts") - kindBytes(r, "tasks");
       html += "<li>" + escape(method) + ": " + fmt(last.seconds, "%.4f") + " s at " + std::to_string(topP) +
               " PEs (speed-up " + fmt(last.speedup, "%.3g") + ", efficiency " + fmt(last.efficiency, "%.3f") + ", imbalance " +
               fmt(last.imbalance, "%.2f") + "); best at P = " + std::to_string(bestPoint->pes) + ", " +
-              fmt(bestPoint->seconds, "%.4f") + " s. Each PE first receives " + formatBytes(perPeBytes) +
+              fmt(bestPoint->seconds, "%.4f") + " s. Each PE but PE 0 first receives " + formatBytes(perPeBytes) +
               " of replicated data, " + fmt(network.broadcastArrival(topP - 1, perPeMessages, perPeBytes), "%.3g") +
               " s until the last of " + std::to_string(topP) + " PEs has it; measured at P = " + std::to_string(r.what.pes) + ", " +
               formatBytes(dataBytes) + " of other data between PEs, computation/communication " +

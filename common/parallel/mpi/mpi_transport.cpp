@@ -5,9 +5,12 @@
 #include <mpi.h>
 
 #include <chrono>
+#include <climits>
+#include <cstdlib>
 #include <cstdio>
 #include <deque>
 #include <mutex>
+#include <stdexcept>
 #include <thread>
 
 #include "common/parallel/transport.h"
@@ -26,6 +29,7 @@ class MpiTransport final : public Transport {
   int ranks() const override { return ranks_; }
 
   void send(int to, int tag, Bytes bytes) override {
+    if (bytes.size() > std::size_t(INT_MAX)) throw std::runtime_error("a message of 2 GiB or more cannot be sent in one MPI call");
     std::lock_guard lock(mutex_);
     completeSends();
     Pending& p = pending_.emplace_back();

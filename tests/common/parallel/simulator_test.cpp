@@ -171,9 +171,9 @@ TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at
 }
 
 TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arrived") {
-  // 1 MB of scene to each of 4 PEs at 1 ms + 1e6 / 12.5e6 s = 81 ms per copy, sent one after
-  // another: PE p has it at (p + 1) x 81 ms. PE 3 then waits for its task packet
-  // (1 ms + 24 bytes / 12.5 MB/s) and runs its 1 s task.
+  // 1 MB of scene from PE 0, which holds it, to each of the 3 other PEs at 1 ms + 1e6 / 12.5e6 s
+  // = 81 ms per copy, sent one after another: PE p has it at p x 81 ms. PE 3 then waits for its
+  // task packet (1 ms + 24 bytes / 12.5 MB/s) and runs its 1 s task.
   pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
   w.stages[0].broadcasts = 1;
   w.stages[0].broadcastBytes = 1000000;
@@ -182,11 +182,12 @@ TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arr
   options.network = networkByName("100mbit");
   const RunRecord r = simulate(w, "balanced", options);
   const double copy = 1e-3 + 1e6 / 12.5e6;
-  CHECK(r.wallSeconds == doctest::Approx(4 * copy + 1e-3 + 24.0 / 12.5e6 + 1.0));
-  CHECK(r.stages[0].pes[3].messageWaitSeconds == doctest::Approx(4 * copy));
-  CHECK(r.stages[0].pes[0].messageWaitSeconds == doctest::Approx(copy));
+  CHECK(r.wallSeconds == doctest::Approx(3 * copy + 1e-3 + 24.0 / 12.5e6 + 1.0));
+  CHECK(r.stages[0].pes[3].messageWaitSeconds == doctest::Approx(3 * copy));
+  CHECK(r.stages[0].pes[1].messageWaitSeconds == doctest::Approx(copy));
   CHECK(r.stages[0].pes[2].broadcastBytesReceived == 1000000);
-  CHECK(options.network.broadcastArrival(1023, 1, 1000000) == doctest::Approx(1024 * copy));
+  CHECK(r.stages[0].pes[0].broadcastBytesReceived == 0);  // the root
+  CHECK(options.network.broadcastArrival(1023, 1, 1000000) == doctest::Approx(1023 * copy));
   options.network = networkByName("zero");
   CHECK(simulate(w, "balanced", options).wallSeconds == doctest::Approx(1.0));
 }
