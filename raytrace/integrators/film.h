@@ -35,8 +35,9 @@ struct FilmBlock {
 
 // A film block on the wire: its rectangle, then its sums (their count follows from the
 // message's length).
+namespace pr::par {
 template <>
-struct pr::par::Wire<pr::rt::FilmBlock> {
+struct Wire<rt::FilmBlock> {
   static constexpr bool kBytewise = false;
   static std::size_t size(const rt::FilmBlock& b) { return b.bytes(); }
   static void encode(const rt::FilmBlock& b, WireWriter& w) {
@@ -50,6 +51,7 @@ struct pr::par::Wire<pr::rt::FilmBlock> {
     return b;
   }
 };
+}  // namespace pr::par
 
 namespace pr::rt {
 

@@ -58,8 +58,9 @@ using ReplyBatch = std::vector<HitReply>;
 
 // A reply on the wire: slot (4 bytes), the two flags (1 each, 2 padding), then the hit and its
 // interaction when it carries them.
+namespace pr::par {
 template <>
-struct pr::par::Wire<pr::rt::HitReply> {
+struct Wire<rt::HitReply> {
   static_assert(std::is_trivially_copyable_v<rt::Hit> && std::is_trivially_copyable_v<rt::SurfaceInteraction>);
   static constexpr bool kBytewise = false;
   static constexpr std::size_t kHeaderBytes = 8;
@@ -89,6 +90,7 @@ struct pr::par::Wire<pr::rt::HitReply> {
     return out;
   }
 };
+}  // namespace pr::par
 
 namespace pr::rt {
 namespace {
