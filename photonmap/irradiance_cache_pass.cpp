@@ -209,14 +209,24 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
   for (int p = 0; p < pes; ++p) probesPerPe[std::size_t(p)] = double(probes->perPe()[std::size_t(p)].items.size());
   std::vector<std::vector<ProbeHit>> found =
       par::gatherToRoot(rt, "irradiance-cache probe merge", "probes", par::MessageKind::Data, takeAll(probes->perPe()), sizeof(ProbeHit));
-  // A pixel's probes in the order its ray met them (one, or more through partly diffuse glass):
-  // an order that does not depend on which PE found which.
-  std::vector<std::vector<ProbeHit>> byPixel(std::size_t(width) * std::size_t(height));
-  for (std::vector<ProbeHit>& list : found)
-    for (ProbeHit& h : list) byPixel[h.pixel].push_back(std::move(h));
-  for (std::vector<ProbeHit>& hits : byPixel)
-    if (hits.size() > 1)
-      std::sort(hits.begin(), hits.end(), [](const ProbeHit& a, const ProbeHit& b) { return a.depth < b.depth; });
+  // Every probe, by pixel and within a pixel in the order its ray met them (one, or more
+  // through partly diffuse glass): an order that does not depend on which PE found which.
+  // Probes of pixel i: ordered[firstProbe[i] .. firstProbe[i + 1]).
+  const std::size_t pixels = std::size_t(width) * std::size_t(height);
+  std::vector<std::uint32_t> firstProbe(pixels + 1, 0);
+  for (const std::vector<ProbeHit>& list : found)
+    for (const ProbeHit& h : list) ++firstProbe[std::size_t(h.pixel) + 1];
+  for (std::size_t i = 0; i < pixels; ++i) firstProbe[i + 1] += firstProbe[i];
+  std::vector<ProbeHit> ordered(firstProbe[pixels]);
+  {
+    std::vector<std::uint32_t> next(firstProbe.begin(), firstProbe.end() - 1);
+    for (std::vector<ProbeHit>& list : found)
+      for (ProbeHit& h : list) ordered[next[h.pixel]++] = std::move(h);
+  }
+  for (std::size_t i = 0; i < pixels; ++i)
+    if (firstProbe[i + 1] - firstProbe[i] > 1)
+      std::sort(ordered.begin() + firstProbe[i], ordered.begin() + firstProbe[i + 1],
+                [](const ProbeHit& a, const ProbeHit& b) { return a.depth < b.depth; });
 
   std::vector<double> gatherHitsPerPe(std::size_t(pes), 0.0);
   double records = 0.0;
@@ -228,8 +238,9 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     for (int y = 0; y < height; y += stride)
       for (int x = 0; x < width; x += stride) {
         const bool coarser = stride < kCoarsestStride && x % (2 * stride) == 0 && y % (2 * stride) == 0;
+        const std::size_t i = std::size_t(y) * std::size_t(width) + std::size_t(x);
         if (!coarser)
-          for (const ProbeHit& p : byPixel[std::size_t(y) * std::size_t(width) + std::size_t(x)]) candidates.push_back(&p);
+          for (std::uint32_t k = firstProbe[i]; k < firstProbe[i + 1]; ++k) candidates.push_back(&ordered[k]);
       }
     // Which of them no record of the coarser levels covers (read-only cache, every PE).
     std::vector<char> uncovered(candidates.size(), 0);
