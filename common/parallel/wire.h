@@ -60,6 +60,7 @@ class WireReader {
   explicit WireReader(std::span<const std::byte> in) : in_(in) {}
   void raw(void* data, std::size_t n) {
     if (n > remaining()) throw WireError("a message ends " + std::to_string(n - remaining()) + " bytes short of its encoding");
+    if (n == 0) return;  // an empty vector's data() may be null, which memcpy may not be given
     std::memcpy(data, in_.data() + at_, n);
     at_ += n;
   }
@@ -94,21 +95,30 @@ class WireReader {
   std::size_t at_ = 0;
 };
 
+// A message type's encoding. Undefined for a type that has none: a type that is not
+// trivially copyable gets one by a specialisation beside its definition.
+template <class T>
+struct Wire;
+
 // The default: a trivially copyable message is its bytes (kBytewise). A specialisation whose
 // encoding is not the object's bytes says kBytewise = false.
 template <class T>
-struct Wire {
-  static_assert(std::is_trivially_copyable_v<T>,
-                "a message type that is not trivially copyable needs its own Wire<T> beside its definition");
+  requires std::is_trivially_copyable_v<T>
+struct Wire<T> {
   static constexpr bool kBytewise = true;
   static std::size_t size(const T&) { return sizeof(T); }
   static void encode(const T& v, WireWriter& w) { w.value(v); }
   static T decode(WireReader& r) { return r.value<T>(); }
 };
 
+// Whether T has an encoding, so that a message of it can leave a rank.
+template <class T>
+concept HasWire = requires { Wire<T>::kBytewise; };
+
 // A message that is a vector: its elements one after another, each as its own Wire encodes it
 // (each must then tell its own length: a bytewise element by its size).
 template <class T>
+  requires HasWire<T>
 struct Wire<std::vector<T>> {
   static constexpr bool kBytewise = false;
   static std::size_t size(const std::vector<T>& v) {

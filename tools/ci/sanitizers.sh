@@ -10,5 +10,6 @@ cmake -S "$root" -B "$build" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANIT
 cmake --build "$build" -j"$(nproc)" --target parrender parrender_tests
 export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+export LSAN_OPTIONS=suppressions=$root/tools/ci/lsan.supp
 cd "$build"
 ctest --output-on-failure -j"$(nproc)"
