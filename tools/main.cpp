@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/parallel/process_group.h"
+#include "common/parallel/runtime.h"
 #include "common/util/allocator.h"
 #include "common/util/error.h"
 #include "common/util/interrupt.h"
@@ -80,6 +81,8 @@ int main(int argc, char** argv) {
   } catch (const pr::InputError& e) {
     status = pr::kExitBadInput;
     error = e.what();
+  } catch (const pr::par::FailedElsewhere&) {
+    status = 1;  // the rank where it failed reports it
   } catch (const std::exception& e) {
     status = 1;
     error = e.what();

@@ -11,6 +11,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <span>
+#include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
@@ -30,7 +32,7 @@ class Channel : public ChannelBase {
   // (tryReceive inside a later task, or drain between stages).
   Channel(Runtime& runtime, std::string name, MessageKind kind, Handler handler = {})
       : ChannelBase(std::move(name), kind), runtime_(runtime), handler_(std::move(handler)) {
-    for (int p = 0; p < runtime_.pes(); ++p) boxes_.push_back(std::make_unique<Mailbox>());
+    for (int p = 0; p < runtime_.pes(); ++p) boxes_.push_back(std::make_unique<Mailbox>());  // only local ones used
     runtime_.attach(this, bool(handler_));
   }
   ~Channel() override { runtime_.detach(this); }
@@ -58,15 +60,10 @@ class Channel : public ChannelBase {
     const SendReceiveTimer timer(from);
     runtime_.countMessage(from.id(), to, bytes);
     if (from.id() != to) countSent(bytes);
+    if (!runtime_.isLocal(to)) return sendToRank(from.id(), to, message, bytes);
     if (handler_) runtime_.outstanding().add();  // before the receiver can see it
-    {
-      std::lock_guard lock(boxes_[to]->mutex);
-      boxes_[to]->queue.push_back(std::move(message));
-      boxes_[to]->size.store(boxes_[to]->queue.size(), std::memory_order_release);
-    }
-    runtime_.ring(to);
+    enqueue(to, std::move(message));
   }
-
   // One copy to every other PE, counted once per receiving PE.
   void broadcast(Pe& from, const T& message) {
     for (int p = 0; p < runtime_.pes(); ++p)
@@ -105,12 +102,46 @@ class Channel : public ChannelBase {
     return true;
   }
 
+  void deliver(int from, int to, std::span<const std::byte> encoding, std::size_t counted) override {
+    if constexpr (HasWire<T>) {
+      T message = decodeMessage<T>(encoding);
+      (void)from;
+      runtime_.countReceived(to, counted);
+      if (handler_) runtime_.outstanding().add();
+      enqueue(to, std::move(message));
+    } else {
+      throw std::logic_error("Channel '" + name() + "': a message without an encoding arrived from another rank");
+    }
+  }
+
  private:
   struct Mailbox {
     std::mutex mutex;
     std::deque<T> queue;
     std::atomic<std::size_t> size{0};  // lets an idle PE poll without taking the lock
   };
+
+  void enqueue(int to, T&& message) {
+    {
+      std::lock_guard lock(boxes_[to]->mutex);
+      boxes_[to]->queue.push_back(std::move(message));
+      boxes_[to]->size.store(boxes_[to]->queue.size(), std::memory_order_release);
+    }
+    runtime_.ring(to);
+  }
+
+  // To a PE on another rank: the message's encoding, behind room for the runtime's header.
+  void sendToRank(int from, int to, const T& message, std::size_t counted) {
+    if constexpr (HasWire<T>) {
+      Bytes framed(Runtime::kFrameBytes);
+      framed.reserve(Runtime::kFrameBytes + Wire<T>::size(message));
+      WireWriter w(framed);
+      Wire<T>::encode(message, w);
+      runtime_.sendToRank(*this, from, to, std::move(framed), counted);
+    } else {
+      throw std::logic_error("Channel '" + name() + "': its messages have no encoding (Wire) and cannot leave a rank");
+    }
+  }
 
   bool pop(int pe, std::optional<T>& out) {
     Mailbox& box = *boxes_[pe];

@@ -153,19 +153,22 @@ int ProcessGroup::finish(int status, const std::string& error) {
   } else {
     // The failure to report, printed as soon as it is known (so a later rank that never
     // answers cannot hide it): rank 0's own, else the first to arrive.
+    // A failure without text (one that another rank reports) waits for that rank's.
     bool reported = false;
-    if (status != 0) {
-      if (!error.empty()) printFailure(status, 0, ranks_, error);
+    if (status != 0 && !error.empty()) {
+      printFailure(status, 0, ranks_, error);
       reported = true;
     }
     for (int got = 1; got < ranks_; ++got) {
       const Envelope e = receive(kStatusTag, "every rank's status at the end of the run");
       std::string theirs;
       const int s = decodeStatus(e.bytes, theirs);
-      if (s != 0 && !reported) {
+      if (s != 0 && !reported && !theirs.empty()) {
         run = s;
-        if (!theirs.empty()) printFailure(s, e.source, ranks_, theirs);
+        printFailure(s, e.source, ranks_, theirs);
         reported = true;
+      } else if (s != 0 && run == 0) {
+        run = s;
       }
     }
     for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, ""));

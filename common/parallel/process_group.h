@@ -44,8 +44,9 @@ class ProcessGroup {
   // Ends the run on this rank with `status` (0, or a failure's exit status with its message)
   // and returns the status the process exits with: the same on every rank. Rank 0 collects
   // every rank's status (bounded), prints one failure as soon as it knows it - its own, else
-  // the first to arrive - naming the rank, and tells every rank the run's status; then every
-  // rank leaves MPI.
+  // the first to arrive with a message - naming the rank, and tells every rank the run's
+  // status; then every rank leaves MPI. A failure another rank reports (FailedElsewhere) is
+  // passed with an empty message.
   int finish(int status, const std::string& error);
 
  private:

@@ -28,6 +28,14 @@ Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(
     throw InputError("grain must be at least 1 task, got " + std::to_string(options_.params.grain));
   schedule_ = makeScheduler(options_.schedule);
   const int p = options_.pes;
+  if (options_.transport && options_.transport->ranks() > 1) {
+    ranks_ = options_.transport->ranks();
+    rank_ = options_.transport->rank();
+    if (p % ranks_ != 0)
+      throw InputError(std::to_string(p) + " PEs cannot be spread evenly over " + std::to_string(ranks_) + " ranks");
+  }
+  localPes_ = p / ranks_;
+  rankStage_.answers.resize(static_cast<std::size_t>(localPes_));
   counters_ = std::vector<PeCounters>(p);
   pairMessages_ = std::vector<std::atomic<std::uint64_t>>(static_cast<std::size_t>(p) * p);
   pairBytes_ = std::vector<std::atomic<std::uint64_t>>(static_cast<std::size_t>(p) * p);
@@ -48,8 +56,8 @@ Runtime::~Runtime() {
 }
 
 void Runtime::startWorkers() {
-  workers_.reserve(options_.pes);
-  for (int p = 0; p < options_.pes; ++p) workers_.emplace_back([this, p] { workerMain(p); });
+  workers_.reserve(localPes_);
+  for (int p = firstLocalPe(); p < firstLocalPe() + localPes_; ++p) workers_.emplace_back([this, p] { workerMain(p); });
 }
 
 namespace {
@@ -144,6 +152,8 @@ std::string_view toString(MessageKind kind) {
 void Runtime::attach(ChannelBase* channel, bool handled) {
   PR_CHECK(!inStage_, "channels are created between stages");
   std::lock_guard lock(channelMutex_);
+  channel->setId(static_cast<std::uint32_t>(channelsById_.size()));
+  channelsById_.push_back(channel);
   registered_.push_back(channel);
   if (handled) channels_.push_back(channel);
 }
@@ -151,6 +161,7 @@ void Runtime::attach(ChannelBase* channel, bool handled) {
 void Runtime::detach(ChannelBase* channel) {
   PR_CHECK(!inStage_, "channels are destroyed between stages");
   std::lock_guard lock(channelMutex_);
+  channelsById_[channel->id()] = nullptr;
   channels_.erase(std::remove(channels_.begin(), channels_.end(), channel), channels_.end());
   registered_.erase(std::remove(registered_.begin(), registered_.end(), channel), registered_.end());
 }
@@ -163,6 +174,10 @@ void Runtime::countMessage(int from, int to, std::size_t bytes) {
   pairBytes_[pair].fetch_add(bytes, std::memory_order_relaxed);
   counters_[from].messagesSent.fetch_add(1, std::memory_order_relaxed);
   counters_[from].bytesSent.fetch_add(bytes, std::memory_order_relaxed);
+  if (isLocal(to)) countReceived(to, bytes);
+}
+
+void Runtime::countReceived(int to, std::size_t bytes) {
   counters_[to].messagesReceived.fetch_add(1, std::memory_order_relaxed);
   counters_[to].bytesReceived.fetch_add(bytes, std::memory_order_relaxed);
 }
@@ -177,7 +192,7 @@ void Runtime::ring(int pe) {
 }
 
 void Runtime::ringAll() {
-  for (int p = 0; p < options_.pes; ++p) ring(p);
+  for (int p = firstLocalPe(); p < firstLocalPe() + localPes_; ++p) ring(p);
 }
 
 void Runtime::fail(int p, const std::string& stage, TaskId task, std::exception_ptr error) {
@@ -185,6 +200,7 @@ void Runtime::fail(int p, const std::string& stage, TaskId task, std::exception_
     std::lock_guard lock(errorMutex_);
     if (!error_) {
       error_ = error;
+      rankStage_.failedHere = true;
       std::string what = "unknown exception";
       try {
         std::rethrow_exception(error);
@@ -212,7 +228,7 @@ void Runtime::waitForWork(int p) {
   const double t0 = now();
   {
     std::unique_lock lock(bell.mutex);
-    bell.cv.wait(lock, [&] { return bell.rung || outstanding_.finished() || abort_.load(std::memory_order_acquire); });
+    bell.cv.wait(lock, [&] { return bell.rung || stageOver() || abort_.load(std::memory_order_acquire); });
     bell.rung = false;
   }
   counters_[p].pendingWaitSeconds += now() - t0;
@@ -274,6 +290,11 @@ void Runtime::peLoop(int p, const StageJob& job) {
   Grab grab;
   bool tasksLeft = true;
   TaskId current = kSetupSpan;
+  // Across ranks a PE is outstanding work until it knows it has no task left (its tasks are
+  // not known to its rank in advance); on one rank every task is counted from the start.
+  const bool acrossRanks = ranks_ > 1;
+  const bool askController = acrossRanks && rank_ != 0 && !scheduler.decidedPerPe();
+  std::vector<TaskReport> reports;  // finished tasks, for the controller's next answer
   try {
     if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) {
       // Messages that arrive meanwhile wait in their channels.
@@ -287,9 +308,10 @@ void Runtime::peLoop(int p, const StageJob& job) {
       current = kMessageSpan;
       if (handleMessages(pe, spans)) continue;
       if (tasksLeft) {
-        scheduler.next(p, now(), grab);
+        nextTasks(pe, scheduler, askController, grab, spans, reports);
         if (grab.tasks.empty()) {
           tasksLeft = false;
+          if (acrossRanks) outstanding_.done();
           continue;
         }
         if (grab.from != p && grab.packets + grab.requests > 0) {
@@ -306,14 +328,18 @@ void Runtime::peLoop(int p, const StageJob& job) {
             return true;
           });
           c.tasks.fetch_add(1, std::memory_order_relaxed);
-          scheduler.finished(p, id, seconds);
-          if (outstanding_.done()) ringAll();
+          if (askController) {
+            reports.push_back({id, seconds});
+          } else {
+            scheduler.finished(p, id, seconds);
+          }
+          if (!acrossRanks && outstanding_.done()) ringAll();
           current = kMessageSpan;
           handleMessages(pe, spans);
         }
         continue;
       }
-      if (outstanding_.finished()) break;
+      if (stageOver()) break;
       waitForWork(p);
     }
   } catch (...) {
@@ -328,6 +354,7 @@ void Runtime::runStage(std::string_view name, const TaskSet& tasks, Scheduler& s
 void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Scheduler& scheduler, const SetupFn* setup,
                        const TaskFn& work, std::vector<int> owners) {
   PR_CHECK(!inStage_, "runStage is called by the controlling thread, not from inside a stage");
+  if (rankStage_.spent) throw std::runtime_error("the runtime stopped after a failure on one of its ranks");
   const int pes = options_.pes;
   const std::string name(nameView);
   const int stage = static_cast<int>(record_.stages.size());
@@ -346,8 +373,18 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   for (auto& s : spans_) s.clear();
   abort_.store(false);
   error_ = nullptr;
-  // Every task and every PE's set-up is outstanding work until it returns (termination.h).
-  outstanding_.reset(static_cast<std::int64_t>(tasks.size()) + (setup && *setup ? pes : 0));
+  // Every task and every PE's set-up is outstanding work until it returns (termination.h);
+  // across ranks, every local PE until it has no task left, and every local set-up.
+  const bool hasSetup = setup && *setup;
+  if (ranks_ == 1)
+    outstanding_.reset(static_cast<std::int64_t>(tasks.size()) + (hasSetup ? pes : 0));
+  else
+    outstanding_.reset(localPes_ + (hasSetup ? localPes_ : 0));
+  rankStage_.over.store(false);
+  rankStage_.sent.store(0);
+  rankStage_.received.store(0);
+  rankStage_.failedHere = rankStage_.announced = false;
+  for (std::optional<Grab>& answer : rankStage_.answers) answer.reset();
   scheduler.reset(tasks, pes, options_.params);
 
   if (workers_.empty()) startWorkers();
@@ -357,10 +394,18 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   {
     std::unique_lock lock(stageMutex_);
     job_ = StageJob{&scheduler, &work, setup, stage, &name};
-    running_ = pes;
+    running_ = localPes_;
     ++generation_;
   }
   stageStart_.notify_all();
+  if (ranks_ > 1) {
+    try {
+      driveRankStage(stage);
+    } catch (...) {  // a message that breaks the protocol: this rank's failure
+      fail(firstLocalPe(), name, kMessageSpan, std::current_exception());
+      rankStage_.spent = true;
+    }
+  }
   spinBriefly([&] { return running_.load(std::memory_order_acquire) == 0; });
   {
     std::unique_lock lock(stageMutex_);

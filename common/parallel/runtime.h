@@ -40,6 +40,8 @@
 #include <memory>
 #include <mutex>
 #include <optional>
+#include <stdexcept>
+#include <span>
 #include <string>
 #include <string_view>
 #include <thread>
@@ -51,14 +53,21 @@
 #include "common/parallel/schedulers/scheduler.h"
 #include "common/parallel/task.h"
 #include "common/parallel/termination.h"
+#include "common/parallel/transport.h"
 
 namespace pr::par {
 
+class Transport;
+
 struct RuntimeOptions {
-  int pes = 1;
+  int pes = 1;                      // P: every PE of the run, on every rank
   std::string schedule = "demand";  // registry name (schedulers/registry.cpp)
   ScheduleParams params;
   bool recordTimeline = true;       // keep one TaskSpan per task, handled message and set-up
+  // The ranks of the run (not owned; nullptr or one rank: this process holds every PE). With
+  // R ranks, this rank runs PEs [rank * P/R, (rank + 1) * P/R) and every rank's controlling
+  // thread runs the same stages (rank_stage.cpp: how a stage ends across ranks).
+  Transport* transport = nullptr;
 };
 
 // What a message carries, for the traffic-by-kind figures of the run record: primitives
@@ -76,6 +85,10 @@ class ChannelBase {
   virtual ~ChannelBase() = default;
   const std::string& name() const { return name_; }
   MessageKind kind() const { return kind_; }
+  // Its number among the runtime's channels, in the order they were made: the same on every
+  // rank, since every rank makes the same channels (set by Runtime::attach).
+  std::uint32_t id() const { return id_; }
+  void setId(std::uint32_t id) { id_ = id; }
   // Called by Channel::send for a message between two PEs.
   void countSent(std::size_t bytes) {
     messages_.fetch_add(1, std::memory_order_relaxed);
@@ -88,11 +101,22 @@ class ChannelBase {
   virtual bool pending(int pe) const = 0;
   // Pops one message for pe and runs the handler on it; false when there was none.
   virtual bool handleOne(Pe& pe) = 0;
+  // A message from another rank's PE `from` to this rank's PE `to`, as its encoding: decoded
+  // and put in to's mailbox. counted: the bytes its sender booked.
+  virtual void deliver(int from, int to, std::span<const std::byte> encoding, std::size_t counted) = 0;
 
  private:
   std::string name_;
   MessageKind kind_;
+  std::uint32_t id_ = 0;
   std::atomic<std::uint64_t> messages_{0}, bytes_{0};
+};
+
+// What runStage throws on a rank whose PEs did not fail when a PE on another rank did: the
+// stage ended there, and that rank reports the failure (its text is what()).
+class FailedElsewhere : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
 };
 
 class Runtime {
@@ -110,6 +134,13 @@ class Runtime {
 
   int pes() const { return options_.pes; }
   const RuntimeOptions& options() const { return options_; }
+  // The ranks and this process's place among them; PE ids are global.
+  int rank() const { return rank_; }
+  int ranks() const { return ranks_; }
+  int firstLocalPe() const { return rank_ * localPes_; }
+  int localPes() const { return localPes_; }
+  bool isLocal(int pe) const { return pe >= firstLocalPe() && pe < firstLocalPe() + localPes_; }
+  int rankOf(int pe) const { return pe / localPes_; }
 
   // Runs one stage on all PEs and returns when it is over (a barrier). Called by the
   // renderer's controlling thread, never from inside a task. The first overload uses the
@@ -145,14 +176,25 @@ class Runtime {
   void addCounter(std::string_view name, int pe, double value);
 
   const RunRecord& record() const { return record_; }
+  // Across ranks, called by every rank between stages (after the last): on rank 0, the record
+  // of every rank's PEs on rank 0's clock (record_gather.cpp); elsewhere this rank's own. Waits
+  // for another rank at most timeoutSeconds.
+  RunRecord gatherRecord(double timeoutSeconds = 300.0);
   // Seconds since the runtime was created (steady clock).
   double now() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
   }
 
   // ---- for Channel and DataManager, on PE threads during a stage ----
-  // Counts one message from pe `from` to pe `to` (nothing for a message to oneself).
+  // Counts one message from pe `from` to pe `to` (nothing for a message to oneself); the
+  // receiver's figures only when it is on this rank (otherwise its rank counts them on arrival).
   void countMessage(int from, int to, std::size_t bytes);
+  // A message from a local PE to a PE on another rank: `framed` is kFrameBytes of room for the
+  // runtime's header, then the message's encoding. Counted by the caller (countMessage).
+  static constexpr std::size_t kFrameBytes = 32;
+  void sendToRank(const ChannelBase& channel, int from, int to, Bytes framed, std::size_t counted);
+  // On arrival of a message from another rank: the receiving PE's figures.
+  void countReceived(int to, std::size_t bytes);
   OutstandingWork& outstanding() { return outstanding_; }
   void ring(int pe);  // wakes pe if it waits for messages
   // Every channel registers (counting); handled ones are also polled for their messages.
@@ -187,8 +229,23 @@ class Runtime {
   static void confirmWait(PeCounters& c);
   void ringAll();
   void fail(int p, const std::string& stage, TaskId task, std::exception_ptr error);
+  // Across ranks (rank_stage.cpp): the stage is over when termination detection says so.
+  bool stageOver() const {
+    return ranks_ == 1 ? outstanding_.finished() : rankStage_.over.load(std::memory_order_acquire);
+  }
+  // askController: a PE on a rank other than 0 under a strategy rank 0 holds; reports: the
+  // tasks it finished since it last asked, sent with the request.
+  struct TaskReport {
+    TaskId task;
+    double seconds;
+  };
+  void nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
+                 std::vector<TaskReport>& reports);
+  void driveRankStage(int stage);
+  void sendControl(int to, std::uint32_t type, int stage, int a, Bytes payload = {});
 
   RuntimeOptions options_;
+  int rank_ = 0, ranks_ = 1, localPes_ = 1;
   std::unique_ptr<Scheduler> schedule_;
   std::chrono::steady_clock::time_point epoch_;
   RunRecord record_;
@@ -223,6 +280,20 @@ class Runtime {
   std::mutex counterMutex_;
   std::mutex errorMutex_;
   std::exception_ptr error_;
+
+  // A stage across ranks: this rank's part of the termination detection (Mattern's four
+  // counters: data messages sent to and received from other ranks), the messages that came
+  // early for a later stage, and the task answers rank 0's controller sent to this rank's PEs.
+  struct RankStage {
+    std::atomic<bool> over{false};
+    std::atomic<std::uint64_t> sent{0}, received{0};
+    bool failedHere = false, announced = false, spent = false;
+    std::vector<Envelope> early;
+    std::mutex answerMutex;
+    std::vector<std::optional<Grab>> answers;  // per local PE
+  };
+  RankStage rankStage_;
+  std::vector<ChannelBase*> channelsById_;  // every channel ever attached, by id (null once gone)
 };
 
 }  // namespace pr::par

@@ -74,6 +74,10 @@ class Scheduler {
   virtual void finished(int pe, TaskId task, double seconds) {
     (void)pe, (void)task, (void)seconds;
   }
+  // Whether PE pe's answers depend only on reset()'s inputs and pe (a static portion): across
+  // ranks, each rank then answers its own PEs; otherwise the system controller on rank 0 holds
+  // the strategy and a PE on another rank asks it with a message (rank_stage.cpp).
+  virtual bool decidedPerPe() const { return false; }
 };
 
 // Registry: name -> factory -> one-line description, and what the strategy declares about

@@ -16,6 +16,7 @@ class StaticPortionScheduler : public Scheduler {
   using Split = std::function<std::vector<std::vector<TaskId>>(const TaskSet&, int pes)>;
   StaticPortionScheduler(std::string_view name, Split split) : name_(name), split_(std::move(split)) {}
   std::string_view name() const override { return name_; }
+  bool decidedPerPe() const override { return true; }
 
   void reset(const TaskSet& tasks, int pes, const ScheduleParams&) override {
     portions_ = split_(tasks, pes);

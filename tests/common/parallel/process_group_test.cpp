@@ -2,6 +2,7 @@
 // as in CI), every command bounded by `timeout` so a failure can never hang the suite.
 #include <chrono>
 #include <string>
+#include <utility>
 
 #include <doctest/doctest.h>
 
@@ -85,4 +86,23 @@ TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the s
   INFO(one.output);
   CHECK(one.exitStatus == 0);
   CHECK(one.output.find("triangles") != std::string::npos);
+}
+
+TEST_CASE("ProcessGroup: the runtime's stages across 2 and 3 ranks run every task once and end after every message") {
+  for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}}) {
+    CAPTURE(ranks);
+    CAPTURE(threads);
+    const CommandResult r = mpirun(ranks, check(), "stages " + std::to_string(threads));
+    INFO(r.output);
+    CHECK(r.exitStatus == 0);
+    CHECK(count(r.output, "tasks once each") == 4);
+  }
+}
+
+TEST_CASE("ProcessGroup: a task that fails on one rank's PE ends the stage on every rank, rank 0 names it once") {
+  const CommandResult r = mpirun(2, check(), "stagefail 3");
+  INFO(r.output);
+  CHECK(r.exitStatus == 1);
+  CHECK(count(r.output, "parrender: failed (rank 1 of 2): an injected task failure") == 1);
+  CHECK(count(r.output, "parrender: failed") == 1);
 }

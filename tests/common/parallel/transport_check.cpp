@@ -4,15 +4,23 @@
 //                pattern of its sender, size and destination; every rank checks what it got
 //   fail RANK    rank RANK throws; the run ends on every rank with rank 0 naming it
 //   hang RANK    rank RANK stops answering; rank 0's bounded wait ends every rank
+//   stages T     the runtime on T PEs per rank: under several strategies, every task runs once
+//                and chains of messages that cross ranks end before their stage does
+//   stagefail PE a task on PE PE throws; the stage ends on every rank, rank 0 reports it
 // Exit status: the run's (finish), the same on every rank.
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <thread>
 
+#include "common/parallel/channel.h"
 #include "common/parallel/process_group.h"
+#include "common/parallel/runtime.h"
 
 namespace {
 
@@ -46,6 +54,60 @@ void exchange(ProcessGroup& group) {
   if (me == 0) std::printf("exchange: %d ranks, %d messages each, all bytes as sent\n", ranks, expected);
 }
 
+struct Hop {
+  std::int32_t left, chain;
+};
+
+// Each rank's figures go to rank 0, which checks their sums: every task once, every hop once.
+void stages(ProcessGroup& group, int threads) {
+  constexpr int kTasks = 200, kChains = 16, kLength = 30;
+  for (const char* schedule : {"demand", "balanced", "distributed", "task-manager"}) {
+    pr::par::Runtime rt(pr::par::RuntimeOptions{group.ranks() * threads, schedule, {}, true, &group.transport()});
+    long taskSum = 0, tasks = 0;
+    std::atomic<long> hopsHandled{0};
+    pr::par::Channel<Hop> hops(rt, "hops", pr::par::MessageKind::Rays, [&](pr::par::Pe& pe, Hop&& h) {
+      ++hopsHandled;
+      if (h.left > 0) hops.send(pe, (pe.id() + 1 + h.chain) % rt.pes(), Hop{h.left - 1, h.chain});
+    });
+    std::mutex mutex;
+    rt.runStage("tasks", pr::par::TaskSet::uniform(kTasks), [&](pr::par::Pe&, pr::par::TaskId t) {
+      std::lock_guard lock(mutex);
+      taskSum += t;
+      ++tasks;
+    });
+    rt.runStage("chains", pr::par::TaskSet::uniform(kChains), [&](pr::par::Pe& pe, pr::par::TaskId t) {
+      hops.send(pe, (pe.id() + 1) % rt.pes(), Hop{kLength, static_cast<std::int32_t>(t)});
+    });
+    const long mine[3] = {tasks, taskSum, hopsHandled.load()};
+    if (group.rank() != 0) {
+      Bytes b(sizeof mine);
+      std::memcpy(b.data(), mine, sizeof mine);
+      group.transport().send(0, kTag, std::move(b));
+      continue;
+    }
+    long sum[3] = {mine[0], mine[1], mine[2]};
+    for (int r = 1; r < group.ranks(); ++r) {
+      const pr::par::Envelope e = group.receive(kTag, "a rank's figures");
+      long theirs[3];
+      std::memcpy(theirs, e.bytes.data(), sizeof theirs);
+      for (int i = 0; i < 3; ++i) sum[i] += theirs[i];
+    }
+    if (sum[0] != kTasks || sum[1] != long(kTasks) * (kTasks - 1) / 2 || sum[2] != long(kChains) * (kLength + 1))
+      throw std::runtime_error(std::string(schedule) + ": " + std::to_string(sum[0]) + " tasks, id sum " +
+                               std::to_string(sum[1]) + ", " + std::to_string(sum[2]) + " hops");
+    std::printf("stages: %s on %d ranks x %d PEs: %d tasks once each, %d hops\n", schedule, group.ranks(), threads,
+                kTasks, kChains * (kLength + 1));
+  }
+}
+
+void stageFail(ProcessGroup& group, int failingPe) {
+  pr::par::Runtime rt(pr::par::RuntimeOptions{group.ranks() * 2, "demand", {}, true, &group.transport()});
+  rt.runStage("breaks", pr::par::TaskSet::uniform(64), [&](pr::par::Pe& pe, pr::par::TaskId) {
+    if (pe.id() == failingPe) throw std::runtime_error("an injected task failure");
+    std::this_thread::sleep_for(std::chrono::microseconds(500));
+  });
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -56,8 +118,12 @@ int main(int argc, char** argv) {
   std::string error;
   try {
     if (mode == "exchange") exchange(group);
+    if (mode == "stages") stages(group, target);
+    if (mode == "stagefail") stageFail(group, target);
     if (mode == "fail" && group.rank() == target) throw std::runtime_error("an injected failure");
     if (mode == "hang" && group.rank() == target) std::this_thread::sleep_for(std::chrono::seconds(60));
+  } catch (const pr::par::FailedElsewhere&) {
+    status = 1;  // the rank where it failed reports it
   } catch (const std::exception& e) {
     status = 1;
     error = e.what();

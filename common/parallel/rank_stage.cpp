@@ -1,0 +1,288 @@
+// A stage across ranks: the part of the runtime that exists only when the PEs live in more
+// than one process (RuntimeOptions::transport with R > 1). Every rank's controlling thread runs
+// the same stages (SPMD); during a stage it is its rank's communication thread: it receives
+// what other ranks send (data messages for its PEs, the system controller's task answers),
+// and takes part in deciding when the stage is over.
+//
+// When is a stage over? When no PE on any rank has work and no message is in flight. Each rank
+// knows only its own part: whether it is passive (OutstandingWork at zero: its PEs have no task
+// left, no set-up running and no message waiting to be handled) and how many data messages it
+// sent to and received from other ranks in this stage. Rank 0 runs waves (Mattern's
+// four-counter method, 1987): it asks every rank for its two counts, which a rank answers only
+// while passive; when two consecutive waves find the same totals and sent equals received,
+// every message sent had been received by the start of the second wave and every rank was
+// passive after receiving it, so no work is left anywhere and none can appear. A passive rank
+// becomes active again only by receiving a message, which the second wave would have counted.
+//
+// Scheduling: a strategy that decides each PE's tasks from reset()'s inputs alone (a static
+// portion) runs on every rank for that rank's PEs; any other is held by the system controller
+// on rank 0, and a PE on another rank asks it for work with a request message (carrying the
+// tasks it finished since it last asked) and waits for the answer, handling its messages.
+//
+// A failure: the rank whose PE failed tells every other rank, each stops its PEs and rethrows
+// the failure's text; the runtime is spent (a later stage throws), and the process group's
+// ending (process_group.h) reports it once.
+#include <chrono>
+#include <cstring>
+#include <stdexcept>
+#include <thread>
+
+#include "common/parallel/process_group.h"
+#include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+namespace {
+
+// Every message of the runtime between ranks goes under one tag with this header in front.
+constexpr int kRuntimeTag = ProcessGroup::kFirstUserTag;
+
+enum FrameType : std::uint32_t { kData = 1, kProbe, kReply, kEnd, kAbort, kTaskRequest, kTaskAnswer };
+
+struct Frame {
+  std::uint32_t type = 0;
+  std::int32_t stage = 0;
+  std::int32_t from = -1;     // data: the sending PE; task request: the asking PE; probe/reply: the wave
+  std::int32_t to = -1;       // data, task answer: the receiving PE
+  std::uint32_t channel = 0;  // data: the channel's id
+  std::uint32_t reserved = 0;
+  std::uint64_t counted = 0;  // data: the bytes the sender booked
+};
+static_assert(sizeof(Frame) == Runtime::kFrameBytes);
+
+void writeFrame(Bytes& framed, const Frame& f) { std::memcpy(framed.data(), &f, sizeof f); }
+
+// The sent and received totals a rank reports for a wave.
+struct WaveCounts {
+  std::uint64_t sent = 0, received = 0;
+};
+
+// A task answer: the Grab's figures, then its task ids.
+struct AnswerHead {
+  std::int32_t from, requests, packets, blocking;
+  std::uint64_t moved;
+};
+
+}  // namespace
+
+void Runtime::sendToRank(const ChannelBase& channel, int from, int to, Bytes framed, std::size_t counted) {
+  Frame f;
+  f.type = kData;
+  f.stage = static_cast<std::int32_t>(record_.stages.size());
+  f.from = from;
+  f.to = to;
+  f.channel = channel.id();
+  f.counted = counted;
+  writeFrame(framed, f);
+  // Counted before it can arrive, so the four counters never see it received and not sent.
+  rankStage_.sent.fetch_add(1, std::memory_order_acq_rel);
+  options_.transport->send(rankOf(to), kRuntimeTag, std::move(framed));
+}
+
+void Runtime::sendControl(int to, std::uint32_t type, int stage, int a, Bytes payload) {
+  Bytes framed(kFrameBytes + payload.size());
+  Frame f;
+  f.type = type;
+  f.stage = stage;
+  f.from = a;
+  f.to = a;
+  writeFrame(framed, f);
+  if (!payload.empty()) std::memcpy(framed.data() + kFrameBytes, payload.data(), payload.size());
+  options_.transport->send(to, kRuntimeTag, std::move(framed));
+}
+
+// A PE's next tasks: from the strategy here, or, on a rank other than 0 for a strategy the
+// controller holds, by asking rank 0 and waiting for its answer (handling messages meanwhile).
+void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
+                        std::vector<TaskReport>& reports) {
+  if (!askController) {
+    scheduler.next(pe.id(), now(), grab);
+    return;
+  }
+  Bytes request(reports.size() * sizeof(TaskReport));
+  if (!reports.empty()) std::memcpy(request.data(), reports.data(), request.size());
+  sendControl(0, kTaskRequest, pe.stage(), pe.id(), std::move(request));
+  reports.clear();
+  std::optional<Grab>& answer = rankStage_.answers[static_cast<std::size_t>(pe.id() - firstLocalPe())];
+  for (;;) {
+    {
+      std::lock_guard lock(rankStage_.answerMutex);
+      if (answer) {
+        grab = std::move(*answer);
+        answer.reset();
+        return;
+      }
+    }
+    if (abort_.load(std::memory_order_acquire)) {
+      grab.clear();
+      return;
+    }
+    if (!handleMessages(pe, spans)) waitForWork(pe.id());
+  }
+}
+
+void Runtime::driveRankStage(int stage) {
+  Transport& transport = *options_.transport;
+  RankStage& rs = rankStage_;
+  // Rank 0's wave, and the others' unanswered probe.
+  std::int32_t wave = 0, probe = -1;
+  bool waveOpen = false, havePrevious = false;
+  int replies = 0;
+  WaveCounts totals, previous;
+
+  const auto reply = [&](std::int32_t w) {
+    const WaveCounts mine{rs.sent.load(std::memory_order_acquire), rs.received.load(std::memory_order_acquire)};
+    Bytes payload(sizeof mine);
+    std::memcpy(payload.data(), &mine, sizeof mine);
+    sendControl(0, kReply, stage, w, std::move(payload));
+  };
+  const auto handle = [&](Envelope& e) {
+    if (e.bytes.size() < kFrameBytes) throw std::runtime_error("a runtime message from rank " + std::to_string(e.source) + " is shorter than its header");
+    Frame f;
+    std::memcpy(&f, e.bytes.data(), sizeof f);
+    if (f.stage > stage) {  // a rank already in a later stage: kept until this rank gets there
+      rs.early.push_back(std::move(e));
+      return;
+    }
+    if (f.stage < stage) return;  // what a failed stage left behind
+    const std::span<const std::byte> payload(e.bytes.data() + kFrameBytes, e.bytes.size() - kFrameBytes);
+    switch (f.type) {
+      case kData: {
+        ChannelBase* channel = f.channel < channelsById_.size() ? channelsById_[f.channel] : nullptr;
+        PR_CHECK(channel != nullptr && isLocal(f.to), "a data message for a channel or PE this rank does not have");
+        channel->deliver(f.from, f.to, payload, f.counted);
+        rs.received.fetch_add(1, std::memory_order_acq_rel);  // after its work was counted
+        break;
+      }
+      case kProbe: probe = f.from; break;
+      case kReply:
+        if (f.from == wave) {
+          WaveCounts c;
+          std::memcpy(&c, payload.data(), sizeof c);
+          totals.sent += c.sent;
+          totals.received += c.received;
+          ++replies;
+        }
+        break;
+      case kEnd:
+        rs.over.store(true, std::memory_order_release);
+        ringAll();
+        break;
+      case kAbort: {
+        std::lock_guard lock(errorMutex_);
+        if (!error_) {
+          record_.error = std::string(reinterpret_cast<const char*>(payload.data()), payload.size());
+          error_ = std::make_exception_ptr(FailedElsewhere(record_.error));
+        }
+        abort_.store(true, std::memory_order_release);
+        ringAll();
+        break;
+      }
+      case kTaskRequest: {
+        Scheduler& scheduler = *job_.scheduler;
+        for (std::size_t at = 0; at + sizeof(TaskReport) <= payload.size(); at += sizeof(TaskReport)) {
+          TaskReport r;
+          std::memcpy(&r, payload.data() + at, sizeof r);
+          scheduler.finished(f.from, r.task, r.seconds);
+        }
+        Grab grab;
+        scheduler.next(f.from, now(), grab);
+        const AnswerHead head{grab.from, grab.requests, grab.packets, grab.blocking ? 1 : 0, grab.moved};
+        Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
+        std::memcpy(answer.data(), &head, sizeof head);
+        if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
+        sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+        break;
+      }
+      case kTaskAnswer: {
+        PR_CHECK(isLocal(f.to) && payload.size() >= sizeof(AnswerHead), "a task answer for a PE this rank does not have");
+        AnswerHead head;
+        std::memcpy(&head, payload.data(), sizeof head);
+        Grab grab;
+        grab.from = head.from;
+        grab.requests = head.requests;
+        grab.packets = head.packets;
+        grab.blocking = head.blocking != 0;
+        grab.moved = head.moved;
+        grab.tasks.resize((payload.size() - sizeof head) / sizeof(TaskId));
+        if (!grab.tasks.empty()) std::memcpy(grab.tasks.data(), payload.data() + sizeof head, grab.tasks.size() * sizeof(TaskId));
+        {
+          std::lock_guard lock(rs.answerMutex);
+          rs.answers[static_cast<std::size_t>(f.to - firstLocalPe())] = std::move(grab);
+        }
+        ring(f.to);
+        break;
+      }
+      default: throw std::runtime_error("a runtime message of unknown type " + std::to_string(f.type) + " from rank " + std::to_string(e.source));
+    }
+  };
+
+  std::vector<Envelope> early = std::move(rs.early);
+  rs.early.clear();
+  for (Envelope& e : early) handle(e);
+
+  int idle = 0;
+  while (!rs.over.load(std::memory_order_acquire) && !abort_.load(std::memory_order_acquire)) {
+    bool progressed = false;
+    while (std::optional<Envelope> e = transport.poll(kRuntimeTag)) {
+      handle(*e);
+      progressed = true;
+    }
+    const bool passive = outstanding_.finished();
+    if (rank_ == 0) {
+      if (!waveOpen && passive) {
+        ++wave;
+        totals = {rs.sent.load(std::memory_order_acquire), rs.received.load(std::memory_order_acquire)};
+        replies = 0;
+        waveOpen = true;
+        for (int r = 1; r < ranks_; ++r) sendControl(r, kProbe, stage, wave);
+        progressed = true;
+      }
+      if (waveOpen && replies == ranks_ - 1) {
+        waveOpen = false;
+        if (havePrevious && totals.sent == totals.received && totals.sent == previous.sent &&
+            totals.received == previous.received) {
+          for (int r = 1; r < ranks_; ++r) sendControl(r, kEnd, stage, 0);
+          rs.over.store(true, std::memory_order_release);
+          ringAll();
+        }
+        previous = totals;
+        havePrevious = true;
+        progressed = true;
+      }
+    } else if (probe >= 0 && passive) {
+      reply(probe);
+      probe = -1;
+      progressed = true;
+    }
+    // Debian's Open MPI moves messages only inside MPI calls (no asynchronous progress), so
+    // this thread polls; it backs off to short sleeps when nothing happens, to leave the cores
+    // to the PEs.
+    if (progressed) {
+      idle = 0;
+    } else if (++idle < 64) {
+      std::this_thread::yield();
+    } else {
+      std::this_thread::sleep_for(std::chrono::microseconds(idle < 1024 ? 5 : 50));
+    }
+  }
+
+  bool announce = false;
+  std::string text;
+  {
+    std::lock_guard lock(errorMutex_);
+    announce = rs.failedHere && !rs.announced;
+    rs.announced = rs.announced || announce;
+    text = record_.error;
+  }
+  if (announce) {
+    Bytes payload(text.size());
+    std::memcpy(payload.data(), text.data(), text.size());
+    for (int r = 0; r < ranks_; ++r)
+      if (r != rank_) sendControl(r, kAbort, stage, 0, payload);
+  }
+  if (abort_.load(std::memory_order_acquire)) rs.spent = true;
+}
+
+}  // namespace pr::par

@@ -1,0 +1,135 @@
+// One run record from R ranks: every rank measured its own PEs (their busy and idle time,
+// messages sent and received, spans, counters); Runtime::gatherRecord brings those parts to
+// rank 0 and sets them in its record, so the record of a run across ranks reads like a record
+// of one process with P = R x T PEs.
+//
+// One clock: each rank's times count from its own runtime's start on its own steady clock.
+// Rank 0 estimates every other rank's offset by a few ping-pongs (Cristian's method: the
+// answer with the shortest round trip, its time taken as half-way) and moves that rank's
+// spans onto its own clock, so the timeline and the Gantt chart line up. Two steady clocks
+// differ by a constant offset (bar a drift far below a span's length over a run), so measuring
+// it where the ranks meet at the end costs no extra synchronisation at the start.
+#include <algorithm>
+#include <chrono>
+#include <cstring>
+#include <limits>
+#include <stdexcept>
+#include <thread>
+
+#include "common/parallel/process_group.h"
+#include "common/parallel/runtime.h"
+
+namespace pr::par {
+namespace {
+
+constexpr int kRecordTag = ProcessGroup::kFirstUserTag + 1;
+constexpr int kClockTag = ProcessGroup::kFirstUserTag + 2;
+constexpr int kClockRounds = 8;
+
+// A message with `tag` from rank `from`, waiting at most `seconds` (polling, then sleeping).
+Envelope awaitFrom(Transport& transport, int tag, double seconds, const char* what) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(seconds);
+  for (int tries = 0;; ++tries) {
+    if (std::optional<Envelope> e = transport.poll(tag)) return std::move(*e);
+    if (std::chrono::steady_clock::now() > deadline)
+      throw std::runtime_error(std::string("no answer from another rank within the time allowed while waiting for ") + what);
+    if (tries < 4096)
+      std::this_thread::yield();
+    else
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+  }
+}
+
+Bytes bytesOf(double v) {
+  Bytes b(sizeof v);
+  std::memcpy(b.data(), &v, sizeof v);
+  return b;
+}
+
+double doubleOf(const Envelope& e) {
+  if (e.bytes.size() != sizeof(double)) throw std::runtime_error("a clock reading of the wrong size");
+  double v;
+  std::memcpy(&v, e.bytes.data(), sizeof v);
+  return v;
+}
+
+// Sets the part of `part` that rank `rank` measured (PEs [first, first + count)) into `into`,
+// with its times moved by `offset` seconds onto into's clock.
+void mergeRankPart(RunRecord& into, const RunRecord& part, int first, int count, double offset) {
+  if (part.stages.size() != into.stages.size())
+    throw std::runtime_error("a rank ran " + std::to_string(part.stages.size()) + " stages, rank 0 " +
+                             std::to_string(into.stages.size()));
+  const auto mine = [&](int pe) { return pe >= first && pe < first + count; };
+  for (std::size_t s = 0; s < into.stages.size(); ++s) {
+    StageRecord& to = into.stages[s];
+    const StageRecord& from = part.stages[s];
+    for (int p = first; p < first + count; ++p) to.pes[static_cast<std::size_t>(p)] = from.pes[static_cast<std::size_t>(p)];
+    for (const Traffic& t : from.traffic)
+      if (mine(t.from)) to.traffic.push_back(t);
+    for (const ChannelTraffic& c : from.channels) {
+      auto it = std::find_if(to.channels.begin(), to.channels.end(), [&](const ChannelTraffic& x) { return x.name == c.name; });
+      if (it == to.channels.end()) {
+        to.channels.push_back(c);
+      } else {
+        it->messages += c.messages;
+        it->bytes += c.bytes;
+      }
+    }
+  }
+  for (TaskSpan span : part.timeline)
+    if (mine(span.pe)) {
+      span.start += offset;
+      span.end += offset;
+      into.timeline.push_back(span);
+    }
+  for (const CounterRecord& c : part.counters) {
+    auto it = std::find_if(into.counters.begin(), into.counters.end(), [&](const CounterRecord& x) { return x.name == c.name; });
+    if (it == into.counters.end())
+      it = into.counters.insert(into.counters.end(), CounterRecord{c.name, std::vector<double>(c.perPe.size(), 0.0)});
+    for (int p = first; p < first + count; ++p) it->perPe[static_cast<std::size_t>(p)] += c.perPe[static_cast<std::size_t>(p)];
+  }
+}
+
+}  // namespace
+
+RunRecord Runtime::gatherRecord(double timeoutSeconds) {
+  PR_CHECK(!inStage_, "gatherRecord is called between stages");
+  if (ranks_ == 1) return record_;
+  Transport& transport = *options_.transport;
+  if (rank_ != 0) {
+    // The clock: answer rank 0's pings with this rank's time.
+    for (int round = 0; round < kClockRounds; ++round) {
+      awaitFrom(transport, kClockTag, timeoutSeconds, "rank 0's clock reading");
+      transport.send(0, kClockTag, bytesOf(now()));
+    }
+    const std::string text = toJsonText(record_);
+    Bytes b(text.size());
+    std::memcpy(b.data(), text.data(), text.size());
+    transport.send(0, kRecordTag, std::move(b));
+    return record_;
+  }
+  RunRecord merged = record_;
+  std::vector<double> offsets(static_cast<std::size_t>(ranks_), 0.0);
+  for (int r = 1; r < ranks_; ++r) {
+    double best = std::numeric_limits<double>::infinity();
+    for (int round = 0; round < kClockRounds; ++round) {
+      const double sent = now();
+      transport.send(r, kClockTag, {});
+      const double theirs = doubleOf(awaitFrom(transport, kClockTag, timeoutSeconds, "a rank's clock reading"));
+      const double back = now();
+      if (back - sent < best) {
+        best = back - sent;
+        offsets[static_cast<std::size_t>(r)] = (sent + back) / 2.0 - theirs;
+      }
+    }
+  }
+  for (int got = 1; got < ranks_; ++got) {
+    const Envelope e = awaitFrom(transport, kRecordTag, timeoutSeconds, "a rank's run record");
+    const RunRecord part = runRecordFromJsonText(std::string(reinterpret_cast<const char*>(e.bytes.data()), e.bytes.size()),
+                                                 "the run record of rank " + std::to_string(e.source));
+    mergeRankPart(merged, part, e.source * localPes_, localPes_, offsets[static_cast<std::size_t>(e.source)]);
+  }
+  return merged;
+}
+
+}  // namespace pr::par

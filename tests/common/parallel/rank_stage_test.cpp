@@ -1,0 +1,188 @@
+// Stages across ranks (rank_stage.cpp), on R ranks inside this process (in_process_ranks.h):
+// every task runs once under every strategy, a message-driven stage ends only when chains of
+// messages that cross ranks are done, messages between ranks are counted as their encoding on
+// both sides, and a failure on one rank ends the stage on every rank with its text.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <atomic>
+#include <chrono>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "common/parallel/channel.h"
+#include "tests/common/parallel/in_process_ranks.h"
+
+using namespace pr::par;
+using pr::test::runOnRanks;
+
+TEST_CASE("RankStage: every task runs once, on a PE of the rank that ran it, under every strategy") {
+  constexpr int kTasks = 97;
+  for (const auto& entry : schedules()) {
+    for (const auto [ranks, threads] : {std::array{2, 1}, std::array{2, 2}, std::array{3, 2}}) {
+      CAPTURE(entry.name);
+      CAPTURE(ranks);
+      CAPTURE(threads);
+      std::vector<std::atomic<int>> runs(kTasks);
+      std::atomic<int> foreign{0};
+      std::vector<double> costs(kTasks);
+      for (int t = 0; t < kTasks; ++t) costs[static_cast<std::size_t>(t)] = 1.0 + t % 7;
+      const auto errors = runOnRanks(ranks, threads, entry.name, [&](Runtime& rt) {
+        for (int stage = 0; stage < 3; ++stage)
+          rt.runStage("tasks", TaskSet::fromCosts(costs), [&](Pe& pe, TaskId t) {
+            runs[static_cast<std::size_t>(t)].fetch_add(1);
+            if (!rt.isLocal(pe.id())) foreign.fetch_add(1);
+          });
+      }, 2);
+      for (const std::string& e : errors) CHECK(e == "");
+      for (int t = 0; t < kTasks; ++t) CHECK(runs[static_cast<std::size_t>(t)].load() == 3);
+      CHECK(foreign.load() == 0);
+    }
+  }
+}
+
+namespace {
+
+struct Hop {
+  std::int32_t left;   // hops still to make
+  std::int32_t chain;  // which chain, for the sum below
+};
+
+}  // namespace
+
+TEST_CASE("RankStage: a stage ends only when chains of messages across ranks are all handled") {
+  constexpr int kChains = 24, kLength = 40;
+  for (const auto [ranks, threads] : {std::array{2, 1}, std::array{3, 1}, std::array{4, 2}}) {
+    CAPTURE(ranks);
+    CAPTURE(threads);
+    std::atomic<long> handled{0};
+    std::vector<long> seenAtEnd(static_cast<std::size_t>(ranks), -1);
+    const auto errors = runOnRanks(ranks, threads, "demand", [&](Runtime& rt) {
+      const int pes = rt.pes();
+      for (int round = 0; round < 2; ++round) {
+        // A new channel per round, made in the same order on every rank: round 1's first hops may
+        // reach a rank still ending round 0.
+        Channel<Hop> hops(rt, "hops", MessageKind::Rays, [&](Pe& pe, Hop&& h) {
+          handled.fetch_add(1);
+          if (h.chain % 5 == 0) std::this_thread::sleep_for(std::chrono::microseconds(50));
+          if (h.left > 0) hops.send(pe, (pe.id() + 1 + h.chain) % pes, Hop{h.left - 1, h.chain});
+        });
+        rt.runStage("chains", TaskSet::uniform(kChains), [&](Pe& pe, TaskId t) {
+          hops.send(pe, (pe.id() + 1) % pes, Hop{kLength, static_cast<std::int32_t>(t)});
+        });
+        if (round == 0) seenAtEnd[static_cast<std::size_t>(rt.rank())] = handled.load();
+      }
+    });
+    for (const std::string& e : errors) CHECK(e == "");
+    // Every rank left round 0 after all of its chains (kLength + 1 messages each) were handled;
+    // round 1's could have started on a faster rank, so the figure is at least that.
+    for (long seen : seenAtEnd) CHECK(seen >= long(kChains) * (kLength + 1));
+    CHECK(handled.load() == 2L * kChains * (kLength + 1));
+  }
+}
+
+TEST_CASE("RankStage: a message to another rank is counted as its encoding by the sender and the receiver") {
+  std::vector<std::vector<int>> drained(4);
+  std::vector<RunRecord> records(2);
+  const auto errors = runOnRanks(2, 2, "balanced", [&](Runtime& rt) {
+    Channel<std::vector<int>> results(rt, "results", MessageKind::Results);
+    // PE p sends PE (p + 2) mod 4, on the other rank, p + 1 ints.
+    rt.runStage("send", TaskSet::uniform(4), [&](Pe& pe, TaskId) {
+      results.send(pe, (pe.id() + 2) % 4, std::vector<int>(static_cast<std::size_t>(pe.id() + 1), pe.id()));
+    });
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p)
+      for (const std::vector<int>& m : results.drain(p)) drained[static_cast<std::size_t>(p)] = m;
+    records[static_cast<std::size_t>(rt.rank())] = rt.record();
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  for (int p = 0; p < 4; ++p) {
+    const int sender = (p + 2) % 4;
+    CHECK(drained[static_cast<std::size_t>(p)] == std::vector<int>(static_cast<std::size_t>(sender + 1), sender));
+    const PeStageRecord& mine = records[static_cast<std::size_t>(p / 2)].stages[0].pes[static_cast<std::size_t>(p)];
+    CHECK(mine.messagesSent == 1);
+    CHECK(mine.bytesSent == 4u * (p + 1));
+    CHECK(mine.messagesReceived == 1);
+    CHECK(mine.bytesReceived == 4u * (sender + 1));
+  }
+}
+
+TEST_CASE("RankStage: a task that fails on one rank ends the stage on every rank with its text") {
+  for (const char* schedule : {"demand", "balanced"}) {
+    CAPTURE(schedule);
+    std::atomic<int> later{0};
+    const auto errors = runOnRanks(3, 2, schedule, [&](Runtime& rt) {
+      Channel<int> pings(rt, "pings", MessageKind::Requests, [&](Pe&, int&&) {});
+      rt.runStage("fine", TaskSet::uniform(12), [&](Pe& pe, TaskId) { pings.send(pe, (pe.id() + 3) % 6, 1); });
+      try {
+        rt.runStage("breaks", TaskSet::uniform(60), [&](Pe& pe, TaskId t) {
+          if (pe.id() == 3 && t >= 0) throw std::runtime_error("task broke");
+          pings.send(pe, (pe.id() + 2) % 6, 1);
+          std::this_thread::sleep_for(std::chrono::microseconds(200));
+        });
+      } catch (...) {
+        CHECK_THROWS_WITH(rt.runStage("after", TaskSet::uniform(1), [&](Pe&, TaskId) { later.fetch_add(1); }),
+                          doctest::Contains("stopped after a failure"));
+        throw;
+      }
+    });
+    // The failing rank rethrows the failure unchanged (as on one rank); the others get its
+    // record's text, naming stage, PE and task.
+    CHECK(errors[1] == "task broke");
+    for (int r : {0, 2}) {
+      CAPTURE(errors[static_cast<std::size_t>(r)]);
+      CHECK(errors[static_cast<std::size_t>(r)].find("stage 'breaks', PE 3, task") != std::string::npos);
+      CHECK(errors[static_cast<std::size_t>(r)].find("task broke") != std::string::npos);
+    }
+    CHECK(later.load() == 0);
+  }
+}
+
+TEST_CASE("RankStage: the gathered record on rank 0 holds every rank's PEs, their messages and spans") {
+  constexpr int kChains = 12, kLength = 9;
+  RunRecord merged;
+  std::vector<std::uint64_t> tasksOnRank(3, 0);
+  const auto errors = runOnRanks(3, 2, "demand", [&](Runtime& rt) {
+    Channel<Hop> hops(rt, "hops", MessageKind::Rays, [&](Pe& pe, Hop&& h) {
+      if (h.left > 0) hops.send(pe, (pe.id() + 1) % rt.pes(), Hop{h.left - 1, h.chain});
+    });
+    rt.runStage("chains", TaskSet::uniform(kChains), [&](Pe& pe, TaskId t) {
+      hops.send(pe, (pe.id() + 1) % rt.pes(), Hop{kLength, static_cast<std::int32_t>(t)});
+    });
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p)
+      tasksOnRank[static_cast<std::size_t>(rt.rank())] += rt.record().stages[0].pes[static_cast<std::size_t>(p)].tasks;
+    RunRecord r = rt.gatherRecord();
+    if (rt.rank() == 0) merged = std::move(r);
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  REQUIRE(merged.stages.size() == 1);
+  const StageRecord& s = merged.stages[0];
+  REQUIRE(s.pes.size() == 6);
+  std::uint64_t tasks = 0, sent = 0, received = 0, handled = 0, trafficMessages = 0;
+  for (const PeStageRecord& pe : s.pes) {
+    tasks += pe.tasks;
+    sent += pe.messagesSent;
+    received += pe.messagesReceived;
+    handled += pe.messagesHandled;
+  }
+  for (const Traffic& t : s.traffic) trafficMessages += t.messages;
+  // Every hop goes to the next PE: each of the kChains x (kLength + 1) messages is between two PEs.
+  const std::uint64_t messages = kChains * (kLength + 1);
+  CHECK(tasks == kChains);
+  CHECK(tasks == tasksOnRank[0] + tasksOnRank[1] + tasksOnRank[2]);
+  CHECK(sent == messages);
+  CHECK(received == messages);
+  CHECK(handled == messages);
+  CHECK(trafficMessages == messages);
+  REQUIRE(s.channels.size() == 1);
+  CHECK(s.channels[0].messages == messages);
+  CHECK(s.channels[0].bytes == messages * sizeof(Hop));
+  // Spans of every PE, on rank 0's clock: inside the stage, give or take the clock estimate.
+  std::vector<int> spans(6, 0);
+  for (const TaskSpan& span : merged.timeline) {
+    ++spans[static_cast<std::size_t>(span.pe)];
+    CHECK(span.start >= s.startSeconds - 0.05);
+    CHECK(span.end <= s.startSeconds + s.wallSeconds + 0.05);
+  }
+  for (int p = 0; p < 6; ++p) CHECK(spans[static_cast<std::size_t>(p)] > 0);
+}
