@@ -206,7 +206,10 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--images", a->images, "folder for each row's image (PNG) and its x8 difference from the reference");
   cmd->add_flag("--quiet", a->quiet, "no progress lines");
   addLightingOptions(*cmd, a->lighting);
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] {
+    requireOneRank("compare");
+    run(*a);
+  });
 }
 
 }  // namespace pr::cli

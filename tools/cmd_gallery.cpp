@@ -193,7 +193,10 @@ void addGalleryCommand(CLI::App& app) {
   addLightingOptions(*cmd, a->lighting);
   // The sky shows shapes, normal maps and metals as the screenshots do; --env FILE overrides.
   a->lighting.env = "sky";
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] {
+    requireOneRank("gallery");
+    run(*a);
+  });
 }
 
 }  // namespace pr::cli

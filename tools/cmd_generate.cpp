@@ -79,7 +79,10 @@ void addGenerateCommand(CLI::App& app) {
   cmd->add_option("-o,--output", options->output, "output file, .gltf (embedded buffer) or .glb (binary)")->required();
   options->sizeOption = cmd->add_option("--size", options->size, "scene detail; meaning and range per scene below");
   options->seedOption = cmd->add_option("--seed", options->seed, "random seed (landscape, hotspot)");
-  cmd->callback([options] { runGenerate(*options); });
+  cmd->callback([options] {
+    requireOneRank("generate");
+    runGenerate(*options);
+  });
 }
 
 }  // namespace pr::cli

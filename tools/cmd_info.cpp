@@ -163,7 +163,10 @@ void addInfoCommand(CLI::App& app) {
                   "camera to report: an index or a name from the file, or \"auto\" for the framing camera "
                   "(default: the file's first camera, else auto)");
   addLightingOptions(*cmd, options->lighting);
-  cmd->callback([options] { runInfo(*options); });
+  cmd->callback([options] {
+    requireOneRank("info");
+    runInfo(*options);
+  });
 }
 
 }  // namespace pr::cli

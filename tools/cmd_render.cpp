@@ -16,6 +16,7 @@
 #include "common/image/codec_loader.h"
 #include "common/image/image_io.h"
 #include "common/parallel/metrics.h"
+#include "common/parallel/process_group.h"
 #include "common/parallel/run_options.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
@@ -88,39 +89,58 @@ std::string defaultOutput(const std::string& scene, const std::string& method) {
   return std::filesystem::path(scene).stem().string() + "_" + method + ".png";
 }
 
+// Under mpirun: the method and integrator must run across ranks (the others say so, exit 2).
+void checkAcrossRanks(const RenderMethod& method, const RenderArgs& a, int ranks) {
+  if (ranks == 1) return;
+  if (!runsAcrossRanks(method))
+    throw InputError("method " + method.name + " does not run across processes yet (launched as " + std::to_string(ranks) +
+                     " ranks by mpirun; methods that do: " + methodsAcrossRanks() + "); run it without mpirun, with --threads P");
+  if (a.settings.ray.integrator == "photonmap")
+    throw InputError("--integrator photonmap does not run across processes yet (launched as " + std::to_string(ranks) +
+                     " ranks by mpirun); run it without mpirun, with --threads P");
+}
+
 void run(RenderArgs& a) {
   const RenderMethod& method = findRenderMethod(a.method);
   checkFamilyOptions(method, a.family);
+  // Under mpirun, --threads is each rank's: P = R x T PEs, and rank 0 writes and prints.
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  checkAcrossRanks(method, a, group.ranks());
+  const bool writes = group.rank() == 0;
+  const int pes = group.ranks() * a.threads;
   checkRenderMemory(method, a.width, a.height, a.threads, samplesPerPixel(a.settings.ray));
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
   if (a.output.empty()) a.output = defaultOutput(a.scene, a.method);
   const std::string ext = std::filesystem::path(a.output).extension().string();
   if (ext != ".png" && ext != ".exr")
     throw InputError("output " + a.output + ": unsupported extension '" + ext + "' (expected .png or .exr)");
-  image::preloadImageCodec();  // opened while the scene loads
+  if (writes) image::preloadImageCodec();  // opened while the scene loads
 
   scene::Scene scene = loadScene(a.scene, a.lighting);
   // Loaded by now, or nearly: a missing codec fails before the render, and its loading never
   // runs beside the timed stages.
-  image::imageCodec();
+  if (writes) image::imageCodec();
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
 
-  par::Runtime runtime(par::RuntimeOptions{a.threads, a.schedule.schedule, a.schedule.params, true});
-  ProgressBar bar(!a.quiet && isatty(STDERR_FILENO));
+  par::Runtime runtime(par::RuntimeOptions{pes, a.schedule.schedule, a.schedule.params, true,
+                                           group.ranks() > 1 ? &group.transport() : nullptr});
+  ProgressBar bar(writes && !a.quiet && isatty(STDERR_FILENO));
   const RenderRequest request{scene, camera, a.width, a.height, a.settings, plan, runtime,
                               [&bar](int64_t done, int64_t total) { bar.update(done, total); }};
   RenderOutcome outcome = method.make(method.name, request);
   bar.finish();
+  if (!writes) return;
 
   image::writeImage(a.output, outcome.image);
   par::writeRunOutputs(runtime.record(), a.outputs);
 
   const par::RunSummary summary = par::summarize(runtime.record());
   const double wall = summary.wallSeconds;
-  std::printf("method %s (%s), P %d, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
-              a.threads, a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+  const std::string ranks = group.ranks() > 1 ? " (" + std::to_string(group.ranks()) + " ranks x " + std::to_string(a.threads) + " PEs)" : "";
+  std::printf("method %s (%s), P %d%s, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
+              pes, ranks.c_str(), a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
   std::printf("%s\n", lighting.c_str());
   std::printf("effects:\n");
   for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());
@@ -158,7 +178,7 @@ void addRenderCommand(CLI::App& app) {
   cmd->add_option("--width", args->width, "image width in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--height", args->height, "image height in pixels")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--camera", args->camera, "camera: index, name, or 'auto' (default: the file's first)");
-  cmd->add_option("--threads", args->threads, "P, the number of PEs")->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_option("--threads", args->threads, "P, the number of PEs (under mpirun: PEs per rank, P = ranks x threads)")->check(CLI::Range(1, 4096))->capture_default_str();
   cmd->add_flag("--quiet", args->quiet, "no progress bar");
   std::string effectNames;
   for (scene::Effect e : scene::allEffects()) effectNames += (effectNames.empty() ? "" : ", ") + std::string(scene::toString(e));

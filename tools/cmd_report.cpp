@@ -219,7 +219,10 @@ void addReportCommand(CLI::App& app) {
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
   addLightingOptions(*cmd, s.lighting);
-  cmd->callback([a] { run(*a); });
+  cmd->callback([a] {
+    requireOneRank("report");
+    run(*a);
+  });
 }
 
 }  // namespace pr::cli

@@ -186,6 +186,7 @@ void addSimulateCommand(CLI::App& app) {
       ->capture_default_str();
   par::addScheduleOptions(*cmd, args->schedule);
   cmd->callback([args, cmd] {
+    requireOneRank("simulate");
     args->scheduleGiven = cmd->count("--schedule") > 0;
     runSimulate(*args);
   });

@@ -138,6 +138,7 @@ void addSweepCommand(CLI::App& app) {
   par::addScheduleOptions(*cmd, a->schedule);
   addLightingOptions(*cmd, a->lighting);
   cmd->callback([a, pathSpp] {
+    requireOneRank("sweep");
     a->pathSppGiven = pathSpp->count() > 0;
     run(*a);
   });

@@ -2,6 +2,8 @@
 // its options, its --help text and the callback that runs it. main.cpp calls them all.
 #pragma once
 
+#include <string_view>
+
 #include <CLI/CLI.hpp>
 
 namespace pr::cli {
@@ -15,5 +17,9 @@ void addRenderCommand(CLI::App& app);
 void addReportCommand(CLI::App& app);
 void addSimulateCommand(CLI::App& app);
 void addSweepCommand(CLI::App& app);
+
+// Under mpirun with more than one rank, throws pr::InputError for a command that does not run
+// across processes, saying what does (main.cpp). Called first by every such command.
+void requireOneRank(std::string_view command);
 
 }  // namespace pr::cli

@@ -13,6 +13,19 @@
 #include "common/util/interrupt.h"
 #include "common/util/memory_limit.h"
 #include "tools/commands.h"
+#include "tools/render_methods.h"
+
+namespace pr::cli {
+
+void requireOneRank(std::string_view command) {
+  const int ranks = par::ProcessGroup::get().ranks();
+  if (ranks > 1)
+    throw InputError("launched as " + std::to_string(ranks) + " ranks by mpirun, but '" + std::string(command) +
+                     "' does not run across processes: under mpirun, 'render' runs across ranks (methods: " +
+                     methodsAcrossRanks() + "); run " + std::string(command) + " without mpirun, with --threads P");
+}
+
+}  // namespace pr::cli
 
 int main(int argc, char** argv) {
   pr::retainFreedMemory();
@@ -64,10 +77,6 @@ int main(int argc, char** argv) {
   std::string error;
   try {
     group->checkSameCommandLine(argc, argv);
-    if (group->ranks() > 1)
-      throw pr::InputError("launched as " + std::to_string(group->ranks()) +
-                           " ranks by mpirun, but parrender's methods do not run across processes yet: its runtime "
-                           "runs P PEs as threads of one process (run it without mpirun, with --threads P)");
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);

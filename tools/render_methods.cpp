@@ -53,6 +53,7 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   job.integrator = integrators(photonSettings).find(r.settings.ray.integrator).make(
       rt::IntegratorSetup{r.scene, r.camera, r.width, r.height, options.integrator});
   rt::TraceResult result = rt::renderRays(job, name, r.runtime);
+  r.runtime.gatherRecord();  // across ranks: rank 0's record becomes the whole run's
   RenderOutcome out;
   out.image = std::move(result.image);
   // The ray figures as the run record holds them (Rays/ counters, summed over PEs).
@@ -186,6 +187,10 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
   out.details += "; regions to the assembler " + std::to_string(resultMessages) + " messages (" +
                  std::to_string(resultBytes) + " bytes)";
   return out;
+}
+
+bool runsAcrossRanksByName(std::string_view name) {
+  return rt::isPartition(name) && rt::makePartition(name)->runsAcrossRanks();
 }
 
 RenderMethodRegistry makeMethods() {
@@ -344,6 +349,15 @@ void checkFamilyOptions(const RenderMethod& method, const FamilyOptions& family)
     if (f != method.properties.family && option->count() > 0)
       throw InputError("option " + option->get_name() + " applies to " + std::string(toString(f)) + " methods, but '" +
                        method.name + "' is a " + std::string(toString(method.properties.family)) + " method");
+}
+
+bool runsAcrossRanks(const RenderMethod& method) { return runsAcrossRanksByName(method.name); }
+
+std::string methodsAcrossRanks() {
+  std::string names;
+  for (const RenderMethod& m : renderMethods())
+    if (runsAcrossRanks(m)) names += (names.empty() ? "" : ", ") + m.name;
+  return names;
 }
 
 }  // namespace pr::cli

@@ -105,6 +105,10 @@ const RenderMethodRegistry& renderMethods();
 const RenderMethod& findRenderMethod(std::string_view name);
 // "name (family): description" lines for --help.
 std::string describeRenderMethods();
+// Whether the method runs on a runtime of several ranks (mpirun): a ray tracer whose partition
+// says so (rt::Partition::runsAcrossRanks); and the names of those that do, comma-separated.
+bool runsAcrossRanks(const RenderMethod& method);
+std::string methodsAcrossRanks();
 
 // Peak memory of a render, an upper estimate from its size alone (no scene): the frame
 // (image, framebuffer, 8-bit output), a full framebuffer per PE for sort-last, and the rays

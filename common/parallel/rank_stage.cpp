@@ -93,179 +93,216 @@ void Runtime::sendControl(int to, std::uint32_t type, int stage, int a, Bytes pa
 }
 
 // A PE's next tasks: from the strategy here, or, on a rank other than 0 for a strategy the
-// controller holds, by asking rank 0 and waiting for its answer (handling messages meanwhile).
+// controller holds, from rank 0's answer to a request. A PE asks ahead: as soon as an answer
+// brings tasks it sends its next request, so the answer travels while those tasks run (a
+// local pool of one packet, the seed's latency hiding, 3.3); only its first request, and one
+// after an empty pool, is waited for. `asked`: a request of this PE is in flight.
 void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
-                        std::vector<TaskReport>& reports) {
+                        std::vector<TaskReport>& reports, bool& asked) {
   if (!askController) {
     scheduler.next(pe.id(), now(), grab);
     return;
   }
-  Bytes request(reports.size() * sizeof(TaskReport));
-  if (!reports.empty()) std::memcpy(request.data(), reports.data(), request.size());
-  sendControl(0, kTaskRequest, pe.stage(), pe.id(), std::move(request));
-  reports.clear();
+  const auto request = [&] {
+    Bytes payload(reports.size() * sizeof(TaskReport));
+    if (!reports.empty()) std::memcpy(payload.data(), reports.data(), payload.size());
+    sendControl(0, kTaskRequest, pe.stage(), pe.id(), std::move(payload));
+    reports.clear();
+    asked = true;
+  };
+  if (!asked) request();
   std::optional<Grab>& answer = rankStage_.answers[static_cast<std::size_t>(pe.id() - firstLocalPe())];
+  int spins = 0;
   for (;;) {
     {
       std::lock_guard lock(rankStage_.answerMutex);
       if (answer) {
         grab = std::move(*answer);
         answer.reset();
-        return;
+        break;
       }
     }
     if (abort_.load(std::memory_order_acquire)) {
       grab.clear();
       return;
     }
-    if (!handleMessages(pe, spans)) waitForWork(pe.id());
+    // Pump while waiting (the answer may be in this rank's queue already), then block.
+    if (handleMessages(pe, spans) || pumpRankStage()) {
+      spins = 0;
+    } else if (++spins < 4096) {
+      std::this_thread::yield();
+    } else {
+      waitForWork(pe.id());
+    }
+  }
+  asked = false;
+  if (!grab.tasks.empty()) request();
+}
+
+// One message from another rank, under pumpMutex.
+void Runtime::handleRankMessage(Envelope& e) {
+  RankStage& rs = rankStage_;
+  const int stage = rs.stage;
+  if (e.bytes.size() < kFrameBytes) throw std::runtime_error("a runtime message from rank " + std::to_string(e.source) + " is shorter than its header");
+  Frame f;
+  std::memcpy(&f, e.bytes.data(), sizeof f);
+  if (f.stage > stage) {  // a rank already in a later stage: kept until this rank gets there
+    rs.early.push_back(std::move(e));
+    return;
+  }
+  if (f.stage < stage) return;  // what a failed stage left behind
+  const std::span<const std::byte> payload(e.bytes.data() + kFrameBytes, e.bytes.size() - kFrameBytes);
+  switch (f.type) {
+    case kData: {
+      ChannelBase* channel = f.channel < channelsById_.size() ? channelsById_[f.channel] : nullptr;
+      PR_CHECK(channel != nullptr && isLocal(f.to), "a data message for a channel or PE this rank does not have");
+      channel->deliver(f.from, f.to, payload, f.counted);
+      rs.received.fetch_add(1, std::memory_order_acq_rel);  // after its work was counted
+      break;
+    }
+    case kProbe: rs.probe = f.from; break;
+    case kReply:
+      if (f.from == rs.wave) {
+        WaveCounts c;
+        std::memcpy(&c, payload.data(), sizeof c);
+        rs.totalSent += c.sent;
+        rs.totalReceived += c.received;
+        ++rs.replies;
+      }
+      break;
+    case kEnd:
+      rs.over.store(true, std::memory_order_release);
+      ringAll();
+      break;
+    case kAbort: {
+      std::lock_guard lock(errorMutex_);
+      if (!error_) {
+        record_.error = std::string(reinterpret_cast<const char*>(payload.data()), payload.size());
+        error_ = std::make_exception_ptr(FailedElsewhere(record_.error));
+      }
+      abort_.store(true, std::memory_order_release);
+      ringAll();
+      break;
+    }
+    case kTaskRequest: {
+      Scheduler& scheduler = *job_.scheduler;
+      for (std::size_t at = 0; at + sizeof(TaskReport) <= payload.size(); at += sizeof(TaskReport)) {
+        TaskReport r;
+        std::memcpy(&r, payload.data() + at, sizeof r);
+        scheduler.finished(f.from, r.task, r.seconds);
+      }
+      Grab grab;
+      scheduler.next(f.from, now(), grab);
+      const AnswerHead head{grab.from, grab.requests, grab.packets, grab.blocking ? 1 : 0, grab.moved};
+      Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
+      std::memcpy(answer.data(), &head, sizeof head);
+      if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
+      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+      break;
+    }
+    case kTaskAnswer: {
+      PR_CHECK(isLocal(f.to) && payload.size() >= sizeof(AnswerHead), "a task answer for a PE this rank does not have");
+      AnswerHead head;
+      std::memcpy(&head, payload.data(), sizeof head);
+      Grab grab;
+      grab.from = head.from;
+      grab.requests = head.requests;
+      grab.packets = head.packets;
+      grab.blocking = head.blocking != 0;
+      grab.moved = head.moved;
+      grab.tasks.resize((payload.size() - sizeof head) / sizeof(TaskId));
+      if (!grab.tasks.empty()) std::memcpy(grab.tasks.data(), payload.data() + sizeof head, grab.tasks.size() * sizeof(TaskId));
+      {
+        std::lock_guard lock(rs.answerMutex);
+        rs.answers[static_cast<std::size_t>(f.to - firstLocalPe())] = std::move(grab);
+      }
+      ring(f.to);
+      break;
+    }
+    default: throw std::runtime_error("a runtime message of unknown type " + std::to_string(f.type) + " from rank " + std::to_string(e.source));
   }
 }
 
-void Runtime::driveRankStage(int stage) {
-  Transport& transport = *options_.transport;
+// Moves this rank's part of the stage along: takes what has arrived, and runs or answers the
+// termination waves. Any thread of the rank may call it (the controlling thread in its loop,
+// a PE between tasks or while it waits for a task answer); one at a time, the others return
+// at once. True when it did something.
+bool Runtime::pumpRankStage() {
   RankStage& rs = rankStage_;
-  // Rank 0's wave, and the others' unanswered probe.
-  std::int32_t wave = 0, probe = -1;
-  bool waveOpen = false, havePrevious = false;
-  int replies = 0;
-  WaveCounts totals, previous;
-
-  const auto reply = [&](std::int32_t w) {
+  std::unique_lock lock(rs.pumpMutex, std::try_to_lock);
+  if (!lock.owns_lock() || !rs.pumping.load(std::memory_order_acquire) || rs.over.load(std::memory_order_acquire))
+    return false;
+  bool progressed = false;
+  while (std::optional<Envelope> e = options_.transport->poll(kRuntimeTag)) {
+    handleRankMessage(*e);
+    progressed = true;
+  }
+  const bool passive = outstanding_.finished();
+  if (rank_ == 0) {
+    if (!rs.waveOpen && passive) {
+      ++rs.wave;
+      rs.totalSent = rs.sent.load(std::memory_order_acquire);
+      rs.totalReceived = rs.received.load(std::memory_order_acquire);
+      rs.replies = 0;
+      rs.waveOpen = true;
+      for (int r = 1; r < ranks_; ++r) sendControl(r, kProbe, rs.stage, rs.wave);
+      progressed = true;
+    }
+    if (rs.waveOpen && rs.replies == ranks_ - 1) {
+      rs.waveOpen = false;
+      if (rs.havePrevious && rs.totalSent == rs.totalReceived && rs.totalSent == rs.previousSent &&
+          rs.totalReceived == rs.previousReceived) {
+        for (int r = 1; r < ranks_; ++r) sendControl(r, kEnd, rs.stage, 0);
+        rs.over.store(true, std::memory_order_release);
+        ringAll();
+      }
+      rs.previousSent = rs.totalSent;
+      rs.previousReceived = rs.totalReceived;
+      rs.havePrevious = true;
+      progressed = true;
+    }
+  } else if (rs.probe >= 0 && passive) {
     const WaveCounts mine{rs.sent.load(std::memory_order_acquire), rs.received.load(std::memory_order_acquire)};
     Bytes payload(sizeof mine);
     std::memcpy(payload.data(), &mine, sizeof mine);
-    sendControl(0, kReply, stage, w, std::move(payload));
-  };
-  const auto handle = [&](Envelope& e) {
-    if (e.bytes.size() < kFrameBytes) throw std::runtime_error("a runtime message from rank " + std::to_string(e.source) + " is shorter than its header");
-    Frame f;
-    std::memcpy(&f, e.bytes.data(), sizeof f);
-    if (f.stage > stage) {  // a rank already in a later stage: kept until this rank gets there
-      rs.early.push_back(std::move(e));
-      return;
-    }
-    if (f.stage < stage) return;  // what a failed stage left behind
-    const std::span<const std::byte> payload(e.bytes.data() + kFrameBytes, e.bytes.size() - kFrameBytes);
-    switch (f.type) {
-      case kData: {
-        ChannelBase* channel = f.channel < channelsById_.size() ? channelsById_[f.channel] : nullptr;
-        PR_CHECK(channel != nullptr && isLocal(f.to), "a data message for a channel or PE this rank does not have");
-        channel->deliver(f.from, f.to, payload, f.counted);
-        rs.received.fetch_add(1, std::memory_order_acq_rel);  // after its work was counted
-        break;
-      }
-      case kProbe: probe = f.from; break;
-      case kReply:
-        if (f.from == wave) {
-          WaveCounts c;
-          std::memcpy(&c, payload.data(), sizeof c);
-          totals.sent += c.sent;
-          totals.received += c.received;
-          ++replies;
-        }
-        break;
-      case kEnd:
-        rs.over.store(true, std::memory_order_release);
-        ringAll();
-        break;
-      case kAbort: {
-        std::lock_guard lock(errorMutex_);
-        if (!error_) {
-          record_.error = std::string(reinterpret_cast<const char*>(payload.data()), payload.size());
-          error_ = std::make_exception_ptr(FailedElsewhere(record_.error));
-        }
-        abort_.store(true, std::memory_order_release);
-        ringAll();
-        break;
-      }
-      case kTaskRequest: {
-        Scheduler& scheduler = *job_.scheduler;
-        for (std::size_t at = 0; at + sizeof(TaskReport) <= payload.size(); at += sizeof(TaskReport)) {
-          TaskReport r;
-          std::memcpy(&r, payload.data() + at, sizeof r);
-          scheduler.finished(f.from, r.task, r.seconds);
-        }
-        Grab grab;
-        scheduler.next(f.from, now(), grab);
-        const AnswerHead head{grab.from, grab.requests, grab.packets, grab.blocking ? 1 : 0, grab.moved};
-        Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
-        std::memcpy(answer.data(), &head, sizeof head);
-        if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
-        sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
-        break;
-      }
-      case kTaskAnswer: {
-        PR_CHECK(isLocal(f.to) && payload.size() >= sizeof(AnswerHead), "a task answer for a PE this rank does not have");
-        AnswerHead head;
-        std::memcpy(&head, payload.data(), sizeof head);
-        Grab grab;
-        grab.from = head.from;
-        grab.requests = head.requests;
-        grab.packets = head.packets;
-        grab.blocking = head.blocking != 0;
-        grab.moved = head.moved;
-        grab.tasks.resize((payload.size() - sizeof head) / sizeof(TaskId));
-        if (!grab.tasks.empty()) std::memcpy(grab.tasks.data(), payload.data() + sizeof head, grab.tasks.size() * sizeof(TaskId));
-        {
-          std::lock_guard lock(rs.answerMutex);
-          rs.answers[static_cast<std::size_t>(f.to - firstLocalPe())] = std::move(grab);
-        }
-        ring(f.to);
-        break;
-      }
-      default: throw std::runtime_error("a runtime message of unknown type " + std::to_string(f.type) + " from rank " + std::to_string(e.source));
-    }
-  };
+    sendControl(0, kReply, rs.stage, rs.probe, std::move(payload));
+    rs.probe = -1;
+    progressed = true;
+  }
+  return progressed;
+}
 
-  std::vector<Envelope> early = std::move(rs.early);
-  rs.early.clear();
-  for (Envelope& e : early) handle(e);
+void Runtime::driveRankStage(int stage) {
+  RankStage& rs = rankStage_;
+  {
+    std::lock_guard lock(rs.pumpMutex);
+    rs.stage = stage;
+    rs.wave = 0;
+    rs.probe = -1;
+    rs.waveOpen = rs.havePrevious = false;
+    rs.replies = 0;
+    std::vector<Envelope> early = std::move(rs.early);
+    rs.early.clear();
+    for (Envelope& e : early) handleRankMessage(e);
+    rs.pumping.store(true, std::memory_order_release);
+  }
 
   int idle = 0;
   while (!rs.over.load(std::memory_order_acquire) && !abort_.load(std::memory_order_acquire)) {
-    bool progressed = false;
-    while (std::optional<Envelope> e = transport.poll(kRuntimeTag)) {
-      handle(*e);
-      progressed = true;
-    }
-    const bool passive = outstanding_.finished();
-    if (rank_ == 0) {
-      if (!waveOpen && passive) {
-        ++wave;
-        totals = {rs.sent.load(std::memory_order_acquire), rs.received.load(std::memory_order_acquire)};
-        replies = 0;
-        waveOpen = true;
-        for (int r = 1; r < ranks_; ++r) sendControl(r, kProbe, stage, wave);
-        progressed = true;
-      }
-      if (waveOpen && replies == ranks_ - 1) {
-        waveOpen = false;
-        if (havePrevious && totals.sent == totals.received && totals.sent == previous.sent &&
-            totals.received == previous.received) {
-          for (int r = 1; r < ranks_; ++r) sendControl(r, kEnd, stage, 0);
-          rs.over.store(true, std::memory_order_release);
-          ringAll();
-        }
-        previous = totals;
-        havePrevious = true;
-        progressed = true;
-      }
-    } else if (probe >= 0 && passive) {
-      reply(probe);
-      probe = -1;
-      progressed = true;
-    }
     // Debian's Open MPI moves messages only inside MPI calls (no asynchronous progress), so
     // this thread polls; it backs off to short sleeps when nothing happens, to leave the cores
-    // to the PEs.
-    if (progressed) {
+    // to the PEs, which also pump between their tasks.
+    if (pumpRankStage()) {
       idle = 0;
     } else if (++idle < 64) {
       std::this_thread::yield();
     } else {
       std::this_thread::sleep_for(std::chrono::microseconds(idle < 1024 ? 5 : 50));
     }
+  }
+  {
+    std::lock_guard lock(rs.pumpMutex);
+    rs.pumping.store(false, std::memory_order_release);
   }
 
   bool announce = false;

@@ -116,6 +116,13 @@ void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>&
   });
 }
 
+void Runtime::runOncePerRank(std::string_view name, const std::function<void(Pe&)>& work) {
+  std::vector<int> owner;
+  for (int r = 0; r < ranks_; ++r) owner.push_back(r * localPes_);
+  const TaskSet tasks = TaskSet::uniform(owner.size());
+  runPinned(name, tasks, std::move(owner), [&](Pe& p, TaskId) { work(p); });
+}
+
 void Runtime::runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work) {
   runPinned(name, TaskSet::uniform(1), {pe}, [&](Pe& p, TaskId) { work(p); });
 }
@@ -295,6 +302,7 @@ void Runtime::peLoop(int p, const StageJob& job) {
   const bool acrossRanks = ranks_ > 1;
   const bool askController = acrossRanks && rank_ != 0 && !scheduler.decidedPerPe();
   std::vector<TaskReport> reports;  // finished tasks, for the controller's next answer
+  bool asked = false;               // a request to the controller is in flight
   try {
     if (job.setup && *job.setup && !abort_.load(std::memory_order_acquire)) {
       // Messages that arrive meanwhile wait in their channels.
@@ -308,7 +316,7 @@ void Runtime::peLoop(int p, const StageJob& job) {
       current = kMessageSpan;
       if (handleMessages(pe, spans)) continue;
       if (tasksLeft) {
-        nextTasks(pe, scheduler, askController, grab, spans, reports);
+        nextTasks(pe, scheduler, askController, grab, spans, reports, asked);
         if (grab.tasks.empty()) {
           tasksLeft = false;
           if (acrossRanks) outstanding_.done();
@@ -334,6 +342,7 @@ void Runtime::peLoop(int p, const StageJob& job) {
             scheduler.finished(p, id, seconds);
           }
           if (!acrossRanks && outstanding_.done()) ringAll();
+          if (acrossRanks) pumpRankStage();  // messages move between tasks too
           current = kMessageSpan;
           handleMessages(pe, spans);
         }

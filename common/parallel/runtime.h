@@ -162,6 +162,10 @@ class Runtime {
   // One task on each PE, task p on PE p: owner-local work (build my BVHs, clear my buffers,
   // composite my rectangle) that no other PE may do for it (shared/DESIGN.md rule 1).
   void runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work);
+  // One task on the first PE of every rank (PE 0 alone on one rank): work each rank does for
+  // itself from what it already holds (the world BVH from the scene every rank loaded), a
+  // replicated computation the record shows on each rank's first PE, not a transfer.
+  void runOncePerRank(std::string_view name, const std::function<void(Pe&)>& work);
   // One task, on PE pe: serial work (a data split, the world BVH) timed as a stage of its own,
   // which the simulator keeps on one PE at any P.
   void runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work);
@@ -176,10 +180,13 @@ class Runtime {
   void addCounter(std::string_view name, int pe, double value);
 
   const RunRecord& record() const { return record_; }
-  // Across ranks, called by every rank between stages (after the last): on rank 0, the record
-  // of every rank's PEs on rank 0's clock (record_gather.cpp); elsewhere this rank's own. Waits
-  // for another rank at most timeoutSeconds.
-  RunRecord gatherRecord(double timeoutSeconds = 300.0);
+  // Across ranks, called by every rank between stages (collectives.cpp; each waits for another
+  // rank at most timeoutSeconds). gatherRecord, after the last stage: on rank 0, record()
+  // becomes the record of every rank's PEs on rank 0's clock; elsewhere it stays this rank's.
+  // sumAcrossRanks: values becomes the element-wise sum of every rank's values (each rank
+  // holding what its PEs computed and zeros elsewhere); on one rank it is left as it is.
+  const RunRecord& gatherRecord(double timeoutSeconds = 300.0);
+  void sumAcrossRanks(std::span<double> values, double timeoutSeconds = 300.0);
   // Seconds since the runtime was created (steady clock).
   double now() const {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - epoch_).count();
@@ -240,8 +247,10 @@ class Runtime {
     double seconds;
   };
   void nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
-                 std::vector<TaskReport>& reports);
+                 std::vector<TaskReport>& reports, bool& asked);
   void driveRankStage(int stage);
+  bool pumpRankStage();
+  void handleRankMessage(Envelope& envelope);
   void sendControl(int to, std::uint32_t type, int stage, int a, Bytes payload = {});
 
   RuntimeOptions options_;
@@ -286,11 +295,19 @@ class Runtime {
   // early for a later stage, and the task answers rank 0's controller sent to this rank's PEs.
   struct RankStage {
     std::atomic<bool> over{false};
+    std::atomic<bool> pumping{false};  // the stage's messages may be pumped (driveRankStage runs)
     std::atomic<std::uint64_t> sent{0}, received{0};
     bool failedHere = false, announced = false, spent = false;
-    std::vector<Envelope> early;
     std::mutex answerMutex;
     std::vector<std::optional<Grab>> answers;  // per local PE
+    // Under pumpMutex: the stage, the messages that came early, the waves.
+    std::mutex pumpMutex;
+    int stage = 0;
+    std::vector<Envelope> early;
+    std::int32_t wave = 0, probe = -1;  // rank 0's wave; elsewhere the probe to answer
+    bool waveOpen = false, havePrevious = false;
+    int replies = 0;
+    std::uint64_t totalSent = 0, totalReceived = 0, previousSent = 0, previousReceived = 0;
   };
   RankStage rankStage_;
   std::vector<ChannelBase*> channelsById_;  // every channel ever attached, by id (null once gone)

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "common/parallel/schedulers/scheduler.h"
 #include "raytrace/partition/film_assembly.h"
@@ -31,17 +32,17 @@ class ImageSpacePartition final : public Partition {
  public:
   std::string_view name() const override { return "image-space"; }
   bool holdsWorldModel() const override { return true; }
+  bool runsAcrossRanks() const override { return true; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
-    // The world BVH is built once, on the assembler's PE in a stage of its own (so its time is
-    // in the record like the partitioned tracers' builds), and replicated: the scene and the
-    // BVH are one broadcast per PE (world model, DESIGN.md rule 1). A BVH handed in by the
-    // caller (TraceOptions::worldBvh) is not rebuilt: its build is then outside the record.
+    // The world BVH is built once per rank, on its first PE in a stage of its own (so its time
+    // is in the record like the partitioned tracers' builds; on one rank, once on the
+    // assembler's PE), and replicated: the scene and the BVH are one broadcast per PE (world
+    // model, DESIGN.md rule 1). A BVH handed in by the caller (TraceOptions::worldBvh) is not
+    // rebuilt: its build is then outside the record.
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)
-      rt.runOnOnePe(job.stage("build"), kAssemblerPe, [&](par::Pe&) {
-        built = std::make_unique<Bvh>(job.scene, job.options.bvh);
-      });
+      rt.runOncePerRank(job.stage("build"), [&](par::Pe&) { built = std::make_unique<Bvh>(job.scene, job.options.bvh); });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
@@ -94,12 +95,14 @@ class ImageSpacePartition final : public Partition {
   // so its time is measured with the render: rays traced per sampled pixel, scaled to the
   // tile's pixel count. Each task writes only its tile's estimate; the scratch film is thrown away.
   // The render's integrator makes the rays, one sample per pixel (sample 0, as in a 1-spp render).
+  // Across ranks each rank holds its own PEs' estimates until they are summed.
   static void estimateCosts(const TraceJob& job, const Integrator& integrator, const Bvh& bvh,
                             std::vector<TileTask>& tiles, par::Runtime& rt) {
     Film scratch(job.width, job.height, 1);
     const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
+    std::vector<double> costs(tiles.size(), 0.0);
     rt.runStage("cost pre-pass", par::TaskSet::uniform(tiles.size()), *balanced, [&](par::Pe&, par::TaskId id) {
-      TileTask& t = tiles[size_t(id)];
+      const TileTask& t = tiles[size_t(id)];
       std::vector<RayMessage> queue;
       TraceStats stats;
       int64_t sampled = 0;
@@ -109,8 +112,10 @@ class ImageSpacePartition final : public Partition {
           integrator.traceToCompletion(bvh, queue, scratch, stats, 0);
           ++sampled;
         }
-      t.cost = tileCostEstimate(stats.total(), t.rect, sampled);
+      costs[size_t(id)] = tileCostEstimate(stats.total(), t.rect, sampled);
     });
+    rt.sumAcrossRanks(costs);
+    for (size_t i = 0; i < tiles.size(); ++i) tiles[i].cost = costs[i];
   }
 
   // Splits each tile costing more than kAdaptiveSplitFactor x the mean into four quarters

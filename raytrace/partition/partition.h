@@ -135,6 +135,9 @@ class Partition {
   // Whether every PE reads the whole scene and one BVH over it (world model, DESIGN.md rule 1):
   // such a tracer shares one BVH between an integrator's pre-pass and its render.
   virtual bool holdsWorldModel() const { return false; }
+  // Whether its stages run as SPMD code on a runtime of several ranks (runtime.h): the code
+  // between its stages reads only what its rank holds.
+  virtual bool runsAcrossRanks() const { return false; }
   // Runs the render on rt's PEs (stages recorded in rt.record()). Called from the
   // controlling thread.
   virtual TraceResult render(const TraceJob& job, par::Runtime& rt) = 0;

@@ -97,7 +97,7 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
   // BVH once for the pre-pass's programs and the render.
   std::unique_ptr<Bvh> built;
   if (p->holdsWorldModel() && !job.options.worldBvh) {
-    rt.runOnOnePe("build", kAssemblerPe, [&](par::Pe&) {
+    rt.runOncePerRank("build", [&](par::Pe&) {
       built = std::make_unique<Bvh>(job.scene, main.options.bvh);
     });
     main.options.worldBvh = built.get();

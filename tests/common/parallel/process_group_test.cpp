@@ -64,7 +64,7 @@ TEST_CASE("ProcessGroup: a rank that stops answering ends every rank after the b
   CHECK(seconds < 30.0);
 }
 
-TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the same options, then says it cannot run across ranks yet") {
+TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the same options, and a command that does not run across ranks says so") {
   const std::string cornell = quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf");
   const std::string glass = quoted(pr::test::sourceDir() / "scenes" / "cornell-glass.gltf");
   const CommandResult differ = pr::test::runCommand(
@@ -79,7 +79,7 @@ TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the s
   INFO(same.output);
   CHECK(same.exitStatus == 2);
   CHECK(count(same.output, "parrender: error (rank 0 of 2)") == 1);
-  CHECK(same.output.find("do not run across processes yet") != std::string::npos);
+  CHECK(same.output.find("'info' does not run across processes") != std::string::npos);
 
   // One rank is today's program.
   const CommandResult one = mpirun(1, parrender(), "info " + cornell);

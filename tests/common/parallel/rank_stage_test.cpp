@@ -7,6 +7,7 @@
 #include <array>
 #include <atomic>
 #include <chrono>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -185,4 +186,34 @@ TEST_CASE("RankStage: the gathered record on rank 0 holds every rank's PEs, thei
     CHECK(span.end <= s.startSeconds + s.wallSeconds + 0.05);
   }
   for (int p = 0; p < 6; ++p) CHECK(spans[static_cast<std::size_t>(p)] > 0);
+}
+
+TEST_CASE("RankStage: sums across ranks and a computation replicated on each rank's first PE") {
+  std::vector<std::vector<double>> sums(3);
+  std::vector<std::vector<int>> replicatedOn(3);
+  const auto errors = runOnRanks(3, 2, "demand", [&](Runtime& rt) {
+    std::vector<double> values(5, 0.0);
+    rt.runStage("fill", TaskSet::uniform(5), [&](Pe& pe, TaskId t) { values[static_cast<std::size_t>(t)] = 10.0 * t + pe.id(); });
+    std::vector<double> mine(5, 0.0);
+    for (int t = 0; t < 5; ++t) mine[static_cast<std::size_t>(t)] = values[static_cast<std::size_t>(t)];
+    rt.sumAcrossRanks(mine);
+    sums[static_cast<std::size_t>(rt.rank())] = mine;
+    std::mutex mutex;
+    rt.runOncePerRank("build", [&](Pe& pe) {
+      std::lock_guard lock(mutex);
+      replicatedOn[static_cast<std::size_t>(rt.rank())].push_back(pe.id());
+    });
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  // Each task ran on one PE of one rank: the sum holds 10 t + that PE on every rank.
+  for (int r = 0; r < 3; ++r)
+    for (int t = 0; t < 5; ++t) {
+      const double v = sums[static_cast<std::size_t>(r)][static_cast<std::size_t>(t)];
+      CHECK(v == sums[0][static_cast<std::size_t>(t)]);
+      CHECK(v >= 10.0 * t);
+      CHECK(v <= 10.0 * t + 5);
+    }
+  CHECK(replicatedOn[0] == std::vector<int>{0});
+  CHECK(replicatedOn[1] == std::vector<int>{2});
+  CHECK(replicatedOn[2] == std::vector<int>{4});
 }

@@ -1,7 +1,11 @@
+// What the ranks do together between stages: sum values across ranks (sumAcrossRanks), and
+// make one run record (gatherRecord). Every rank calls them at the same point (SPMD); each
+// wait for another rank is bounded.
+//
 // One run record from R ranks: every rank measured its own PEs (their busy and idle time,
-// messages sent and received, spans, counters); Runtime::gatherRecord brings those parts to
-// rank 0 and sets them in its record, so the record of a run across ranks reads like a record
-// of one process with P = R x T PEs.
+// messages sent and received, spans, counters); gatherRecord brings those parts to rank 0 and
+// sets them in its record, so the record of a run across ranks reads like a record of one
+// process with P = R x T PEs.
 //
 // One clock: each rank's times count from its own runtime's start on its own steady clock.
 // Rank 0 estimates every other rank's offset by a few ping-pongs (Cristian's method: the
@@ -24,6 +28,7 @@ namespace {
 
 constexpr int kRecordTag = ProcessGroup::kFirstUserTag + 1;
 constexpr int kClockTag = ProcessGroup::kFirstUserTag + 2;
+constexpr int kSumTag = ProcessGroup::kFirstUserTag + 3;
 constexpr int kClockRounds = 8;
 
 // A message with `tag` from rank `from`, waiting at most `seconds` (polling, then sleeping).
@@ -92,7 +97,42 @@ void mergeRankPart(RunRecord& into, const RunRecord& part, int first, int count,
 
 }  // namespace
 
-RunRecord Runtime::gatherRecord(double timeoutSeconds) {
+void Runtime::sumAcrossRanks(std::span<double> values, double timeoutSeconds) {
+  PR_CHECK(!inStage_, "sumAcrossRanks is called between stages");
+  if (ranks_ == 1) return;
+  Transport& transport = *options_.transport;
+  const auto asBytes = [&] {
+    Bytes b(values.size_bytes());
+    if (!values.empty()) std::memcpy(b.data(), values.data(), b.size());
+    return b;
+  };
+  const auto check = [&](const Envelope& e) {
+    if (e.bytes.size() != values.size_bytes()) throw std::runtime_error("ranks sum vectors of different lengths");
+  };
+  if (rank_ != 0) {
+    transport.send(0, kSumTag, asBytes());
+    const Envelope e = awaitFrom(transport, kSumTag, timeoutSeconds, "rank 0's sums");
+    check(e);
+    if (!values.empty()) std::memcpy(values.data(), e.bytes.data(), e.bytes.size());
+    return;
+  }
+  // Summed in rank order, so every run adds the same numbers in the same order.
+  std::vector<Bytes> parts(static_cast<std::size_t>(ranks_));
+  for (int got = 1; got < ranks_; ++got) {
+    Envelope e = awaitFrom(transport, kSumTag, timeoutSeconds, "every rank's values to sum");
+    check(e);
+    parts[static_cast<std::size_t>(e.source)] = std::move(e.bytes);
+  }
+  for (int r = 1; r < ranks_; ++r)
+    for (std::size_t i = 0; i < values.size(); ++i) {
+      double v;
+      std::memcpy(&v, parts[static_cast<std::size_t>(r)].data() + i * sizeof v, sizeof v);
+      values[i] += v;
+    }
+  for (int r = 1; r < ranks_; ++r) transport.send(r, kSumTag, asBytes());
+}
+
+const RunRecord& Runtime::gatherRecord(double timeoutSeconds) {
   PR_CHECK(!inStage_, "gatherRecord is called between stages");
   if (ranks_ == 1) return record_;
   Transport& transport = *options_.transport;
@@ -129,7 +169,8 @@ RunRecord Runtime::gatherRecord(double timeoutSeconds) {
                                                  "the run record of rank " + std::to_string(e.source));
     mergeRankPart(merged, part, e.source * localPes_, localPes_, offsets[static_cast<std::size_t>(e.source)]);
   }
-  return merged;
+  record_ = std::move(merged);
+  return record_;
 }
 
 }  // namespace pr::par

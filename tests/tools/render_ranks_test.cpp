@@ -1,0 +1,122 @@
+// `parrender render` across processes: mpirun on loopback (--oversubscribe, root allowed as in
+// CI), each command under `timeout` so a failure can never hang the suite. The image of every
+// R x T equals the single-process image bit for bit; the run record of R = 2 ranks of one PE
+// counts the same messages and bytes per kind as the thread runtime at P = 2; methods that do
+// not run across ranks yet, and the other commands, refuse with one message.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <filesystem>
+#include <string>
+
+#include "common/image/image_io.h"
+#include "common/parallel/run_record.h"
+#include "test_support.h"
+
+using pr::test::CommandResult;
+using pr::test::join;
+using pr::test::quoted;
+
+namespace {
+
+const std::string kMpiEnv =
+    "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" ";
+
+CommandResult mpiParrender(int ranks, const std::string& args) {
+  return pr::test::runCommand(kMpiEnv + "timeout 120 mpirun --oversubscribe -np " + std::to_string(ranks) + " " +
+                              quoted(PARRENDER_EXE) + " " + args);
+}
+
+std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
+
+std::size_t count(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
+
+}  // namespace
+
+TEST_CASE("RenderRanks: image-space across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks");
+  for (const char* integrator : {"whitted", "path"}) {
+    CAPTURE(integrator);
+    const std::string common = join({"render ", cornell(), " -m image-space --integrator ", integrator,
+                                     " --width 40 --height 32 --spp 2 --tile-size 8 --quiet"});
+    const std::filesystem::path reference = dir / (std::string(integrator) + "_reference.exr");
+    const CommandResult one = pr::test::runParrender(join({common, " --threads 1 -o ", quoted(reference)}));
+    INFO(one.output);
+    REQUIRE(one.exitStatus == 0);
+    const pr::image::Image expected = pr::image::readImage(reference);
+    for (const auto [ranks, threads] : {std::array{2, 1}, std::array{2, 2}, std::array{3, 1}, std::array{3, 2},
+                                        std::array{4, 1}, std::array{4, 2}}) {
+      CAPTURE(ranks);
+      CAPTURE(threads);
+      const std::filesystem::path out = dir / (std::string(integrator) + "_" + std::to_string(ranks) + "x" + std::to_string(threads) + ".exr");
+      const CommandResult r = mpiParrender(ranks, join({common, " --threads ", std::to_string(threads), " -o ", quoted(out)}));
+      INFO(r.output);
+      REQUIRE(r.exitStatus == 0);
+      CHECK(count(r.output, "method image-space") == 1);  // rank 0 alone prints
+      CHECK(r.output.find("P " + std::to_string(ranks * threads) + " (" + std::to_string(ranks) + " ranks x " +
+                          std::to_string(threads) + " PEs)") != std::string::npos);
+      CHECK(pr::image::readImage(out).pixels == expected.pixels);
+    }
+  }
+}
+
+TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread runtime at P = 2 counts, and P = R x T") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_record");
+  const std::string common = join({"render ", cornell(), " -m image-space --integrator path --width 48 --height 48 --spp 1 "
+                                   "--tile-size 8 --schedule balanced --quiet"});
+  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
+                                                             quoted(dir / "threads.json")}));
+  INFO(threads.output);
+  REQUIRE(threads.exitStatus == 0);
+  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
+                                                    quoted(dir / "ranks.json")}));
+  INFO(ranks.output);
+  REQUIRE(ranks.exitStatus == 0);
+  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  CHECK(r.pes == 2);
+  REQUIRE(r.stages.size() == t.stages.size());
+  for (std::size_t s = 0; s < t.stages.size(); ++s) {
+    CAPTURE(t.stages[s].name);
+    CHECK(r.stages[s].name == t.stages[s].name);
+    REQUIRE(r.stages[s].channels.size() == t.stages[s].channels.size());
+    for (std::size_t c = 0; c < t.stages[s].channels.size(); ++c) {
+      CHECK(r.stages[s].channels[c].kind == t.stages[s].channels[c].kind);
+      CHECK(r.stages[s].channels[c].messages == t.stages[s].channels[c].messages);
+      CHECK(r.stages[s].channels[c].bytes == t.stages[s].channels[c].bytes);
+    }
+    // The world BVH is built on each rank (a replicated computation, on its first PE), once
+    // on one rank; every other stage's tasks fall on the same PEs.
+    const bool build = t.stages[s].name == "build";
+    for (int p = 0; p < 2; ++p) {
+      CHECK(r.stages[s].pes[std::size_t(p)].tasks == (build ? 1u : t.stages[s].pes[std::size_t(p)].tasks));
+      CHECK(r.stages[s].pes[std::size_t(p)].messagesReceived == t.stages[s].pes[std::size_t(p)].messagesReceived);
+    }
+  }
+  // Four PEs on two ranks: the record has them all, each with its tasks.
+  const CommandResult four = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "f.png"), " --metrics ",
+                                                   quoted(dir / "four.json")}));
+  INFO(four.output);
+  REQUIRE(four.exitStatus == 0);
+  const pr::par::RunRecord f = pr::par::readRunRecord(dir / "four.json");
+  CHECK(f.pes == 4);
+  const pr::par::StageRecord& trace = f.stages.back();
+  for (int p = 0; p < 4; ++p) CHECK(trace.pes[std::size_t(p)].tasks > 0);
+}
+
+TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0") {
+  const CommandResult object = mpiParrender(2, join({"render ", cornell(), " -m object --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(object.exitStatus == 2);
+  CHECK(count(object.output, "method object does not run across processes yet") == 1);
+  CHECK(object.output.find("image-space") != std::string::npos);
+  const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(photons.exitStatus == 2);
+  CHECK(count(photons.output, "--integrator photonmap does not run across processes yet") == 1);
+  const CommandResult info = mpiParrender(2, join({"info ", cornell()}));
+  CHECK(info.exitStatus == 2);
+  CHECK(count(info.output, "'info' does not run across processes") == 1);
+}
