@@ -297,7 +297,7 @@ void Runtime::driveRankStage(int stage) {
     } else if (++idle < 64) {
       std::this_thread::yield();
     } else {
-      std::this_thread::sleep_for(std::chrono::microseconds(idle < 1024 ? 5 : 50));
+      std::this_thread::sleep_for(std::chrono::microseconds(idle < 256 ? 5 : 200));
     }
   }
   {
