@@ -29,6 +29,7 @@ namespace {
 constexpr int kRecordTag = ProcessGroup::kFirstUserTag + 1;
 constexpr int kClockTag = ProcessGroup::kFirstUserTag + 2;
 constexpr int kSumTag = ProcessGroup::kFirstUserTag + 3;
+constexpr int kShareTag = ProcessGroup::kFirstUserTag + 4;
 constexpr int kClockRounds = 8;
 
 // A message with `tag` from rank `from`, waiting at most `seconds` (polling, then sleeping).
@@ -130,6 +131,24 @@ void Runtime::sumAcrossRanks(std::span<double> values, double timeoutSeconds) {
       values[i] += v;
     }
   for (int r = 1; r < ranks_; ++r) transport.send(r, kSumTag, asBytes());
+}
+
+void Runtime::shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds) {
+  PR_CHECK(inStage_ && pe.id() == firstLocalPe(), "shareFromRank0 runs on each rank's first PE, inside a stage");
+  if (ranks_ == 1) return;
+  Transport& transport = *options_.transport;
+  if (rank_ == 0) {
+    for (int r = 1; r < ranks_; ++r) transport.send(r, kShareTag, r + 1 < ranks_ ? data : std::move(data));
+    // Until the data has left: without asynchronous progress it moves only while this rank
+    // calls the transport.
+    const double t0 = now();
+    if (!transport.flush(timeoutSeconds)) throw std::runtime_error("a broadcast did not leave rank 0 within the time allowed");
+    pe.recordWait(now() - t0);
+    return;
+  }
+  const double t0 = now();
+  data = awaitFrom(transport, kShareTag, timeoutSeconds, "rank 0's broadcast").bytes;
+  pe.recordWait(now() - t0);
 }
 
 const RunRecord& Runtime::gatherRecord(double timeoutSeconds) {

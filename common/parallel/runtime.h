@@ -186,6 +186,10 @@ class Runtime {
   // sumAcrossRanks: values becomes the element-wise sum of every rank's values (each rank
   // holding what its PEs computed and zeros elsewhere); on one rank it is left as it is.
   const RunRecord& gatherRecord(double timeoutSeconds = 300.0);
+  // Inside a runOncePerRank stage, on each rank's first PE: data, held on rank 0, becomes every
+  // other rank's (rank 0 sends it to each, and no longer holds it; the wait for it is booked as
+  // waiting). A real broadcast of replicated data, which the caller books with recordBroadcast.
+  void shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds = 300.0);
   void sumAcrossRanks(std::span<double> values, double timeoutSeconds = 300.0);
   // Seconds since the runtime was created (steady clock).
   double now() const {

@@ -29,6 +29,8 @@ class WireError : public std::runtime_error {
 class WireWriter {
  public:
   explicit WireWriter(Bytes& out) : out_(out) {}
+  // Room for n more bytes, so a large encoding grows its buffer once.
+  void reserve(std::size_t n) { out_.reserve(out_.size() + n); }
   void raw(const void* data, std::size_t n) {
     const auto* p = static_cast<const std::byte*>(data);
     out_.insert(out_.end(), p, p + n);

@@ -17,6 +17,11 @@
 #include "raytrace/core/alpha_test.h"
 #include "raytrace/core/ray.h"
 
+namespace pr::par {
+class WireWriter;
+class WireReader;
+}  // namespace pr::par
+
 namespace pr::rt {
 
 // Children per node: one AVX2 slab test of eight lanes, or two SSE tests of four where the
@@ -141,6 +146,12 @@ class Bvh {
   std::span<const BvhLeafBlock> leafBlocks() const { return leafBlocks_; }
   const BvhStats& stats() const { return stats_; }
   scene::Bounds bounds() const;
+
+  // The BVH as bytes, for a broadcast between ranks (bvh_wire.cpp): everything but the alpha
+  // test, which the receiver makes from its own copy of the scene (what the build would have
+  // used). decode throws par::WireError on bytes that are not one BVH.
+  void encode(par::WireWriter& w) const;
+  static Bvh decode(par::WireReader& r, std::shared_ptr<const AlphaTest> alpha);
 
  private:
   void build(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,

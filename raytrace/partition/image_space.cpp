@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/parallel/schedulers/scheduler.h"
+#include "common/parallel/wire.h"
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/partition.h"
 #include "raytrace/partition/partitioned.h"
@@ -35,14 +36,29 @@ class ImageSpacePartition final : public Partition {
   bool runsAcrossRanks() const override { return true; }
 
   TraceResult render(const TraceJob& job, par::Runtime& rt) override {
-    // The world BVH is built once per rank, on its first PE in a stage of its own (so its time
-    // is in the record like the partitioned tracers' builds; on one rank, once on the
-    // assembler's PE), and replicated: the scene and the BVH are one broadcast per PE (world
-    // model, DESIGN.md rule 1). A BVH handed in by the caller (TraceOptions::worldBvh) is not
-    // rebuilt: its build is then outside the record.
+    // The world BVH is built once, on the assembler's PE in a stage of its own (so its time is
+    // in the record like the partitioned tracers' builds), and replicated: the scene and the
+    // BVH are one broadcast per PE (world model, DESIGN.md rule 1). Across ranks the stage runs
+    // on each rank's first PE: rank 0's builds and sends the BVH's encoding, the others decode
+    // it (every rank loaded the scene file itself). A BVH handed in by the caller
+    // (TraceOptions::worldBvh) is not rebuilt: its build is then outside the record.
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)
-      rt.runOncePerRank(job.stage("build"), [&](par::Pe&) { built = std::make_unique<Bvh>(job.scene, job.options.bvh); });
+      rt.runOncePerRank(job.stage("build"), [&](par::Pe& pe) {
+        if (rt.rank() == 0) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
+        if (rt.ranks() == 1) return;
+        par::Bytes bytes;
+        if (rt.rank() == 0) {
+          par::WireWriter w(bytes);
+          built->encode(w);
+        }
+        rt.shareFromRank0(pe, bytes);
+        if (rt.rank() != 0) {
+          par::WireReader r(bytes);
+          built = std::make_unique<Bvh>(
+              Bvh::decode(r, job.options.bvh.alpha ? job.options.bvh.alpha : AlphaTest::forScene(job.scene)));
+        }
+      });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;

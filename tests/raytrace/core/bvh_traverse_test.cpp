@@ -7,6 +7,7 @@
 #include <random>
 #include <vector>
 
+#include "common/parallel/wire.h"
 #include "common/util/cpu_features.h"
 #include "common/util/error.h"
 #include "raytrace/core/bvh.h"
@@ -241,4 +242,29 @@ TEST_CASE("BvhTraverse: a slab test of other than 4 or 8 lanes is an input error
   CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(3), pr::InputError);
   CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(16), pr::InputError);
   if (!pr::hasAvx2()) CHECK_THROWS_AS(pr::rt::setBvhSlabLanes(8), pr::InputError);
+}
+
+TEST_CASE("BvhTraverse: a BVH decoded from its encoding answers every query as the one built, and short bytes are refused") {
+  const auto scene = pr::test::randomSoup(900, 1.0f, glm::vec3(0.0f), 5);
+  const Bvh built(scene);
+  pr::par::Bytes bytes;
+  pr::par::WireWriter w(bytes);
+  built.encode(w);
+  pr::par::WireReader r(bytes);
+  const Bvh decoded = Bvh::decode(r, nullptr);
+  CHECK(r.remaining() == 0);
+  CHECK(decoded.root() == built.root());
+  CHECK(decoded.nodes().size() == built.nodes().size());
+  CHECK(decoded.stats().memoryBytes == built.stats().memoryBytes);
+  int hits = 0;
+  for (const Ray& ray : randomRays(2000, 1.0f, glm::vec3(0.0f), 17)) {
+    const Hit want = query(built, ray);
+    checkSame(query(decoded, ray), want);
+    CHECK(decoded.occluded(ray) == built.occluded(ray));
+    hits += want.valid();
+  }
+  CHECK(hits > 500);
+  bytes.resize(bytes.size() - 1);
+  pr::par::WireReader shortReader(bytes);
+  CHECK_THROWS_AS(Bvh::decode(shortReader, nullptr), pr::par::WireError);
 }
