@@ -78,15 +78,11 @@ int main(int argc, char** argv) {
   try {
     group->checkSameCommandLine(argc, argv);
     app.parse(argc, argv);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForVersion& e) {
-    return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    app.exit(e);  // prints the message and usage hint
-    return pr::kExitBadInput;
+    // --help, --version (status 0) and bad options (the message and a usage hint): printed by
+    // rank 0 only, and every rank still ends through the group.
+    const int printed = group->rank() == 0 ? app.exit(e) : e.get_exit_code();
+    return group->finish(printed == 0 ? 0 : pr::kExitBadInput, "");
   } catch (const pr::InputError& e) {
     status = pr::kExitBadInput;
     error = e.what();

@@ -108,7 +108,7 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
   for (int p = 0; p < 4; ++p) CHECK(trace.pes[std::size_t(p)].tasks > 0);
 }
 
-TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0") {
+TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {
   const CommandResult object = mpiParrender(2, join({"render ", cornell(), " -m object --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(object.exitStatus == 2);
   CHECK(count(object.output, "method object does not run across processes yet") == 1);
@@ -116,6 +116,13 @@ TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one mess
   const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(photons.exitStatus == 2);
   CHECK(count(photons.output, "--integrator photonmap does not run across processes yet") == 1);
+  // CLI11's output is rank 0's alone, and every rank ends through the group.
+  const CommandResult help = mpiParrender(2, "--help");
+  CHECK(help.exitStatus == 0);
+  CHECK(count(help.output, "render a glTF scene") == 1);
+  const CommandResult badOption = mpiParrender(2, join({"render ", cornell(), " --width 0"}));
+  CHECK(badOption.exitStatus == 2);
+  CHECK(count(badOption.output, "Run with --help for more information") == 1);
   const CommandResult info = mpiParrender(2, join({"info ", cornell()}));
   CHECK(info.exitStatus == 2);
   CHECK(count(info.output, "'info' does not run across processes") == 1);
