@@ -48,8 +48,9 @@ TEST_CASE("RenderRanks: image-space across R = 2, 3, 4 ranks of 1 and 2 PEs equa
     INFO(one.output);
     REQUIRE(one.exitStatus == 0);
     const pr::image::Image expected = pr::image::readImage(reference);
-    for (const auto [ranks, threads] : {std::array{2, 1}, std::array{2, 2}, std::array{3, 1}, std::array{3, 2},
-                                        std::array{4, 1}, std::array{4, 2}}) {
+    for (const auto& shape : {std::array{2, 1}, std::array{2, 2}, std::array{3, 1}, std::array{3, 2},
+                                 std::array{4, 1}, std::array{4, 2}}) {
+      const int ranks = shape[0], threads = shape[1];  // CAPTURE cannot take a structured binding
       CAPTURE(ranks);
       CAPTURE(threads);
       const std::filesystem::path out = dir / (std::string(integrator) + "_" + std::to_string(ranks) + "x" + std::to_string(threads) + ".exr");

@@ -89,7 +89,8 @@ TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the s
 }
 
 TEST_CASE("ProcessGroup: the runtime's stages across 2 and 3 ranks run every task once and end after every message") {
-  for (const auto& [ranks, threads] : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}}) {
+  for (const auto& shape : {std::pair{2, 1}, std::pair{3, 1}, std::pair{2, 2}}) {
+    const int ranks = shape.first, threads = shape.second;  // CAPTURE cannot take a structured binding
     CAPTURE(ranks);
     CAPTURE(threads);
     const CommandResult r = mpirun(ranks, check(), "stages " + std::to_string(threads));

@@ -21,7 +21,8 @@ using pr::test::runOnRanks;
 TEST_CASE("RankStage: every task runs once, on a PE of the rank that ran it, under every strategy") {
   constexpr int kTasks = 97;
   for (const auto& entry : schedules()) {
-    for (const auto [ranks, threads] : {std::array{2, 1}, std::array{2, 2}, std::array{3, 2}}) {
+    for (const auto& shape : {std::array{2, 1}, std::array{2, 2}, std::array{3, 2}}) {
+      const int ranks = shape[0], threads = shape[1];  // CAPTURE cannot take a structured binding
       CAPTURE(entry.name);
       CAPTURE(ranks);
       CAPTURE(threads);
@@ -54,7 +55,8 @@ struct Hop {
 
 TEST_CASE("RankStage: a stage ends only when chains of messages across ranks are all handled") {
   constexpr int kChains = 24, kLength = 40;
-  for (const auto [ranks, threads] : {std::array{2, 1}, std::array{3, 1}, std::array{4, 2}}) {
+  for (const auto& shape : {std::array{2, 1}, std::array{3, 1}, std::array{4, 2}}) {
+    const int ranks = shape[0], threads = shape[1];  // CAPTURE cannot take a structured binding
     CAPTURE(ranks);
     CAPTURE(threads);
     std::atomic<long> handled{0};
