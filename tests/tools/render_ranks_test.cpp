@@ -11,29 +11,19 @@
 
 #include "common/image/image_io.h"
 #include "common/parallel/run_record.h"
-#include "test_support.h"
+#include "mpirun_support.h"
 
 using pr::test::CommandResult;
 using pr::test::join;
+using pr::test::occurrences;
 using pr::test::quoted;
 
 namespace {
 
-const std::string kMpiEnv =
-    "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" ";
-
-CommandResult mpiParrender(int ranks, const std::string& args) {
-  return pr::test::runCommand(kMpiEnv + "timeout 120 mpirun --oversubscribe -np " + std::to_string(ranks) + " " +
-                              quoted(PARRENDER_EXE) + " " + args);
-}
+CommandResult mpiParrender(int ranks, const std::string& args) { return pr::test::mpirun(ranks, quoted(PARRENDER_EXE), args, 120); }
 
 std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
 
 }  // namespace
 
@@ -57,7 +47,7 @@ TEST_CASE("RenderRanks: image-space across R = 2, 3, 4 ranks of 1 and 2 PEs equa
       const CommandResult r = mpiParrender(ranks, join({common, " --threads ", std::to_string(threads), " -o ", quoted(out)}));
       INFO(r.output);
       REQUIRE(r.exitStatus == 0);
-      CHECK(count(r.output, "method image-space") == 1);  // rank 0 alone prints
+      CHECK(occurrences(r.output, "method image-space") == 1);  // rank 0 alone prints
       CHECK(r.output.find("P " + std::to_string(ranks * threads) + " (" + std::to_string(ranks) + " ranks x " +
                           std::to_string(threads) + " PEs)") != std::string::npos);
       CHECK(pr::image::readImage(out).pixels == expected.pixels);
@@ -112,19 +102,19 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
 TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {
   const CommandResult object = mpiParrender(2, join({"render ", cornell(), " -m object --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(object.exitStatus == 2);
-  CHECK(count(object.output, "method object does not run across processes yet") == 1);
+  CHECK(occurrences(object.output, "method object does not run across processes yet") == 1);
   CHECK(object.output.find("image-space") != std::string::npos);
   const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(photons.exitStatus == 2);
-  CHECK(count(photons.output, "--integrator photonmap does not run across processes yet") == 1);
+  CHECK(occurrences(photons.output, "--integrator photonmap does not run across processes yet") == 1);
   // CLI11's output is rank 0's alone, and every rank ends through the group.
   const CommandResult help = mpiParrender(2, "--help");
   CHECK(help.exitStatus == 0);
-  CHECK(count(help.output, "render a glTF scene") == 1);
+  CHECK(occurrences(help.output, "render a glTF scene") == 1);
   const CommandResult badOption = mpiParrender(2, join({"render ", cornell(), " --width 0"}));
   CHECK(badOption.exitStatus == 2);
-  CHECK(count(badOption.output, "Run with --help for more information") == 1);
+  CHECK(occurrences(badOption.output, "Run with --help for more information") == 1);
   const CommandResult info = mpiParrender(2, join({"info ", cornell()}));
   CHECK(info.exitStatus == 2);
-  CHECK(count(info.output, "'info' does not run across processes") == 1);
+  CHECK(occurrences(info.output, "'info' does not run across processes") == 1);
 }

@@ -6,33 +6,18 @@
 
 #include <doctest/doctest.h>
 
-#include "test_support.h"
+#include "mpirun_support.h"
 
 namespace {
 
 using pr::test::CommandResult;
+using pr::test::kMpiEnv;
+using pr::test::mpirun;
+using pr::test::occurrences;
 using pr::test::quoted;
-
-// What every mpirun here is started with: root allowed (CI runs as root), and, in the ASan job,
-// no leak check in the ranks: Open MPI unloads its components before exit and leaves
-// allocations LeakSanitizer cannot attribute (frames in no loaded module); address and UB
-// checks stay on.
-const std::string kMpiEnv = "OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 ASAN_OPTIONS=\"$ASAN_OPTIONS:detect_leaks=0\" ";
-
-// mpirun -np N PROGRAM ARGS, ended after `limit` seconds at most (timeout's status 124).
-CommandResult mpirun(int ranks, const std::string& program, const std::string& args, int limit = 60,
-                     const std::string& env = "") {
-  return pr::test::runCommand(kMpiEnv + env + " timeout " + std::to_string(limit) + " mpirun --oversubscribe -np " +
-                              std::to_string(ranks) + " " + program + " " + args);
-}
 
 std::string check() { return quoted(pr::test::binaryDir() / "tests" / "parrender_transport_check"); }
 std::string parrender() { return quoted(PARRENDER_EXE); }
-std::size_t count(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-  return n;
-}
 
 }  // namespace
 
@@ -50,7 +35,7 @@ TEST_CASE("ProcessGroup: a rank that fails ends every rank, with one message fro
   const CommandResult r = mpirun(3, check(), "fail 1");
   INFO(r.output);
   CHECK(r.exitStatus == 1);
-  CHECK(count(r.output, "parrender: failed (rank 1 of 3): an injected failure") == 1);
+  CHECK(occurrences(r.output, "parrender: failed (rank 1 of 3): an injected failure") == 1);
 }
 
 TEST_CASE("ProcessGroup: a rank that stops answering ends every rank after the bounded wait, no hang") {
@@ -72,13 +57,13 @@ TEST_CASE("ProcessGroup: parrender under mpirun checks that every rank got the s
       " info " + cornell + " : -np 1 " + parrender() + " info " + glass);
   INFO(differ.output);
   CHECK(differ.exitStatus == 2);
-  CHECK(count(differ.output, "parrender: error") == 1);
+  CHECK(occurrences(differ.output, "parrender: error") == 1);
   CHECK(differ.output.find("rank 1 was started with a different command line") != std::string::npos);
 
   const CommandResult same = mpirun(2, parrender(), "info " + cornell);
   INFO(same.output);
   CHECK(same.exitStatus == 2);
-  CHECK(count(same.output, "parrender: error (rank 0 of 2)") == 1);
+  CHECK(occurrences(same.output, "parrender: error (rank 0 of 2)") == 1);
   CHECK(same.output.find("'info' does not run across processes") != std::string::npos);
 
   // One rank is today's program.
@@ -96,7 +81,7 @@ TEST_CASE("ProcessGroup: the runtime's stages across 2 and 3 ranks run every tas
     const CommandResult r = mpirun(ranks, check(), "stages " + std::to_string(threads));
     INFO(r.output);
     CHECK(r.exitStatus == 0);
-    CHECK(count(r.output, "tasks once each") == 4);
+    CHECK(occurrences(r.output, "tasks once each") == 4);
   }
 }
 
@@ -104,6 +89,6 @@ TEST_CASE("ProcessGroup: a task that fails on one rank's PE ends the stage on ev
   const CommandResult r = mpirun(2, check(), "stagefail 3");
   INFO(r.output);
   CHECK(r.exitStatus == 1);
-  CHECK(count(r.output, "parrender: failed (rank 1 of 2): an injected task failure") == 1);
-  CHECK(count(r.output, "parrender: failed") == 1);
+  CHECK(occurrences(r.output, "parrender: failed (rank 1 of 2): an injected task failure") == 1);
+  CHECK(occurrences(r.output, "parrender: failed") == 1);
 }
