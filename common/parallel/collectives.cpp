@@ -88,11 +88,16 @@ void mergeRankPart(RunRecord& into, const RunRecord& part, int first, int count,
       span.end += offset;
       into.timeline.push_back(span);
     }
+  // A rank's counters for its own PEs are the ones it measured: whatever rank 0 booked for
+  // them (code run on every rank may add a figure for every PE) is replaced, 0 where the rank
+  // has no such counter.
+  for (CounterRecord& c : into.counters)
+    for (int p = first; p < first + count; ++p) c.perPe[static_cast<std::size_t>(p)] = 0.0;
   for (const CounterRecord& c : part.counters) {
     auto it = std::find_if(into.counters.begin(), into.counters.end(), [&](const CounterRecord& x) { return x.name == c.name; });
     if (it == into.counters.end())
       it = into.counters.insert(into.counters.end(), CounterRecord{c.name, std::vector<double>(c.perPe.size(), 0.0)});
-    for (int p = first; p < first + count; ++p) it->perPe[static_cast<std::size_t>(p)] += c.perPe[static_cast<std::size_t>(p)];
+    for (int p = first; p < first + count; ++p) it->perPe[static_cast<std::size_t>(p)] = c.perPe[static_cast<std::size_t>(p)];
   }
 }
 

@@ -103,7 +103,7 @@ class ObjectFrame {
         maxPieceTriangles_(maxPieceTriangles),
         replicatedFraction_(replicatedFraction),
         integrator_(jobIntegrator(job)),
-        films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
+        films_(makeFilms(job, rt, integrator_->options().spp, kAssemblerPe)),
         bvhs_(rt.pes()),
         replicas_(rt.pes()),
         views_(job, rt.pes()),

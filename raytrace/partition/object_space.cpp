@@ -88,7 +88,7 @@ class ObjectSpaceFrame {
         rt_(rt),
         integrator_(jobIntegrator(job)),
         voxelsPerPe_(voxelsPerPe),
-        films_(makeFilms(job, rt.pes(), integrator_->options().spp)),
+        films_(makeFilms(job, rt, integrator_->options().spp, kAssemblerPe)),
         bvhs_(rt.pes()),
         held_(rt.pes()),
         views_(job, rt.pes()),
@@ -98,12 +98,16 @@ class ObjectSpaceFrame {
     const int pes = rt_.pes();
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     // The split and the tiles' preferred PEs, on the assembler's PE alone: a serial part of the
-    // method, timed as such.
+    // method, timed as such. Across ranks the stage runs on each rank's first PE: rank 0's
+    // makes them and sends them, the others decode them (every rank loaded the scene itself).
     std::vector<int> preferred;
-    rt_.runOnOnePe(job_.stage("split"), kAssemblerPe, [&](par::Pe&) {
-      split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp, integrator_->context().lights().emitters());
-      owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
-      if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
+    rt_.runOncePerRank(job_.stage("split"), [&](par::Pe& pe) {
+      if (rt_.rank() == 0) {
+        split_ = makeSplit(job_, voxelCount(voxelsPerPe_, pes), integrator_->options().spp, integrator_->context().lights().emitters());
+        owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
+        if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
+      }
+      shareSplit(pe, preferred);
     });
 
     const auto total = int64_t(tiles.size());
@@ -165,6 +169,27 @@ class ObjectSpaceFrame {
     TraceStats stats;
     uint64_t raysSent = 0;
   };
+
+  // On each rank's first PE in the split stage, across ranks: rank 0's split, voxel owners and
+  // the tiles' preferred PEs reach every rank.
+  void shareSplit(par::Pe& pe, std::vector<int>& preferred) {
+    if (rt_.ranks() == 1) return;
+    par::Bytes bytes;
+    if (rt_.rank() == 0) {
+      par::WireWriter w(bytes);
+      split_.encode(w);
+      w.sequence(std::span<const int>(owners_));
+      w.sequence(std::span<const int>(preferred));
+    }
+    rt_.shareFromRank0(pe, bytes);
+    if (rt_.rank() == 0) return;
+    par::WireReader r(bytes);
+    split_ = VoxelSplit::decode(r);
+    owners_ = r.sequence<int>();
+    preferred = r.sequence<int>();
+    if (owners_.size() != size_t(split_.voxels()))
+      throw par::WireError("object-space: a voxel split whose owners do not match its voxels");
+  }
 
   // On PE pe, before it traces anything: one BVH over its voxels' triangles (a triangle
   // straddling two of them once) and its view of the scene.

@@ -22,6 +22,8 @@ class ObjectSpacePartition final : public Partition {
   // barrier waited for the owner with the most triangles, 4 was).
   explicit ObjectSpacePartition(int voxelsPerPe = 2);
   std::string_view name() const override { return "object-space"; }
+  // Rays travel between ranks as messages; rank 0 sends the split (object_space.cpp).
+  bool runsAcrossRanks() const override { return true; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
 
  private:

@@ -113,9 +113,12 @@ inline std::vector<PixelRect> cameraTiles(int width, int height, int tileSizePx)
 
 // One film per PE: shading adds to the film of the PE that shades (no shared writes); the
 // films go to the assembler at the end (film_assembly.h).
-inline std::vector<std::unique_ptr<Film>> makeFilms(const TraceJob& job, int pes, int spp) {
-  std::vector<std::unique_ptr<Film>> films;
-  for (int p = 0; p < pes; ++p) films.push_back(std::make_unique<Film>(job.filmWidth(), job.filmHeight(), spp));
+// Across ranks only this rank's PEs and the assembler (`assembler`, whose film is the image on
+// rank 0 and a place for the render's result on the others) have one; the rest are null.
+inline std::vector<std::unique_ptr<Film>> makeFilms(const TraceJob& job, const par::Runtime& rt, int spp, int assembler) {
+  std::vector<std::unique_ptr<Film>> films(size_t(rt.pes()));
+  for (int p = 0; p < rt.pes(); ++p)
+    if (rt.isLocal(p) || p == assembler) films[size_t(p)] = std::make_unique<Film>(job.filmWidth(), job.filmHeight(), spp);
   return films;
 }
 

@@ -12,6 +12,7 @@
 
 #include <glm/glm.hpp>
 
+#include "common/parallel/wire.h"
 #include "common/scene/scene.h"
 #include "raytrace/core/ray.h"
 #include "raytrace/partition/ray_slabs.h"
@@ -93,6 +94,12 @@ class VoxelSplit {
   template <class Visit>
   void walk(const Ray& ray, Visit&& visit) const;
   std::vector<VoxelSpan> spans(const Ray& ray) const;
+
+  // The whole split as bytes (voxel_split_wire.cpp), and back: a rank that decodes it walks
+  // rays through the same voxels and finds the same triangles in each as the rank that made it.
+  // decode throws par::WireError for bytes that are not an encoding.
+  void encode(par::WireWriter& w) const;
+  static VoxelSplit decode(par::WireReader& r);
 
  private:
   // axis < 0: a leaf, voxel index in `left`. Otherwise children `left` (below split) and

@@ -5,8 +5,10 @@
 // not run across ranks yet, and the other commands, refuse with one message.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
+#include <initializer_list>
 #include <string>
 
 #include "common/image/image_io.h"
@@ -24,35 +26,48 @@ CommandResult mpiParrender(int ranks, const std::string& args) { return pr::test
 
 std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 
+// Renders `args` in one process of one PE, then under mpirun at each R x T: the same image bit
+// for bit, rank 0 alone printing, P = R x T.
+void checkEqualsOneProcess(const std::string& name, const std::string& method, const std::string& args,
+                           std::initializer_list<std::array<int, 2>> shapes) {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_" + name);
+  const std::string common = join({"render ", cornell(), " -m ", method, " ", args, " --quiet"});
+  const std::filesystem::path reference = dir / "reference.exr";
+  const CommandResult one = pr::test::runParrender(join({common, " --threads 1 -o ", quoted(reference)}));
+  INFO(one.output);
+  REQUIRE(one.exitStatus == 0);
+  const pr::image::Image expected = pr::image::readImage(reference);
+  for (const std::array<int, 2>& shape : shapes) {
+    const int ranks = shape[0], threads = shape[1];  // CAPTURE cannot take a structured binding
+    CAPTURE(ranks);
+    CAPTURE(threads);
+    const std::filesystem::path out = dir / (std::to_string(ranks) + "x" + std::to_string(threads) + ".exr");
+    const CommandResult r = mpiParrender(ranks, join({common, " --threads ", std::to_string(threads), " -o ", quoted(out)}));
+    INFO(r.output);
+    REQUIRE(r.exitStatus == 0);
+    CHECK(occurrences(r.output, "method " + method) == 1);  // rank 0 alone prints
+    CHECK(r.output.find("P " + std::to_string(ranks * threads) + " (" + std::to_string(ranks) + " ranks x " +
+                        std::to_string(threads) + " PEs)") != std::string::npos);
+    CHECK(pr::image::readImage(out).pixels == expected.pixels);
+  }
+}
 
 }  // namespace
 
 TEST_CASE("RenderRanks: image-space across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
-  const std::filesystem::path dir = pr::test::scratchDir("render_ranks");
   for (const char* integrator : {"whitted", "path"}) {
     CAPTURE(integrator);
-    const std::string common = join({"render ", cornell(), " -m image-space --integrator ", integrator,
-                                     " --width 40 --height 32 --spp 2 --tile-size 8 --quiet"});
-    const std::filesystem::path reference = dir / (std::string(integrator) + "_reference.exr");
-    const CommandResult one = pr::test::runParrender(join({common, " --threads 1 -o ", quoted(reference)}));
-    INFO(one.output);
-    REQUIRE(one.exitStatus == 0);
-    const pr::image::Image expected = pr::image::readImage(reference);
-    for (const auto& shape : {std::array{2, 1}, std::array{2, 2}, std::array{3, 1}, std::array{3, 2},
-                                 std::array{4, 1}, std::array{4, 2}}) {
-      const int ranks = shape[0], threads = shape[1];  // CAPTURE cannot take a structured binding
-      CAPTURE(ranks);
-      CAPTURE(threads);
-      const std::filesystem::path out = dir / (std::string(integrator) + "_" + std::to_string(ranks) + "x" + std::to_string(threads) + ".exr");
-      const CommandResult r = mpiParrender(ranks, join({common, " --threads ", std::to_string(threads), " -o ", quoted(out)}));
-      INFO(r.output);
-      REQUIRE(r.exitStatus == 0);
-      CHECK(occurrences(r.output, "method image-space") == 1);  // rank 0 alone prints
-      CHECK(r.output.find("P " + std::to_string(ranks * threads) + " (" + std::to_string(ranks) + " ranks x " +
-                          std::to_string(threads) + " PEs)") != std::string::npos);
-      CHECK(pr::image::readImage(out).pixels == expected.pixels);
-    }
+    checkEqualsOneProcess(std::string("image_space_") + integrator, "image-space",
+                          join({"--integrator ", integrator, " --width 40 --height 32 --spp 2 --tile-size 8"}),
+                          {{2, 1}, {2, 2}, {3, 1}, {3, 2}, {4, 1}, {4, 2}});
   }
+}
+
+// Object-space: rays cross ranks as messages between the owners of the voxels along them, the
+// split made on rank 0 and sent; path tracing sends continuation and shadow rays too.
+TEST_CASE("RenderRanks: object-space across R = 2, 3 ranks of 1 and 2 PEs equals the single-process image") {
+  checkEqualsOneProcess("object_space", "object-space", "--integrator path --width 40 --height 32 --spp 2 --tile-size 8",
+                        {{2, 1}, {2, 2}, {3, 1}, {3, 2}});
 }
 
 TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread runtime at P = 2 counts, and P = R x T") {
@@ -97,6 +112,48 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
   CHECK(f.pes == 4);
   const pr::par::StageRecord& trace = f.stages.back();
   for (int p = 0; p < 4; ++p) CHECK(trace.pes[std::size_t(p)].tasks > 0);
+}
+
+// With a static schedule every ray takes the same way from owner to owner whatever the
+// timing, so the rays crossing between the two PEs are the same ones, encoded in the same
+// bytes, whether the PEs are threads or ranks (the number of batches is not: a batch leaves
+// when its PE runs dry).
+TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and their bytes, of the thread runtime at P = 2") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_object_record");
+  const std::string common = join({"render ", cornell(), " -m object-space --integrator path --width 48 --height 48 --spp 1 "
+                                   "--tile-size 8 --schedule balanced --quiet"});
+  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
+                                                             quoted(dir / "threads.json")}));
+  INFO(threads.output);
+  REQUIRE(threads.exitStatus == 0);
+  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
+                                                    quoted(dir / "ranks.json")}));
+  INFO(ranks.output);
+  REQUIRE(ranks.exitStatus == 0);
+  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const auto raysChannel = [](const pr::par::RunRecord& record) {
+    for (const pr::par::StageRecord& stage : record.stages)
+      for (const pr::par::ChannelTraffic& c : stage.channels)
+        if (c.name == "rays") return c;
+    FAIL("no rays channel in the record");
+    return pr::par::ChannelTraffic{};
+  };
+  const pr::par::ChannelTraffic tr = raysChannel(t), rr = raysChannel(r);
+  CHECK(tr.bytes > 0);
+  CHECK(rr.bytes == tr.bytes);
+  const auto raysSent = [](const pr::par::RunRecord& record) {
+    const auto it = std::find_if(record.counters.begin(), record.counters.end(),
+                                 [](const pr::par::CounterRecord& c) { return c.name == "Partition/rays_sent"; });
+    REQUIRE(it != record.counters.end());
+    return it->perPe;
+  };
+  CHECK(raysSent(r) == raysSent(t));
+  // The split is made once on rank 0's PE and decoded on rank 1's: one task on each.
+  const auto split = std::find_if(r.stages.begin(), r.stages.end(), [](const pr::par::StageRecord& s) { return s.name == "split"; });
+  REQUIRE(split != r.stages.end());
+  CHECK(split->pes[0].tasks == 1);
+  CHECK(split->pes[1].tasks == 1);
 }
 
 TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {

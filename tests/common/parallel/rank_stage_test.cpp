@@ -1,9 +1,11 @@
 // Stages across ranks (rank_stage.cpp), on R ranks inside this process (in_process_ranks.h):
 // every task runs once under every strategy, a message-driven stage ends only when chains of
 // messages that cross ranks are done, messages between ranks are counted as their encoding on
-// both sides, and a failure on one rank ends the stage on every rank with its text.
+// both sides, a failure on one rank ends the stage on every rank with its text, and the
+// gathered record holds each PE's figures as its own rank measured them.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
@@ -154,6 +156,10 @@ TEST_CASE("RankStage: the gathered record on rank 0 holds every rank's PEs, thei
     });
     for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p)
       tasksOnRank[static_cast<std::size_t>(rt.rank())] += rt.record().stages[0].pes[static_cast<std::size_t>(p)].tasks;
+    // Code run on every rank may book a figure for every PE: a PE's figure in the record is
+    // the one its own rank booked.
+    for (int p = 0; p < rt.pes(); ++p) rt.addCounter("everywhere", p, double(rt.rank() + 1));
+    if (rt.rank() == 1) rt.addCounter("rank 1 only", rt.firstLocalPe(), 5.0);
     RunRecord r = rt.gatherRecord();
     if (rt.rank() == 0) merged = std::move(r);
   });
@@ -188,6 +194,13 @@ TEST_CASE("RankStage: the gathered record on rank 0 holds every rank's PEs, thei
     CHECK(span.end <= s.startSeconds + s.wallSeconds + 0.05);
   }
   for (int p = 0; p < 6; ++p) CHECK(spans[static_cast<std::size_t>(p)] > 0);
+  const auto counter = [&](const std::string& name) {
+    const auto it = std::find_if(merged.counters.begin(), merged.counters.end(), [&](const CounterRecord& c) { return c.name == name; });
+    REQUIRE(it != merged.counters.end());
+    return it->perPe;
+  };
+  CHECK(counter("everywhere") == std::vector<double>{1, 1, 2, 2, 3, 3});
+  CHECK(counter("rank 1 only") == std::vector<double>{0, 0, 5, 0, 0, 0});
 }
 
 TEST_CASE("RankStage: sums across ranks and a computation replicated on each rank's first PE") {

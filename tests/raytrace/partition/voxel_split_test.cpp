@@ -343,3 +343,56 @@ TEST_CASE("VoxelSplit: one voxel holds the whole scene, bad counts are input err
   CHECK(empty.voxels() == 4);
   CHECK(empty.storedTriangles() == 0);
 }
+
+TEST_CASE("VoxelSplit: a split decoded from its encoding walks, holds and tests content as the one made, and bad bytes are refused") {
+  // Two clusters, one replicated, with work points: every part of the split is non-trivial.
+  pr::scene::Scene s = pr::test::randomSoup(300, 0.5f, glm::vec3(-2.0f, 0.0f, 0.0f), 3);
+  const auto firstReplicated = uint32_t(s.triangles.size());
+  pr::test::appendTriangles(s, pr::test::randomSoup(300, 0.5f, glm::vec3(2.0f, 0.0f, 0.0f), 4));
+  std::vector<uint32_t> replicated;
+  for (auto t = firstReplicated; t < s.triangles.size(); ++t) replicated.push_back(t);
+  std::vector<pr::rt::WorkPoint> work;
+  for (int i = 0; i < 64; ++i) work.push_back({glm::vec3(-2.0f + 0.06f * float(i), 0.0f, 0.0f), 1.0f + float(i % 3)});
+  const glm::vec3 eye(0.0f, 0.5f, 5.0f);
+  const VoxelSplit made(s, {8, pr::rt::partitionMargin(s, eye), work, replicated});
+  pr::par::Bytes bytes;
+  pr::par::WireWriter w(bytes);
+  made.encode(w);
+  pr::par::WireReader r(bytes);
+  const VoxelSplit decoded = VoxelSplit::decode(r);
+  CHECK(r.remaining() == 0);
+  REQUIRE(decoded.voxels() == made.voxels());
+  CHECK(decoded.margin() == made.margin());
+  CHECK(decoded.treeBytes() == made.treeBytes());
+  for (int v = 0; v < made.voxels(); ++v) {
+    CHECK(std::ranges::equal(decoded.triangles(v), made.triangles(v)));
+    CHECK(decoded.work(v) == made.work(v));
+  }
+  CHECK(decoded.hasWork());
+  std::mt19937 rng(12);
+  std::uniform_real_distribution<float> u(-3.0f, 3.0f);
+  int reached = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Ray ray = eyeOrRandomRay(i, eye, rng, u);
+    const std::vector<VoxelSpan> a = made.spans(ray), b = decoded.spans(ray);
+    REQUIRE(a.size() == b.size());
+    const pr::rt::RaySlabs slabs(ray);
+    for (size_t k = 0; k < a.size(); ++k) {
+      CHECK(a[k].voxel == b[k].voxel);
+      CHECK(a[k].tEnter == b[k].tEnter);
+      CHECK(a[k].tExit == b[k].tExit);
+      const bool content = made.reachesContent(a[k].voxel, slabs, a[k].tEnter, a[k].tExit);
+      CHECK(decoded.reachesContent(b[k].voxel, slabs, b[k].tEnter, b[k].tExit) == content);
+      CHECK(decoded.reachesHeldOnly(b[k].voxel, slabs, b[k].tEnter, b[k].tExit) ==
+            made.reachesHeldOnly(a[k].voxel, slabs, a[k].tEnter, a[k].tExit));
+      reached += content;
+    }
+  }
+  CHECK(reached > 30);
+  pr::par::Bytes truncated(bytes.begin(), bytes.end() - 1);
+  pr::par::WireReader shortReader(truncated);
+  CHECK_THROWS_AS(VoxelSplit::decode(shortReader), pr::par::WireError);
+  pr::par::Bytes empty;
+  pr::par::WireReader emptyReader(empty);
+  CHECK_THROWS_AS(VoxelSplit::decode(emptyReader), pr::par::WireError);
+}
