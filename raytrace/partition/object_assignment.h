@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "common/parallel/wire.h"
 #include "common/scene/scene.h"
 #include "raytrace/core/ray.h"
 
@@ -63,6 +64,12 @@ class ObjectAssignment {
   std::span<const uint32_t> curveOrder() const { return curveOrder_; }
   // Bytes of the directory every PE keeps to route rays: each piece's bounds and owner.
   size_t directoryBytes() const { return pieces_.size() * (sizeof(scene::Bounds) + sizeof(int)); }
+
+  // The whole assignment as bytes (object_assignment_wire.cpp), and back: a rank that decodes
+  // it holds and routes by the same pieces as the rank that made it. decode throws
+  // par::WireError for bytes that are not an encoding.
+  void encode(par::WireWriter& w) const;
+  static ObjectAssignment decode(par::WireReader& r);
 
  private:
   std::vector<ObjectPiece> pieces_;

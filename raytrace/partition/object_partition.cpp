@@ -17,6 +17,7 @@
 // preferred-bias schedule a tile starts where its rays are answered without a message.
 #include "raytrace/partition/object_partition.h"
 
+#include <algorithm>
 #include <atomic>
 #include <memory>
 #include <vector>
@@ -113,11 +114,15 @@ class ObjectFrame {
     const int pes = rt_.pes();
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
     // The pieces, their owners, the owner directory and the tiles' probe rays, on the
-    // assembler's PE alone: a serial part of the method, timed as such.
+    // assembler's PE alone: a serial part of the method, timed as such. Across ranks the stage
+    // runs on each rank's first PE: rank 0's makes the assignment and sends it, and every rank
+    // makes the directory and the probes from it (every rank loaded the scene itself).
     std::vector<Ray> probes;
-    rt_.runOnOnePe(job_.stage("split"), kAssemblerPe, [&](par::Pe&) {
-      assignment_ = ObjectAssignment(
-          job_.scene, {pes, maxPieceTriangles_, partitionMargin(job_.scene, job_.camera.position()), replicatedFraction_});
+    rt_.runOncePerRank(job_.stage("split"), [&](par::Pe& pe) {
+      if (rt_.rank() == 0)
+        assignment_ = ObjectAssignment(
+            job_.scene, {pes, maxPieceTriangles_, partitionMargin(job_.scene, job_.camera.position()), replicatedFraction_});
+      shareAssignment(pe);
       directory_ = OwnerDirectory(assignment_);
       if (wantsTileAffinity(job_, pes)) probes = affinityProbes(*integrator_, tiles);
     });
@@ -141,7 +146,11 @@ class ObjectFrame {
       nearest = par::gatherToRoot(rt_, job_.stage("affinity"), "affinity", par::MessageKind::Results, std::move(nearest),
                                   sizeof(float), kAssemblerPe);
     std::vector<int> preferred;
-    if (!probes.empty()) preferred = preferredPes(nearestOwners(nearest, shared), tiles.size(), pes);
+    if (!probes.empty()) {
+      // Chosen where the probe hits are, on rank 0; the other ranks receive its choice.
+      preferred = rt_.rank() == 0 ? preferredPes(nearestOwners(nearest, shared), tiles.size(), pes) : std::vector<int>(tiles.size());
+      shareFromRank0(preferred);
+    }
     const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
 
     const auto total = int64_t(tiles.size());
@@ -226,6 +235,33 @@ class ObjectFrame {
     uint64_t queriesSent = 0, repliesSent = 0;
     size_t live = 0;  // pending records in use
   };
+
+  // On each rank's first PE in the split stage, across ranks: rank 0's assignment reaches
+  // every rank.
+  void shareAssignment(par::Pe& pe) {
+    if (rt_.ranks() == 1) return;
+    par::Bytes bytes;
+    if (rt_.rank() == 0) {
+      par::WireWriter w(bytes);
+      assignment_.encode(w);
+    }
+    rt_.shareFromRank0(pe, bytes);
+    if (rt_.rank() == 0) return;
+    par::WireReader r(bytes);
+    assignment_ = ObjectAssignment::decode(r);
+    if (assignment_.pes() != rt_.pes()) throw par::WireError("object partitioning: an assignment for another number of PEs");
+  }
+
+  // Between stages, across ranks: the tiles' preferred PEs, chosen on rank 0 where the probe
+  // hits were gathered, reach every rank (a sum in which only rank 0's values are not zero),
+  // so every rank's task set names the same PEs.
+  void shareFromRank0(std::vector<int>& preferred) {
+    if (rt_.ranks() == 1) return;
+    std::vector<double> values(preferred.size());
+    if (rt_.rank() == 0) std::copy(preferred.begin(), preferred.end(), values.begin());
+    rt_.sumAcrossRanks(values);
+    std::transform(values.begin(), values.end(), preferred.begin(), [](double v) { return int(v); });
+  }
 
   // The nearest hit of each probe on bvh's triangles (kInfinity: none).
   static std::vector<float> nearestHits(const Bvh& bvh, const std::vector<Ray>& probes) {

@@ -27,6 +27,8 @@ class ObjectPartition final : public Partition {
   explicit ObjectPartition(uint32_t maxPieceTriangles = 0, double replicatedFraction = kReplicatedFraction)
       : maxPieceTriangles_(maxPieceTriangles), replicatedFraction_(replicatedFraction) {}
   std::string_view name() const override { return "object"; }
+  // Queries and hit replies travel between ranks; rank 0 sends the assignment (object_partition.cpp).
+  bool runsAcrossRanks() const override { return true; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
 
  private:

@@ -70,6 +70,18 @@ TEST_CASE("RenderRanks: object-space across R = 2, 3 ranks of 1 and 2 PEs equals
                         {{2, 1}, {2, 2}, {3, 1}, {3, 2}});
 }
 
+// Object partitioning: queries go to the owners of the pieces a ray can reach and hit replies
+// come back across ranks; rank 0 makes the assignment and sends it, and chooses the tiles'
+// preferred PEs from the probe hits gathered from every rank (preferred-bias uses them).
+TEST_CASE("RenderRanks: object partitioning across R = 2, 3 ranks of 1 and 2 PEs equals the single-process image") {
+  for (const char* schedule : {"demand", "preferred-bias"}) {
+    CAPTURE(schedule);
+    checkEqualsOneProcess(std::string("object_") + schedule, "object",
+                          join({"--integrator path --width 40 --height 32 --spp 2 --tile-size 8 --schedule ", schedule}),
+                          {{2, 1}, {2, 2}, {3, 1}});
+  }
+}
+
 TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread runtime at P = 2 counts, and P = R x T") {
   const std::filesystem::path dir = pr::test::scratchDir("render_ranks_record");
   const std::string common = join({"render ", cornell(), " -m image-space --integrator path --width 48 --height 48 --spp 1 "
@@ -157,10 +169,10 @@ TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and th
 }
 
 TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {
-  const CommandResult object = mpiParrender(2, join({"render ", cornell(), " -m object --width 8 --height 8 -o /tmp/never.png"}));
-  CHECK(object.exitStatus == 2);
-  CHECK(occurrences(object.output, "method object does not run across processes yet") == 1);
-  CHECK(object.output.find("image-space") != std::string::npos);
+  const CommandResult sortFirst = mpiParrender(2, join({"render ", cornell(), " -m sort-first --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(sortFirst.exitStatus == 2);
+  CHECK(occurrences(sortFirst.output, "method sort-first does not run across processes yet") == 1);
+  CHECK(sortFirst.output.find("image-space, object-space, object") != std::string::npos);
   const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(photons.exitStatus == 2);
   CHECK(occurrences(photons.output, "--integrator photonmap does not run across processes yet") == 1);

@@ -3,10 +3,12 @@
 // non-empty list, of the stated bytes per item.
 #include <doctest/doctest.h>
 
+#include <string>
 #include <vector>
 
 #include "common/parallel/gather_to_root.h"
 #include "common/parallel/runtime.h"
+#include "tests/common/parallel/in_process_ranks.h"
 
 using namespace pr;
 
@@ -37,4 +39,22 @@ TEST_CASE("GatherToRoot: the lists reach the root by source PE, one counted mess
     CHECK(messages == uint64_t(senders));
     CHECK(bytes == sentItems * 8);
   }
+}
+
+TEST_CASE("GatherToRoot: across ranks the lists reach the root's rank by source PE, as their bytes") {
+  constexpr int kRanks = 3, kThreads = 2, kPes = kRanks * kThreads;
+  std::vector<std::vector<int>> expected(kPes);
+  for (int p = 0; p < kPes; ++p)
+    for (int i = 0; i < (p == 3 ? 0 : 5 + p); ++i) expected[size_t(p)].push_back(100 * p + i);  // PE 3 has none
+  std::vector<std::vector<std::vector<int>>> got(kRanks);
+  const auto errors = pr::test::runOnRanks(kRanks, kThreads, "demand", [&](par::Runtime& rt) {
+    std::vector<std::vector<int>> lists(kPes);
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p) lists[size_t(p)] = expected[size_t(p)];
+    got[size_t(rt.rank())] = par::gatherToRoot(rt, "merge", "items", par::MessageKind::Data, std::move(lists), 8);
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  CHECK(got[0] == expected);
+  // The other ranks sent theirs away.
+  for (int r = 1; r < kRanks; ++r)
+    for (const std::vector<int>& l : got[size_t(r)]) CHECK(l.empty());
 }

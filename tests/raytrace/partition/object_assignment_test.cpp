@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <set>
@@ -241,4 +242,68 @@ TEST_CASE("OwnerDirectory: the box test is conservative for axis-parallel and bo
   away.tMax = pr::rt::kInfinity;
   away.direction = -away.direction;
   CHECK(!reaches(away, 0.0f));
+}
+
+TEST_CASE("ObjectAssignment: an assignment decoded from its encoding holds and routes as the one made, and bad bytes are refused") {
+  pr::scene::Scene s = objectsScene({900, 100, 100, 100});
+  pr::scene::Object floor;
+  floor.firstTriangle = uint32_t(s.triangles.size());
+  floor.triangleCount = 2;
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, -50}, {50, -5, 50});
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, 50}, {-50, -5, 50});
+  s.objects.push_back(floor);
+  const ObjectAssignment made(s, {4, 0, 0.05f, 0.01});
+  REQUIRE(!made.replicated().empty());
+  pr::par::Bytes bytes;
+  pr::par::WireWriter w(bytes);
+  made.encode(w);
+  pr::par::WireReader r(bytes);
+  const ObjectAssignment decoded = ObjectAssignment::decode(r);
+  CHECK(r.remaining() == 0);
+  REQUIRE(decoded.pes() == made.pes());
+  CHECK(decoded.margin() == made.margin());
+  REQUIRE(decoded.pieces().size() == made.pieces().size());
+  for (size_t i = 0; i < made.pieces().size(); ++i) {
+    CHECK(decoded.pieces()[i].object == made.pieces()[i].object);
+    CHECK(decoded.pieces()[i].owner == made.pieces()[i].owner);
+    CHECK(decoded.pieces()[i].triangles == made.pieces()[i].triangles);
+    CHECK(decoded.pieces()[i].bounds.min == made.pieces()[i].bounds.min);
+    CHECK(decoded.pieces()[i].bounds.max == made.pieces()[i].bounds.max);
+  }
+  for (int pe = 0; pe < made.pes(); ++pe) {
+    CHECK(std::ranges::equal(decoded.triangles(pe), made.triangles(pe)));
+    CHECK(std::ranges::equal(decoded.piecesOf(pe), made.piecesOf(pe)));
+  }
+  CHECK(std::ranges::equal(decoded.replicated(), made.replicated()));
+  CHECK(std::ranges::equal(decoded.curveOrder(), made.curveOrder()));
+  // The directories made from both list the same owners for every ray.
+  const pr::rt::OwnerDirectory a(made), b(decoded);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<float> u(-2.0f, 12.0f);
+  std::vector<pr::rt::OwnerEntry> fromMade, fromDecoded;
+  std::vector<pr::rt::OwnerDirectory::NodeEntry> heap;
+  size_t listed = 0;
+  for (int i = 0; i < 200; ++i) {
+    const glm::vec3 origin(u(rng), 4.0f, u(rng) * 0.1f);
+    const Ray ray{origin, 0.0f, glm::normalize(glm::vec3(u(rng) - origin.x, -4.0f, 0.0f)), 100.0f};
+    a.ownersNearestFirst(ray, -1, fromMade, heap);
+    b.ownersNearestFirst(ray, -1, fromDecoded, heap);
+    REQUIRE(fromMade.size() == fromDecoded.size());
+    for (size_t k = 0; k < fromMade.size(); ++k) {
+      CHECK(fromMade[k].owner == fromDecoded[k].owner);
+      CHECK(fromMade[k].t == fromDecoded[k].t);
+    }
+    listed += fromMade.size();
+  }
+  CHECK(listed > 100);
+  pr::par::Bytes truncated(bytes.begin(), bytes.end() - 1);
+  pr::par::WireReader shortReader(truncated);
+  CHECK_THROWS_AS(ObjectAssignment::decode(shortReader), pr::par::WireError);
+  // A piece owner out of range (the first piece's owner follows the margin, the piece count
+  // and its object index).
+  pr::par::Bytes badOwner = bytes;
+  const std::int32_t owner = 99;
+  std::memcpy(badOwner.data() + sizeof(float) + sizeof(std::uint64_t) + sizeof(uint32_t), &owner, sizeof owner);
+  pr::par::WireReader badReader(badOwner);
+  CHECK_THROWS_AS(ObjectAssignment::decode(badReader), pr::par::WireError);
 }
