@@ -46,18 +46,12 @@ class ImageSpacePartition final : public Partition {
     if (!job.options.worldBvh)
       rt.runOncePerRank(job.stage("build"), [&](par::Pe& pe) {
         if (rt.rank() == 0) built = std::make_unique<Bvh>(job.scene, job.options.bvh);
-        if (rt.ranks() == 1) return;
-        par::Bytes bytes;
-        if (rt.rank() == 0) {
-          par::WireWriter w(bytes);
-          built->encode(w);
-        }
-        rt.shareFromRank0(pe, bytes);
-        if (rt.rank() != 0) {
-          par::WireReader r(bytes);
-          built = std::make_unique<Bvh>(
-              Bvh::decode(r, job.options.bvh.alpha ? job.options.bvh.alpha : AlphaTest::forScene(job.scene)));
-        }
+        shareEncodedFromRank0(
+            rt, pe, [&](par::WireWriter& w) { built->encode(w); },
+            [&](par::WireReader& r) {
+              built = std::make_unique<Bvh>(
+                  Bvh::decode(r, job.options.bvh.alpha ? job.options.bvh.alpha : AlphaTest::forScene(job.scene)));
+            });
       });
     const Bvh& bvh = job.options.worldBvh ? *job.options.worldBvh : *built;
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);

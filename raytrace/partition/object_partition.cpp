@@ -149,7 +149,7 @@ class ObjectFrame {
     if (!probes.empty()) {
       // Chosen where the probe hits are, on rank 0; the other ranks receive its choice.
       preferred = rt_.rank() == 0 ? preferredPes(nearestOwners(nearest, shared), tiles.size(), pes) : std::vector<int>(tiles.size());
-      shareFromRank0(preferred);
+      preferredFromRank0(preferred);
     }
     const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
 
@@ -239,23 +239,18 @@ class ObjectFrame {
   // On each rank's first PE in the split stage, across ranks: rank 0's assignment reaches
   // every rank.
   void shareAssignment(par::Pe& pe) {
-    if (rt_.ranks() == 1) return;
-    par::Bytes bytes;
-    if (rt_.rank() == 0) {
-      par::WireWriter w(bytes);
-      assignment_.encode(w);
-    }
-    rt_.shareFromRank0(pe, bytes);
-    if (rt_.rank() == 0) return;
-    par::WireReader r(bytes);
-    assignment_ = ObjectAssignment::decode(r);
-    if (assignment_.pes() != rt_.pes()) throw par::WireError("object partitioning: an assignment for another number of PEs");
+    shareEncodedFromRank0(
+        rt_, pe, [&](par::WireWriter& w) { assignment_.encode(w); },
+        [&](par::WireReader& r) {
+          assignment_ = ObjectAssignment::decode(r);
+          if (assignment_.pes() != rt_.pes()) throw par::WireError("object partitioning: an assignment for another number of PEs");
+        });
   }
 
   // Between stages, across ranks: the tiles' preferred PEs, chosen on rank 0 where the probe
   // hits were gathered, reach every rank (a sum in which only rank 0's values are not zero),
   // so every rank's task set names the same PEs.
-  void shareFromRank0(std::vector<int>& preferred) {
+  void preferredFromRank0(std::vector<int>& preferred) {
     if (rt_.ranks() == 1) return;
     std::vector<double> values(preferred.size());
     if (rt_.rank() == 0) std::copy(preferred.begin(), preferred.end(), values.begin());

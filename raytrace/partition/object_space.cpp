@@ -173,22 +173,20 @@ class ObjectSpaceFrame {
   // On each rank's first PE in the split stage, across ranks: rank 0's split, voxel owners and
   // the tiles' preferred PEs reach every rank.
   void shareSplit(par::Pe& pe, std::vector<int>& preferred) {
-    if (rt_.ranks() == 1) return;
-    par::Bytes bytes;
-    if (rt_.rank() == 0) {
-      par::WireWriter w(bytes);
-      split_.encode(w);
-      w.sequence(std::span<const int>(owners_));
-      w.sequence(std::span<const int>(preferred));
-    }
-    rt_.shareFromRank0(pe, bytes);
-    if (rt_.rank() == 0) return;
-    par::WireReader r(bytes);
-    split_ = VoxelSplit::decode(r);
-    owners_ = r.sequence<int>();
-    preferred = r.sequence<int>();
-    if (owners_.size() != size_t(split_.voxels()))
-      throw par::WireError("object-space: a voxel split whose owners do not match its voxels");
+    shareEncodedFromRank0(
+        rt_, pe,
+        [&](par::WireWriter& w) {
+          split_.encode(w);
+          w.sequence(std::span<const int>(owners_));
+          w.sequence(std::span<const int>(preferred));
+        },
+        [&](par::WireReader& r) {
+          split_ = VoxelSplit::decode(r);
+          owners_ = r.sequence<int>();
+          preferred = r.sequence<int>();
+          if (owners_.size() != size_t(split_.voxels()))
+            throw par::WireError("object-space: a voxel split whose owners do not match its voxels");
+        });
   }
 
   // On PE pe, before it traces anything: one BVH over its voxels' triangles (a triangle

@@ -16,6 +16,7 @@
 
 #include "common/parallel/runtime.h"
 #include "common/parallel/task.h"
+#include "common/parallel/wire.h"
 #include "common/util/error.h"
 #include "common/scene/poisoned_view.h"
 #include "common/scene/scene.h"
@@ -94,6 +95,23 @@ class SceneViews {
   const TraceJob& job_;
   std::vector<std::unique_ptr<scene::Scene>> views_;
 };
+
+// Inside a stage, on each rank's first PE, across ranks: what rank 0 made reaches every other
+// rank as its encoding. encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others;
+// nothing moves on one rank.
+template <class Encode, class Decode>
+void shareEncodedFromRank0(par::Runtime& rt, par::Pe& pe, Encode&& encode, Decode&& decode) {
+  if (rt.ranks() == 1) return;
+  par::Bytes bytes;
+  if (rt.rank() == 0) {
+    par::WireWriter w(bytes);
+    encode(w);
+  }
+  rt.shareFromRank0(pe, bytes);
+  if (rt.rank() == 0) return;
+  par::WireReader r(bytes);
+  decode(r);
+}
 
 // Throws pr::InputError for a ray batch size outside [1, kMaxRayBatch].
 inline void checkRayBatch(const TraceOptions& options, std::string_view method) {

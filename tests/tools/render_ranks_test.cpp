@@ -9,6 +9,7 @@
 #include <array>
 #include <filesystem>
 #include <initializer_list>
+#include <utility>
 #include <string>
 
 #include "common/image/image_io.h"
@@ -52,6 +53,23 @@ void checkEqualsOneProcess(const std::string& name, const std::string& method, c
   }
 }
 
+// The run records of `method` on the Cornell box (48x48, 1 spp, tiles of 8, a static schedule)
+// at P = 2: two PE threads in one process, and two ranks of one PE under mpirun.
+std::pair<pr::par::RunRecord, pr::par::RunRecord> threadsAndRanksRecords(const std::filesystem::path& dir,
+                                                                       const std::string& method) {
+  const std::string common = join({"render ", cornell(), " -m ", method, " --integrator path --width 48 --height 48 --spp 1 "
+                                   "--tile-size 8 --schedule balanced --quiet"});
+  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
+                                                             quoted(dir / "threads.json")}));
+  INFO(threads.output);
+  REQUIRE(threads.exitStatus == 0);
+  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
+                                                    quoted(dir / "ranks.json")}));
+  INFO(ranks.output);
+  REQUIRE(ranks.exitStatus == 0);
+  return {pr::par::readRunRecord(dir / "threads.json"), pr::par::readRunRecord(dir / "ranks.json")};
+}
+
 }  // namespace
 
 TEST_CASE("RenderRanks: image-space across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
@@ -86,16 +104,9 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
   const std::filesystem::path dir = pr::test::scratchDir("render_ranks_record");
   const std::string common = join({"render ", cornell(), " -m image-space --integrator path --width 48 --height 48 --spp 1 "
                                    "--tile-size 8 --schedule balanced --quiet"});
-  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
-                                                             quoted(dir / "threads.json")}));
-  INFO(threads.output);
-  REQUIRE(threads.exitStatus == 0);
-  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
-                                                    quoted(dir / "ranks.json")}));
-  INFO(ranks.output);
-  REQUIRE(ranks.exitStatus == 0);
-  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
-  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const auto records = threadsAndRanksRecords(dir, "image-space");  // CAPTURE cannot take a structured binding
+  const pr::par::RunRecord& t = records.first;
+  const pr::par::RunRecord& r = records.second;
   CHECK(r.pes == 2);
   REQUIRE(r.stages.size() == t.stages.size());
   for (std::size_t s = 0; s < t.stages.size(); ++s) {
@@ -131,19 +142,9 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
 // bytes, whether the PEs are threads or ranks (the number of batches is not: a batch leaves
 // when its PE runs dry).
 TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and their bytes, of the thread runtime at P = 2") {
-  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_object_record");
-  const std::string common = join({"render ", cornell(), " -m object-space --integrator path --width 48 --height 48 --spp 1 "
-                                   "--tile-size 8 --schedule balanced --quiet"});
-  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
-                                                             quoted(dir / "threads.json")}));
-  INFO(threads.output);
-  REQUIRE(threads.exitStatus == 0);
-  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
-                                                    quoted(dir / "ranks.json")}));
-  INFO(ranks.output);
-  REQUIRE(ranks.exitStatus == 0);
-  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
-  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const auto records = threadsAndRanksRecords(pr::test::scratchDir("render_ranks_object_record"), "object-space");
+  const pr::par::RunRecord& t = records.first;
+  const pr::par::RunRecord& r = records.second;
   const auto raysChannel = [](const pr::par::RunRecord& record) {
     for (const pr::par::StageRecord& stage : record.stages)
       for (const pr::par::ChannelTraffic& c : stage.channels)

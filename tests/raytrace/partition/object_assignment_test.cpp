@@ -46,6 +46,17 @@ pr::scene::Scene objectsScene(const std::vector<uint32_t>& sizes) {
   return s;
 }
 
+// A floor of two triangles under every object of s, added as one more object.
+pr::scene::Object addFloor(pr::scene::Scene& s) {
+  pr::scene::Object floor;
+  floor.firstTriangle = uint32_t(s.triangles.size());
+  floor.triangleCount = 2;
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, -50}, {50, -5, 50});
+  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, 50}, {-50, -5, 50});
+  s.objects.push_back(floor);
+  return floor;
+}
+
 }  // namespace
 
 TEST_CASE("ObjectAssignment: every triangle has exactly one owner and pieces stay within objects") {
@@ -104,12 +115,7 @@ TEST_CASE("ObjectAssignment: the small pieces rays reach most are replicated, wi
   // floor's bounds are hundreds of times larger than a soup piece's, so it is replicated first;
   // a soup piece (75 triangles) does not fit the rest of a 1% budget (12 triangles).
   pr::scene::Scene s = objectsScene({900, 100, 100, 100});
-  pr::scene::Object floor;
-  floor.firstTriangle = uint32_t(s.triangles.size());
-  floor.triangleCount = 2;
-  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, -50}, {50, -5, 50});
-  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, 50}, {-50, -5, 50});
-  s.objects.push_back(floor);
+  const pr::scene::Object floor = addFloor(s);
   const ObjectAssignment a(s, {4, 0, 0.0f, 0.01});
   REQUIRE(a.replicated().size() == 2);
   CHECK(a.replicated()[0] == floor.firstTriangle);
@@ -246,12 +252,7 @@ TEST_CASE("OwnerDirectory: the box test is conservative for axis-parallel and bo
 
 TEST_CASE("ObjectAssignment: an assignment decoded from its encoding holds and routes as the one made, and bad bytes are refused") {
   pr::scene::Scene s = objectsScene({900, 100, 100, 100});
-  pr::scene::Object floor;
-  floor.firstTriangle = uint32_t(s.triangles.size());
-  floor.triangleCount = 2;
-  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, -50}, {50, -5, 50});
-  pr::test::addTriangle(s, {-50, -5, -50}, {50, -5, 50}, {-50, -5, 50});
-  s.objects.push_back(floor);
+  addFloor(s);
   const ObjectAssignment made(s, {4, 0, 0.05f, 0.01});
   REQUIRE(!made.replicated().empty());
   pr::par::Bytes bytes;
