@@ -5,6 +5,29 @@
 
 #include "common/util/error.h"
 
+namespace pr::par {
+
+void Wire<raster::RegionFramebuffer>::encode(const raster::RegionFramebuffer& b, WireWriter& w) {
+  const size_t pixels = static_cast<size_t>(b.rect().area());
+  w.reserve(raster::regionMessageBytes(b.rect()));
+  w.value(b.rect());
+  w.raw(b.keys(), pixels * sizeof(uint64_t));
+  w.raw(b.colours(), pixels * sizeof(glm::vec3));
+}
+
+raster::RegionFramebuffer Wire<raster::RegionFramebuffer>::decode(WireReader& r) {
+  const raster::Rect rect = r.value<raster::Rect>();
+  if (rect.width() < 0 || rect.height() < 0) throw WireError("a region message names an inverted rectangle");
+  const size_t pixels = static_cast<size_t>(rect.area());
+  if (pixels > r.remaining() / raster::kRegionPixelBytes) throw WireError("a region message is shorter than its rectangle");
+  raster::RegionFramebuffer b(rect);
+  r.raw(b.keys(), pixels * sizeof(uint64_t));
+  r.raw(b.colours(), pixels * sizeof(glm::vec3));
+  return b;
+}
+
+}  // namespace pr::par
+
 namespace pr::raster {
 
 RegionFramebuffer RegionBufferPool::take(const Rect& rect) {
@@ -57,8 +80,7 @@ void FrameAssembly::deliver(par::Pe& pe, RegionFramebuffer&& region) {
     store(std::move(region));
     return;
   }
-  const size_t bytes = regionMessageBytes(region.rect());
-  regions_.sendDeclared(pe, kAssemblerPe, std::move(region), bytes);
+  regions_.send(pe, kAssemblerPe, std::move(region));
 }
 
 void FrameAssembly::deliver(par::Pe& pe, const RegionFramebuffer& src, const Rect& within) {

@@ -22,15 +22,31 @@ namespace pr::raster {
 inline constexpr int kAssemblerPe = 0;
 
 // A region message on the wire: a header naming the rectangle (x0, y0, x1, y1 as four int32)
-// and, per pixel, what the frame holds: the depth key (8 bytes) and the linear colour (three
-// floats, 12 bytes), row-major over the rectangle. The message is the drawn buffer itself
-// (moved, not copied); its triangle indices are not part of the message and not counted: the
-// assembler never reads them (they mean something only in the buffer that rasterized them).
+// and, per pixel, what the frame holds: the depth keys (8 bytes each), then the linear colours
+// (three floats, 12 bytes each), row-major over the rectangle (Wire<RegionFramebuffer> below).
+// Inside a rank the message is the drawn buffer itself (moved, not copied); its triangle
+// indices are not part of the message: the assembler never reads them (they mean something
+// only in the buffer that rasterized them), and a decoded region has none.
 inline constexpr size_t kRegionHeaderBytes = 4 * sizeof(int32_t);
+static_assert(sizeof(Rect) == kRegionHeaderBytes, "a region message's header is its Rect");
 inline constexpr size_t kRegionPixelBytes = sizeof(uint64_t) + sizeof(glm::vec3);
 inline size_t regionMessageBytes(const Rect& r) {
   return kRegionHeaderBytes + static_cast<size_t>(r.area()) * kRegionPixelBytes;
 }
+
+}  // namespace pr::raster
+
+namespace pr::par {
+template <>
+struct Wire<raster::RegionFramebuffer> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const raster::RegionFramebuffer& b) { return raster::regionMessageBytes(b.rect()); }
+  static void encode(const raster::RegionFramebuffer& b, WireWriter& w);
+  static raster::RegionFramebuffer decode(WireReader& r);
+};
+}  // namespace pr::par
+
+namespace pr::raster {
 
 // Storage for region messages, kept by a sort point from frame to frame: a sender takes a
 // buffer, draws into it and sends it; the assembler's handler, once it has stored the pixels,

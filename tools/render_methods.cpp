@@ -131,7 +131,7 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
                         last);
     if (r.progress) r.progress(frame + 1, o.frames);
   }
-  const par::RunRecord& record = r.runtime.record();
+  const par::RunRecord& record = r.runtime.gatherRecord();  // across ranks: the whole run's, on rank 0
   // The raster stages (raster/stages/shade.cpp) shade each visible pixel once: direct light
   // from punctual lights and the environment (image-based; a headlight without either) with
   // its glossy highlight, emission and textures, each skipped (and counted) when the plan has
@@ -190,6 +190,7 @@ RenderOutcome renderRaster(std::string_view name, const RenderRequest& r) {
 }
 
 bool runsAcrossRanksByName(std::string_view name) {
+  if (raster::isSortPoint(name)) return raster::makeSortPoint(name)->runsAcrossRanks();
   return rt::isPartition(name) && rt::makePartition(name)->runsAcrossRanks();
 }
 

@@ -105,8 +105,9 @@ const RenderMethodRegistry& renderMethods();
 const RenderMethod& findRenderMethod(std::string_view name);
 // "name (family): description" lines for --help.
 std::string describeRenderMethods();
-// Whether the method runs on a runtime of several ranks (mpirun): a ray tracer whose partition
-// says so (rt::Partition::runsAcrossRanks); and the names of those that do, comma-separated.
+// Whether the method runs on a runtime of several ranks (mpirun): a sort point or a ray
+// tracer whose partition says so (raster::SortPoint::runsAcrossRanks,
+// rt::Partition::runsAcrossRanks); and the names of those that do, comma-separated.
 bool runsAcrossRanks(const RenderMethod& method);
 std::string methodsAcrossRanks();
 

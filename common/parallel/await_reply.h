@@ -32,7 +32,9 @@ void waitUntil(Pe& pe, ChannelBase& serving, const std::string& what, Done&& don
       t0 = rt.now();
       continue;
     }
-    std::this_thread::yield();
+    // Across ranks a reply from another rank arrives only while some thread of this one calls
+    // the transport: this PE does, rather than wait for the controlling thread's next poll.
+    if (!rt.pumpMessages()) std::this_thread::yield();
     const double t1 = rt.now();
     pe.recordWait(t1 - t0);
     t0 = t1;

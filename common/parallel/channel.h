@@ -53,8 +53,7 @@ class Channel : public ChannelBase {
 
   // A message whose counted size the sender states instead of its encoding: for the messages
   // that do not yet carry what they are counted as (sort-first's primitive ids counted as the
-  // primitives' data, the data manager's items, the compositors' pixels without their
-  // rectangles, region buffers, a share's range counted as its primitives).
+  // primitives' data, the data manager's items, a share's range counted as its primitives).
   void sendDeclared(Pe& from, int to, T message, std::size_t bytes) {
     PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name() + "': destination PE out of range");
     const SendReceiveTimer timer(from);

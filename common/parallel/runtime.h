@@ -216,6 +216,10 @@ class Runtime {
   // waits inside itself for other PEs (a reply, a handshake) must stop waiting, since a failed
   // PE never answers; what it throws then is dropped, the first error is the one rethrown.
   bool aborting() const { return abort_.load(std::memory_order_acquire); }
+  // Inside a stage, on a PE that waits inside a task for a message from another rank: moves
+  // what has arrived from other ranks into this rank's mailboxes (one thread at a time; the
+  // others return at once). True when it did something; false on a runtime of one rank.
+  bool pumpMessages() { return ranks_ > 1 && pumpRankStage(); }
 
  private:
   struct Doorbell;

@@ -38,7 +38,7 @@ class BinarySwap : public Compositor {
     const int rounds = std::countr_zero(static_cast<unsigned>(pes));
 
     // kept[p]: the rectangle PE p still composites; its pixels stay in buffers[p].
-    std::vector<Rect> kept(pes, buffers[0].rect());
+    std::vector<Rect> kept(pes, buffers[rt.firstLocalPe()].rect());  // every PE's is full screen
     std::vector<std::vector<PixelMessage>> inbox(pes);
     std::vector<CompositeTally> counters(pes);
     for (int k = 0; k < rounds; ++k) {
@@ -52,9 +52,8 @@ class BinarySwap : public Compositor {
                     PixelMessage m = packPixels(buffers[p], keepLower ? upper : lower, drawn[p], sparse);
                     kept[p] = keepLower ? lower : upper;
                     if (sparse && m.pixels() == 0) return;  // nothing drawn there: no message
-                    const size_t bytes = m.bytes();
-                    counters[p].count(m, bytes);
-                    pixels.sendDeclared(pe, p ^ (1 << k), std::move(m), bytes);
+                    counters[p].count(m);
+                    pixels.send(pe, p ^ (1 << k), std::move(m));
                   });
       for (int p = 0; p < pes; ++p) inbox[p] = pixels.drain(p);
     }

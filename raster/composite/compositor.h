@@ -15,28 +15,58 @@
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
 #include "common/util/registry.h"
 #include "raster/framebuffer.h"
 
 namespace pr::raster {
 
 // Bytes per pixel on the wire: the fragment's depth key (8; it names the primitive, so the
-// region's owner shades it after compositing). Message headers are not counted, so
-// full-frame volumes equal the analytic b * A * (1 - 1/P) exactly.
+// region's owner shades it after compositing). A message also carries its two rectangles
+// (kPixelHeaderBytes), so a full-frame compositing step moves the analytic b * A * (1 - 1/P)
+// pixel bytes per PE plus one header per message.
 inline constexpr size_t kPixelBytes = sizeof(uint64_t);
+inline constexpr size_t kPixelHeaderBytes = 2 * sizeof(Rect);
 
 // Pixels of one rectangle of a PE's framebuffer, every pixel in row-major order. `drawn` is the
 // part of rect where the sender's buffer may hold fragments (outside it every pixel is clear,
 // so the receiver skips it). Full frame: rect is the whole region. Sparse: rect is the
 // region's bounding rectangle of what the sender drew (Ma et al. 1994), rect == drawn.
+// On the wire (Wire<PixelMessage> below): rect, drawn, then the keys.
 struct PixelMessage {
   Rect rect;
   Rect drawn;
   std::vector<uint64_t> keys;
 
   size_t pixels() const { return keys.size(); }
-  size_t bytes() const { return pixels() * kPixelBytes; }
+  size_t bytes() const { return kPixelHeaderBytes + pixels() * kPixelBytes; }
 };
+
+}  // namespace pr::raster
+
+namespace pr::par {
+template <>
+struct Wire<raster::PixelMessage> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const raster::PixelMessage& m) { return m.bytes(); }
+  static void encode(const raster::PixelMessage& m, WireWriter& w) {
+    w.value(m.rect);
+    w.value(m.drawn);
+    w.elements(std::span<const uint64_t>(m.keys));
+  }
+  static raster::PixelMessage decode(WireReader& r) {
+    raster::PixelMessage m;
+    m.rect = r.value<raster::Rect>();
+    m.drawn = r.value<raster::Rect>();
+    m.keys = r.elements<uint64_t>();
+    if (m.keys.size() != static_cast<size_t>(m.rect.area()))
+      throw WireError("a pixel message's keys do not fill its rectangle");
+    return m;
+  }
+};
+}  // namespace pr::par
+
+namespace pr::raster {
 
 // The part of fb inside region, as the sending PE packs it; drawn bounds the pixels of fb
 // that may hold fragments (every other pixel is clear).
@@ -50,10 +80,10 @@ void mergePixels(const PixelMessage& message, RegionFramebuffer& dst, Rect& dstD
 // the Channel counted, in pixels).
 struct CompositeTally {
   uint64_t pixelsSent = 0, messages = 0, bytes = 0;
-  void count(const PixelMessage& m, size_t bytesSent) {
+  void count(const PixelMessage& m) {
     pixelsSent += m.pixels();
     messages += 1;
-    bytes += bytesSent;
+    bytes += m.bytes();  // the encoding's size, as the Channel counts it
   }
 };
 void recordCompositeTallies(par::Runtime& runtime, const std::vector<CompositeTally>& tallies);
@@ -63,7 +93,8 @@ class Compositor {
   virtual ~Compositor() = default;
   virtual std::string_view name() const = 0;  // "direct-send" | "binary-swap"
   // Called by the controlling thread after every PE has rendered and shaded into buffers[pe]
-  // (full screen each; every pixel outside drawn[pe] is clear); runs its own stages, merging
+  // (full screen each; every pixel outside drawn[pe] is clear; across ranks a rank holds the
+  // buffers of its own PEs only); runs its own stages, merging
   // received pixels into the receiver's own buffer and widening its drawn[pe] by them. Returns rects: afterwards buffers[p] holds the composited pixels inside rects[p]
   // (disjoint rectangles that cover the screen; empty for a PE left without one).
   // Each PE's traffic goes to the run record (recordCompositeTallies). rowCost: the expected

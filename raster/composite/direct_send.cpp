@@ -63,7 +63,7 @@ class DirectSend : public Compositor {
   std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,
                               bool sparse, std::span<const double> rowCost) override {
     const int pes = rt.pes();
-    const Rect screen = buffers[0].rect();
+    const Rect screen = buffers[rt.firstLocalPe()].rect();  // every PE's is full screen
     // Strip i belongs to PE i (fewer strips than PEs only when the screen has fewer rows),
     // cut so that each owner expects the same shading work.
     std::vector<Rect> strips = weightedStripRegions(screen.width(), screen.height(), pes, rowCost);
@@ -77,9 +77,8 @@ class DirectSend : public Compositor {
         if (o == pe.id()) continue;
         PixelMessage m = packPixels(buffers[pe.id()], strips[o], drawn[pe.id()], sparse);
         if (sparse && m.pixels() == 0) continue;  // nothing drawn there: no message
-        const size_t bytes = m.bytes();
-        c.count(m, bytes);
-        pixels.sendDeclared(pe, o, std::move(m), bytes);
+        c.count(m);
+        pixels.send(pe, o, std::move(m));
       }
     });
 

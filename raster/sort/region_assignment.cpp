@@ -86,8 +86,8 @@ std::span<const double> TileShares::forFrame(int pes) const {
   return shares_;
 }
 
-void TileShares::learn(const RegionGrid& grid, const par::StageRecord& drawStage) {
-  const int pes = static_cast<int>(drawStage.pes.size());
+void TileShares::learn(const RegionGrid& grid, std::span<const double> busySeconds) {
+  const int pes = static_cast<int>(busySeconds.size());
   if (grid.dynamic() || pes < 2) return;
   std::vector<double> tiles(size_t(pes), 0.0);
   for (int owner : grid.owners()) tiles[size_t(owner)] += 1.0;
@@ -95,7 +95,7 @@ void TileShares::learn(const RegionGrid& grid, const par::StageRecord& drawStage
   std::vector<double> rate(size_t(pes), 0.0);
   double sum = 0.0;
   for (int p = 0; p < pes; ++p) {
-    const double busy = drawStage.pes[size_t(p)].busySeconds;
+    const double busy = busySeconds[size_t(p)];
     rate[size_t(p)] = tiles[size_t(p)] > 0.0 && busy > 0.0 ? tiles[size_t(p)] / busy : 0.0;
     sum += rate[size_t(p)];
   }

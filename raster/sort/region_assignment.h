@@ -90,8 +90,10 @@ class TileShares {
  public:
   // The shares for a frame on `pes` PEs (empty: deal equally).
   std::span<const double> forFrame(int pes) const;
-  // After the frame drawn with `grid`: learns from its draw stage's record.
-  void learn(const RegionGrid& grid, const par::StageRecord& drawStage);
+  // After the frame drawn with `grid`: learns from each PE's busy seconds in its draw stage
+  // (across ranks, every rank's PEs: the same figures on every rank, so every rank deals the
+  // next frame's tiles alike).
+  void learn(const RegionGrid& grid, std::span<const double> busySeconds);
 
  private:
   std::vector<double> shares_;

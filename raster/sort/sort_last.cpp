@@ -36,6 +36,7 @@ namespace {
 class SortLast : public SortPoint {
  public:
   std::string_view name() const override { return "sort-last"; }
+  bool runsAcrossRanks() const override { return true; }
   std::vector<ShadeCounters> takeShadeCounters() override {
     std::vector<ShadeCounters> out;
     for (int p = 0; p < pe_.size(); ++p) out.push_back(std::exchange(pe_[p].shade, {}));
@@ -95,6 +96,7 @@ class SortLast : public SortPoint {
     for (int p = 0; p < pes; ++p)
       if (pe_[p].rowCost.size() == rowCost_.size())
         for (size_t y = 0; y < rowCost_.size(); ++y) rowCost_[y] += pe_[p].rowCost[y];
+    rt.sumAcrossRanks(rowCost_);  // a rank holds its own PEs' costs: every rank cuts the same strips
     const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse, rowCost_);
 
     // Stage 3, shading of the visible fragments of each PE's region, in its own buffer.

@@ -36,6 +36,7 @@ void recordTallies(par::Runtime& rt, const par::PerPe<Tally>& tallies) {
 class SortMiddle : public SortPoint {
  public:
   std::string_view name() const override { return "sort-middle"; }
+  bool runsAcrossRanks() const override { return true; }
   std::vector<ShadeCounters> takeShadeCounters() override {
     std::vector<ShadeCounters> out;
     for (int p = 0; p < drawers_.size(); ++p) out.push_back(drawers_[p].takeShadeCounters());
@@ -114,7 +115,11 @@ class SortMiddle : public SortPoint {
       const int p = pe.id();
       drawers_[p].draw(pe, ctx, inbox[p], grid, grid.regionsOf(p), frame);
     });
-    shares_.learn(grid, rt.record().stages.back());
+    // Each rank measured its own PEs: the busy times summed across ranks are every PE's.
+    std::vector<double> busy;
+    for (const par::PeStageRecord& pe : rt.record().stages.back().pes) busy.push_back(pe.busySeconds);
+    rt.sumAcrossRanks(busy);
+    shares_.learn(grid, busy);
     recordTallies(rt, counters);
   }
 

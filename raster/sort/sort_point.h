@@ -72,6 +72,9 @@ class SortPoint {
   // The shading counters of the last frame, per PE, reset by the call (the plan's skipped work).
   virtual std::vector<ShadeCounters> takeShadeCounters() = 0;
   virtual std::string_view name() const = 0;  // "sort-first" | "sort-middle" | "sort-last"
+  // Whether renderFrame runs on a runtime whose PEs live in several ranks (mpirun): every rank
+  // calls it (SPMD), each holding its own PEs' buffers, and what crosses ranks is a message.
+  virtual bool runsAcrossRanks() const { return false; }
   // Renders one frame on the runtime's PEs into image (full screen), writing every pixel: what
   // it held before does not matter, so a caller can reuse one image from frame to frame.
   // Called by the controlling thread; runs one or more stages; may keep state between frames

@@ -37,6 +37,27 @@ constexpr Case kCases[] = {
     {"sort-first", "direct-send"}, {"sort-middle", "direct-send"}, {"sort-last", "direct-send"},
     {"sort-last", "binary-swap"}};
 
+// What leaves a rank is the region's encoding: its size is what the record counts, and the
+// decoded region holds the same keys and colours (no triangle indices); bad bytes are refused.
+TEST_CASE("FrameAssembly: a region message decodes to the keys and colours it was made of, and is counted as its encoding") {
+  RegionFramebuffer region(Rect{3, 5, 10, 9});
+  for (int y = 5; y < 9; ++y)
+    for (int x = 3; x < 10; ++x) {
+      region.keys()[region.index(x, y)] = uint64_t(x * 100 + y);
+      region.colours()[region.index(x, y)] = glm::vec3(float(x), float(y), 0.25f);
+    }
+  const par::Bytes bytes = par::encodeMessage(region);
+  CHECK(bytes.size() == regionMessageBytes(region.rect()));
+  CHECK(bytes.size() == kRegionHeaderBytes + 7 * 4 * kRegionPixelBytes);
+  const RegionFramebuffer back = par::decodeMessage<RegionFramebuffer>(bytes);
+  CHECK(identical(back, region));
+  par::Bytes shortened(bytes.begin(), bytes.end() - 1);
+  CHECK_THROWS_AS(par::decodeMessage<RegionFramebuffer>(shortened), par::WireError);
+  par::Bytes longer = bytes;
+  longer.push_back(std::byte{0});
+  CHECK_THROWS_AS(par::decodeMessage<RegionFramebuffer>(longer), par::WireError);
+}
+
 TEST_CASE("FrameAssembly: at P = 2 on static strips PE 1's region is one message of header + 64*16 pixels") {
   // Strips: PE 0 rows 0..15, PE 1 rows 16..31. Sort-last composites the same strips with
   // direct-send; binary-swap cuts 64 x 32 across its longer side into two 32 x 32 halves, PE 1

@@ -53,12 +53,15 @@ void checkEqualsOneProcess(const std::string& name, const std::string& method, c
   }
 }
 
-// The run records of `method` on the Cornell box (48x48, 1 spp, tiles of 8, a static schedule)
-// at P = 2: two PE threads in one process, and two ranks of one PE under mpirun.
+// The ray tracers' options of the record comparisons: 48x48, 1 spp, tiles of 8, a static schedule.
+const std::string kRayRecordArgs = "--integrator path --width 48 --height 48 --spp 1 --tile-size 8 --schedule balanced";
+
+// The run records of `method` on the Cornell box with `args` at P = 2: two PE threads in one
+// process, and two ranks of one PE under mpirun.
 std::pair<pr::par::RunRecord, pr::par::RunRecord> threadsAndRanksRecords(const std::filesystem::path& dir,
-                                                                       const std::string& method) {
-  const std::string common = join({"render ", cornell(), " -m ", method, " --integrator path --width 48 --height 48 --spp 1 "
-                                   "--tile-size 8 --schedule balanced --quiet"});
+                                                                       const std::string& method,
+                                                                       const std::string& args = kRayRecordArgs) {
+  const std::string common = join({"render ", cornell(), " -m ", method, " ", args, " --quiet"});
   const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
                                                              quoted(dir / "threads.json")}));
   INFO(threads.output);
@@ -68,6 +71,21 @@ std::pair<pr::par::RunRecord, pr::par::RunRecord> threadsAndRanksRecords(const s
   INFO(ranks.output);
   REQUIRE(ranks.exitStatus == 0);
   return {pr::par::readRunRecord(dir / "threads.json"), pr::par::readRunRecord(dir / "ranks.json")};
+}
+
+// The messages, and their bytes, of each channel in each stage of two records.
+void checkSameTraffic(const pr::par::RunRecord& t, const pr::par::RunRecord& r) {
+  REQUIRE(r.stages.size() == t.stages.size());
+  for (std::size_t s = 0; s < t.stages.size(); ++s) {
+    CAPTURE(t.stages[s].name);
+    CHECK(r.stages[s].name == t.stages[s].name);
+    REQUIRE(r.stages[s].channels.size() == t.stages[s].channels.size());
+    for (std::size_t c = 0; c < t.stages[s].channels.size(); ++c) {
+      CHECK(r.stages[s].channels[c].kind == t.stages[s].channels[c].kind);
+      CHECK(r.stages[s].channels[c].messages == t.stages[s].channels[c].messages);
+      CHECK(r.stages[s].channels[c].bytes == t.stages[s].channels[c].bytes);
+    }
+  }
 }
 
 }  // namespace
@@ -100,6 +118,51 @@ TEST_CASE("RenderRanks: object partitioning across R = 2, 3 ranks of 1 and 2 PEs
   }
 }
 
+// Sort-middle: screen triangles cross ranks to the regions' owners (static tiles and strips), or
+// a tile's bins are pulled from every rank by the PE the demand-driven pool gave it (dynamic);
+// the finished regions go to the assembler on rank 0.
+TEST_CASE("RenderRanks: sort-middle across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
+  for (const char* regions : {"static-tiles", "static-strips", "dynamic"}) {
+    CAPTURE(regions);
+    checkEqualsOneProcess(std::string("sort_middle_") + regions, "sort-middle",
+                          join({"--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ", regions}),
+                          {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
+  }
+}
+
+// Sort-last: every PE's fragments are depth-composited across ranks (direct-send, binary-swap;
+// full frame and sparse), each region shaded by its owner and sent to rank 0. Two frames, so
+// the second frame's strips are cut by the row costs summed across ranks.
+TEST_CASE("RenderRanks: sort-last across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
+  checkEqualsOneProcess("sort_last_direct", "sort-last", "--width 64 --height 48 --frames 2 --orbit --compositor direct-send",
+                        {{2, 1}, {2, 2}, {3, 1}, {3, 2}});
+  checkEqualsOneProcess("sort_last_swap_sparse", "sort-last",
+                        "--width 64 --height 48 --frames 2 --orbit --compositor binary-swap --sparse",
+                        {{2, 1}, {2, 2}, {4, 1}});
+}
+
+// Static regions and compositing strips are decided alike on every rank, so the sort points
+// send the same messages, of the same encoded sizes, whether the two PEs are threads or ranks;
+// the Sort/ counters agree PE by PE.
+TEST_CASE("RenderRanks: sort-middle and sort-last on 2 ranks of one PE send what the thread runtime at P = 2 sends") {
+  for (const char* method : {"sort-middle", "sort-last"}) {
+    CAPTURE(method);
+    const auto records = threadsAndRanksRecords(pr::test::scratchDir(std::string("render_ranks_record_") + method), method,
+                                                "--width 64 --height 48 --tile 16 --regions static-tiles");
+    const pr::par::RunRecord& t = records.first;
+    const pr::par::RunRecord& r = records.second;
+    CHECK(r.pes == 2);
+    checkSameTraffic(t, r);
+    for (const pr::par::CounterRecord& c : t.counters) {
+      if (c.name.rfind("Sort/", 0) != 0) continue;
+      CAPTURE(c.name);
+      const auto it = std::find_if(r.counters.begin(), r.counters.end(), [&](const pr::par::CounterRecord& x) { return x.name == c.name; });
+      REQUIRE(it != r.counters.end());
+      CHECK(it->perPe == c.perPe);
+    }
+  }
+}
+
 TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread runtime at P = 2 counts, and P = R x T") {
   const std::filesystem::path dir = pr::test::scratchDir("render_ranks_record");
   const std::string common = join({"render ", cornell(), " -m image-space --integrator path --width 48 --height 48 --spp 1 "
@@ -108,16 +171,9 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
   const pr::par::RunRecord& t = records.first;
   const pr::par::RunRecord& r = records.second;
   CHECK(r.pes == 2);
-  REQUIRE(r.stages.size() == t.stages.size());
+  checkSameTraffic(t, r);
   for (std::size_t s = 0; s < t.stages.size(); ++s) {
     CAPTURE(t.stages[s].name);
-    CHECK(r.stages[s].name == t.stages[s].name);
-    REQUIRE(r.stages[s].channels.size() == t.stages[s].channels.size());
-    for (std::size_t c = 0; c < t.stages[s].channels.size(); ++c) {
-      CHECK(r.stages[s].channels[c].kind == t.stages[s].channels[c].kind);
-      CHECK(r.stages[s].channels[c].messages == t.stages[s].channels[c].messages);
-      CHECK(r.stages[s].channels[c].bytes == t.stages[s].channels[c].bytes);
-    }
     // The world BVH is built on each rank (a replicated computation, on its first PE), once
     // on one rank; every other stage's tasks fall on the same PEs.
     const bool build = t.stages[s].name == "build";
@@ -173,7 +229,7 @@ TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one mess
   const CommandResult sortFirst = mpiParrender(2, join({"render ", cornell(), " -m sort-first --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(sortFirst.exitStatus == 2);
   CHECK(occurrences(sortFirst.output, "method sort-first does not run across processes yet") == 1);
-  CHECK(sortFirst.output.find("image-space, object-space, object") != std::string::npos);
+  CHECK(sortFirst.output.find("image-space, object-space, object, sort-middle, sort-last") != std::string::npos);
   const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(photons.exitStatus == 2);
   CHECK(occurrences(photons.output, "--integrator photonmap does not run across processes yet") == 1);

@@ -41,7 +41,7 @@ MethodClass classifyMethod(std::string_view method) {
       {"sort-last",
        {"object space: every PE renders its primitives full screen", "sort-last (after rasterization)",
         "scene replicated; depth-keyed pixels composited by region",
-        "pixels composited (pixels messages) against the analytic b A (1 - 1/P) per PE", "§5.1.1"}},
+        "pixels composited (pixels messages) against the analytic b A (1 - 1/P) per PE and a header per message", "§5.1.1"}},
   };
   const auto it = kClasses.find(method);
   if (it == kClasses.end()) throw InputError("report: method " + std::string(method) + " has no class in the seed's classification");

@@ -40,9 +40,13 @@ std::uint64_t kindBytes(const ComparisonRow& r, const std::string& kind, bool me
   return !k ? 0 : messages ? k->messages : k->bytes;
 }
 
-// The analytic compositing volume of sort-last over the full frame: b A (1 - 1/P) per PE.
-double analyticCompositeBytes(int width, int height, int pes) {
-  return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1);
+// The analytic compositing volume of sort-last over the full frame: b A (1 - 1/P) per PE, and
+// each message's header h (its two rectangles): P (P - 1) messages by direct-send, P log2 P by
+// binary-swap.
+double analyticCompositeBytes(int width, int height, int pes, const std::string& compositor) {
+  const double messages = compositor == "binary-swap" ? double(pes) * std::log2(double(pes)) : double(pes) * double(pes - 1);
+  return double(raster::kPixelBytes) * double(width) * double(height) * double(pes - 1) +
+         double(raster::kPixelHeaderBytes) * messages;
 }
 
 // What one copy of a run's broadcasts is, whatever P (the record's stages say it even at P = 1):
@@ -73,7 +77,7 @@ std::string measuredFigure(const ComparisonRow& r, int width, int height) {
            formatBytes(kindBytes(r, "primitives")) + " (P=" + std::to_string(p) + ")";
   if (m == "sort-last")
     return formatBytes(std::uint64_t(counterTotal(r, "Sort/composite_bytes"))) + " composited, analytic " +
-           formatBytes(std::uint64_t(analyticCompositeBytes(width, height, p))) + " (P=" + std::to_string(p) + ")";
+           formatBytes(std::uint64_t(analyticCompositeBytes(width, height, p, r.what.compositor))) + " (P=" + std::to_string(p) + ")";
   return "-";
 }
 
@@ -344,8 +348,8 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                           {"messages", k.messages}});
     if (r.what.method == "sort-last" && r.what.pes > 1 && !spec.settings.raster.sparse) {
       analytic.push_back({{"P", r.what.pes}, {"source", "measured"}, {"bytes", counterTotal(r, "Sort/composite_bytes")}});
-      analytic.push_back({{"P", r.what.pes}, {"source", "analytic b A (P - 1)"},
-                          {"bytes", analyticCompositeBytes(spec.width, spec.height, r.what.pes)}});
+      analytic.push_back({{"P", r.what.pes}, {"source", "analytic b A (P - 1) + h M"},
+                          {"bytes", analyticCompositeBytes(spec.width, spec.height, r.what.pes, spec.settings.raster.compositor)}});
     }
   }
   html += "<h3>Communication volume</h3><p>Bytes between PEs by kind: tasks (scheduling), primitives, rays, pixels, "

@@ -38,7 +38,15 @@ TEST_CASE("Compositor: full and sparse messages carry the same pixels, sparse on
     CHECK(m.drawn == Rect{1, 2, 3, 4});
     CHECK(m.rect == (sparse ? Rect{1, 2, 3, 4} : region));
     CHECK(m.pixels() == (sparse ? 4u : 12u));
-    CHECK(m.bytes() == m.pixels() * kPixelBytes);
+    CHECK(m.bytes() == kPixelHeaderBytes + m.pixels() * kPixelBytes);
+    CHECK(par::encodeMessage(m).size() == m.bytes());  // what is counted is what travels
+    const PixelMessage back = par::decodeMessage<PixelMessage>(par::encodeMessage(m));
+    CHECK(back.rect == m.rect);
+    CHECK(back.drawn == m.drawn);
+    CHECK(back.keys == m.keys);
+    par::Bytes truncated = par::encodeMessage(m);
+    truncated.resize(truncated.size() - kPixelBytes);  // a key short of the rectangle
+    CHECK_THROWS_AS(par::decodeMessage<PixelMessage>(truncated), par::WireError);
     RegionFramebuffer dst(Rect{0, 0, 6, 4});
     Rect dstDrawn{5, 0, 6, 1};
     mergePixels(m, dst, dstDrawn);

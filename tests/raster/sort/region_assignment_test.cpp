@@ -72,11 +72,10 @@ TEST_CASE("TileShares: a PE slower per tile gets a smaller share, and balanced t
   TileShares shares;
   CHECK(shares.forFrame(2).empty());  // the first frame deals equally
   RegionGrid grid(64, 64, RegionStrategy::StaticTiles, 16, 2);  // 8 tiles each
-  par::StageRecord draw;
-  draw.pes.resize(2);
-  draw.pes[0].busySeconds = 0.012;  // the assembler: its own tiles and the other PE's stores
-  draw.pes[1].busySeconds = 0.008;
-  shares.learn(grid, draw);
+  std::vector<double> busy(2);
+  busy[0] = 0.012;  // the assembler: its own tiles and the other PE's stores
+  busy[1] = 0.008;
+  shares.learn(grid, busy);
   REQUIRE(shares.forFrame(2).size() == 2);
   const double first0 = shares.forFrame(2)[0], first1 = shares.forFrame(2)[1];
   CHECK(first0 < 1.0);
@@ -89,9 +88,9 @@ TEST_CASE("TileShares: a PE slower per tile gets a smaller share, and balanced t
   std::vector<int> tiles(2, 0);
   for (int owner : next.owners()) ++tiles[size_t(owner)];
   CHECK(tiles[0] < tiles[1]);
-  draw.pes[0].busySeconds = 0.001 * tiles[0] / first0;
-  draw.pes[1].busySeconds = 0.001 * tiles[1] / first1;
-  shares.learn(next, draw);
+  busy[0] = 0.001 * tiles[0] / first0;
+  busy[1] = 0.001 * tiles[1] / first1;
+  shares.learn(next, busy);
   CHECK(shares.forFrame(2)[0] == doctest::Approx(first0).epsilon(0.05));
   CHECK(shares.forFrame(2)[1] == doctest::Approx(first1).epsilon(0.05));
 }

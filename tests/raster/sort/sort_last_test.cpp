@@ -36,9 +36,10 @@ void checkAnalyticVolume(const char* compositor, int pes) {
   CHECK(identical(image, renderSequential(s, view)));
   test::CounterTotals c = test::counterTotals(rt.record());
   const uint64_t area = uint64_t(kW) * kH;
-  const uint64_t perPeBytes = kPixelBytes * area * (pes - 1) / pes;  // b A (1 - 1/P)
   const uint64_t perPeMessages =
       std::string(compositor) == "direct-send" ? uint64_t(pes - 1) : uint64_t(std::countr_zero(unsigned(pes)));
+  // b A (1 - 1/P), and each message's two rectangles.
+  const uint64_t perPeBytes = kPixelBytes * area * (pes - 1) / pes + perPeMessages * kPixelHeaderBytes;
   for (int p = 0; p < pes; ++p) {
     CAPTURE(p);
     const test::StageTraffic t = test::stageTraffic(rt.record(), compositor, p);
@@ -58,7 +59,7 @@ void checkAnalyticVolume(const char* compositor, int pes) {
   CHECK(assemble.bytesSent == uint64_t(pes - 1) * (kRegionHeaderBytes + area / pes * kRegionPixelBytes));
 }
 
-TEST_CASE("SortLast: full-frame direct-send moves b*A*(1-1/P) bytes in P-1 messages per PE") {
+TEST_CASE("SortLast: full-frame direct-send moves b*A*(1-1/P) pixel bytes in P-1 messages per PE") {
   for (int pes : {1, 2, 3, 4, 8}) {
     if (pes == 3) {
       // 32 rows in 3 strips are not equal: check the totals instead (every other PE's strip).
@@ -77,7 +78,7 @@ TEST_CASE("SortLast: full-frame direct-send moves b*A*(1-1/P) bytes in P-1 messa
   }
 }
 
-TEST_CASE("SortLast: full-frame binary-swap moves b*A*(1-1/P) bytes in log2(P) messages per PE") {
+TEST_CASE("SortLast: full-frame binary-swap moves b*A*(1-1/P) pixel bytes in log2(P) messages per PE") {
   for (int pes : {1, 2, 4, 8}) checkAnalyticVolume("binary-swap", pes);
 }
 
@@ -112,7 +113,7 @@ TEST_CASE("SortLast: sparse compositing sends the bounding rectangle of what the
     CHECK(intersect(covered, sent) == covered);
     CHECK(c["Sort/pixels_sent"] == uint64_t(sent.area()));
     CHECK(c["Sort/composite_messages"] == 1);
-    CHECK(c["Sort/composite_bytes"] == uint64_t(sent.area()) * kPixelBytes);
+    CHECK(c["Sort/composite_bytes"] == kPixelHeaderBytes + uint64_t(sent.area()) * kPixelBytes);
     const test::StageTraffic t = test::stageTraffic(rt.record(), compositor);
     CHECK(t.bytesSent == c["Sort/composite_bytes"]);
     CHECK(t.bytesReceived == t.bytesSent);
