@@ -1,6 +1,7 @@
 // The scene's distribution to the raster PEs: sizes, shares and the first-frame records.
 #include "raster/scene_distribution.h"
 
+#include <stdexcept>
 #include <string>
 
 #include "common/parallel/channel.h"
@@ -37,28 +38,65 @@ void distributeReplicated(par::Runtime& rt, const scene::Scene& s) {
   }
 }
 
-void distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage) {
-  struct Share {
-    uint32_t first, end;
-  };
+PrimitiveRecord primitiveRecord(const scene::Scene& s, uint32_t id) {
+  PrimitiveRecord r;
+  r.id = id;
+  r.triangle = s.triangles[id];
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t v = r.triangle.v[k];
+    r.position[k] = s.positions[v];
+    if (v < s.normals.size()) r.normal[k] = s.normals[v];
+    if (v < s.uvs.size()) r.uv[k] = s.uvs[v];
+    if (v < s.colors.size()) r.colour[k] = s.colors[v];
+    if (v < s.tangents.size()) r.tangent[k] = s.tangents[v];
+  }
+  return r;
+}
+
+void installPrimitive(scene::Scene& view, const PrimitiveRecord& r) {
+  // A message from another rank is checked, not trusted: what it names must exist.
+  if (r.id >= view.triangles.size())
+    throw std::out_of_range("a primitive message names triangle " + std::to_string(r.id) + " of " +
+                            std::to_string(view.triangles.size()));
+  view.triangles[r.id] = r.triangle;
+  for (int k = 0; k < 3; ++k) {
+    const uint32_t v = r.triangle.v[k];
+    if (v >= view.positions.size())
+      throw std::out_of_range("a primitive message names vertex " + std::to_string(v) + " of " +
+                              std::to_string(view.positions.size()));
+    view.positions[v] = r.position[k];
+    if (v < view.normals.size()) view.normals[v] = r.normal[k];
+    if (v < view.uvs.size()) view.uvs[v] = r.uv[k];
+    if (v < view.colors.size()) view.colors[v] = r.colour[k];
+    if (v < view.tangents.size()) view.tangents[v] = r.tangent[k];
+  }
+}
+
+std::vector<std::vector<PrimitiveRecord>> distributeShares(par::Runtime& rt, const scene::Scene& s,
+                                                           std::string_view stage) {
   const uint32_t total = static_cast<uint32_t>(s.triangles.size());
   rt.recordBroadcast(shadingDataBytes(s));
-  par::Channel<Share> shares(rt, "scene geometry", par::MessageKind::Data);
+  par::Channel<std::vector<PrimitiveRecord>> shares(rt, "scene geometry", par::MessageKind::Data);
   rt.runOnEachPe(stage, [&](par::Pe& pe) {
     if (pe.id() != 0) return;
     for (int p = 1; p < rt.pes(); ++p) {
       const auto [first, end] = primitiveShare(total, p, rt.pes());
-      if (end > first) shares.sendDeclared(pe, p, Share{first, end}, size_t(end - first) * kPrimitiveBytes);
+      if (end == first) continue;
+      std::vector<PrimitiveRecord> share;
+      share.reserve(end - first);
+      for (uint32_t id = first; id < end; ++id) share.push_back(primitiveRecord(s, id));
+      shares.send(pe, p, std::move(share));
     }
   });
+  std::vector<std::vector<PrimitiveRecord>> received(size_t(rt.pes()));
   for (int p = 0; p < rt.pes(); ++p) {
-    // The message names the share's id range and is counted as the share's data, which the
-    // receiving PE reads from the scene arrays from now on (as sort-first's primitive messages).
-    shares.drain(p);
+    for (std::vector<PrimitiveRecord>& m : shares.drain(p))
+      received[size_t(p)].insert(received[size_t(p)].end(), m.begin(), m.end());
     const auto [first, end] = primitiveShare(total, p, rt.pes());
     rt.addCounter("Scene/geometry_bytes_held", p, double(uint64_t(end - first) * kPrimitiveBytes));
     rt.addCounter("Scene/primitives_held", p, double(end - first));
   }
+  return received;
 }
 
 }  // namespace pr::raster

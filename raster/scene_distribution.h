@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <string_view>
 #include <utility>
+#include <vector>
 
 #include <glm/glm.hpp>
 
@@ -20,10 +21,28 @@
 namespace pr::raster {
 
 // One primitive as a distributed sort-first holds and sends it: its id, its index triple and
-// material (scene::Triangle) and its three vertices' position, normal and uv (as the ray
-// tracers' kTriangleVertexBytes, plus the 4-byte id): 4 + 16 + 3 * (12 + 12 + 8) = 116 bytes.
-inline constexpr size_t kPrimitiveBytes =
-    sizeof(uint32_t) + sizeof(scene::Triangle) + 3 * (2 * sizeof(glm::vec3) + sizeof(glm::vec2));
+// material (scene::Triangle) and what the raster stages read of its three vertices: position,
+// normal, uv, colour and tangent (zero where the scene has none of an attribute). A message of
+// primitives is a vector of these, its encoding their bytes: 4 + 16 + 3 * (12 + 12 + 8 + 16 +
+// 16) = 212 bytes each.
+struct PrimitiveRecord {
+  uint32_t id = 0;
+  scene::Triangle triangle{};
+  glm::vec3 position[3]{};
+  glm::vec3 normal[3]{};
+  glm::vec2 uv[3]{};
+  glm::vec4 colour[3]{};
+  glm::vec4 tangent[3]{};
+};
+inline constexpr size_t kPrimitiveBytes = sizeof(PrimitiveRecord);
+static_assert(kPrimitiveBytes == 212, "PrimitiveRecord has padding: its bytes would not all be data");
+
+// The record of scene triangle id, read from s.
+PrimitiveRecord primitiveRecord(const scene::Scene& s, uint32_t id);
+// Writes what r carries into view, a copy of the scene (the same arrays, indices and
+// materials) in which the PE may hold only some primitives: the vertices' attributes of every
+// array the view has.
+void installPrimitive(scene::Scene& view, const PrimitiveRecord& r);
 
 // The scene's geometry arrays (vertices, triangles, objects) and everything else (shading data).
 uint64_t geometryBytes(const scene::Scene& s);
@@ -47,9 +66,11 @@ class SceneDistribution {
 // World model: the whole scene to every PE, counted as one broadcast per PE in the next stage.
 void distributeReplicated(par::Runtime& rt, const scene::Scene& s);
 
-// Sort-first: the shading data as a broadcast, then stage `stage` in which PE 0 sends every
-// other PE its primitiveShare as one message of share * kPrimitiveBytes (channel "scene
-// geometry", kind data); PE 0 keeps its own share.
-void distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage);
+// Sort-first: the shading data as a broadcast, then stage `stage` in which PE 0 (where the
+// scene was loaded) sends every other PE its primitiveShare as one message of records (channel
+// "scene geometry", kind data); PE 0 keeps its own share. Returns, per PE of this rank, the
+// records it received (empty for PE 0 and for PEs of other ranks).
+std::vector<std::vector<PrimitiveRecord>> distributeShares(par::Runtime& rt, const scene::Scene& s,
+                                                           std::string_view stage);
 
 }  // namespace pr::raster

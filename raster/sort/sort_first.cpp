@@ -5,18 +5,20 @@
 // (geometry again, rasterize, shade) on their regions and deliver each finished region to the
 // assembler (frame_assembly.h).
 //
-// What a primitive message costs. A distributed sort-first holds only its share of the
-// geometry, so sending a primitive means sending its data; we count exactly that: each
-// primitive in a message is kPrimitiveBytes (its id, index triple and material, and its three
-// vertices' position, normal and uv; scene_distribution.h), and the first frame counts the
-// initial distribution of the shares (distributeShares) besides the replicated shading data.
-// We chose to count the data rather than to copy it into the message because the stages
-// (shared with sort-middle and sort-last) read a primitive by id from the scene arrays: the
-// message carries the ids, and the receiver reads from the scene the very bytes the message
-// is counted as carrying. This makes sort-first's primitive traffic comparable with
-// sort-middle's 80-byte ScreenTriangles.
+// What a primitive message carries. A distributed sort-first holds only its share of the
+// geometry, so sending a primitive means sending its data: a message is a vector of
+// PrimitiveRecords (its id, index triple and material, and everything the stages read of its
+// three vertices; scene_distribution.h), counted as their bytes, and the first frame sends
+// each PE its initial share the same way (distributeShares) besides the replicated shading
+// data. A PE whose geometry is its own (every PE under mpirun, and every PE under
+// SortOptions::poisonForeignGeometry) reads only its copy of the scene, in which every vertex
+// it was not given is NaN: its initial share, then each primitive it receives, installed from
+// the message. In one process otherwise the PEs read the scene they share, in which the
+// received primitives are the very bytes the messages carried. This makes sort-first's
+// primitive traffic comparable with sort-middle's 80-byte ScreenTriangles.
 #include <algorithm>
 #include <numeric>
+#include <memory>
 #include <optional>
 #include <span>
 
@@ -91,27 +93,20 @@ void recordTallies(par::Runtime& rt, const par::PerPe<Tally>& tallies) {
   }
 }
 
-// The scene as a PE may read it for the primitives `ids` it holds or was sent: the shared one,
-// or under SortOptions::poisonForeignGeometry a copy in which only those are intact.
-class ReadableScene {
- public:
-  ReadableScene(const FrameInputs& f, std::span<const uint32_t> ids)
-      : shared_(f.scene), view_(f.options.poisonForeignGeometry ? scene::poisonedView(f.scene, ids) : nullptr) {
-    if (view_) shading_ = makeShadingContext(*view_, f.view, f.options.effects, f.options.headlight);
-  }
-  const scene::Scene& scene() const { return view_ ? *view_ : shared_; }
-  // The shading context over the same scene (deferred shading reads vertex attributes).
-  const ShadingContext& shading(const ShadingContext& shared) const { return view_ ? *shading_ : shared; }
-
- private:
-  const scene::Scene& shared_;
-  std::unique_ptr<scene::Scene> view_;
-  std::optional<ShadingContext> shading_;
-};
+// The ids of records, sorted and without repeats.
+std::vector<uint32_t> idsOf(std::span<const PrimitiveRecord> records) {
+  std::vector<uint32_t> ids;
+  ids.reserve(records.size());
+  for (const PrimitiveRecord& r : records) ids.push_back(r.id);
+  std::sort(ids.begin(), ids.end());
+  ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+  return ids;
+}
 
 class SortFirst : public SortPoint {
  public:
   std::string_view name() const override { return "sort-first"; }
+  bool runsAcrossRanks() const override { return true; }
   std::vector<ShadeCounters> takeShadeCounters() override {
     std::vector<ShadeCounters> out;
     for (int p = 0; p < drawers_.size(); ++p) out.push_back(drawers_[p].takeShadeCounters());
@@ -127,7 +122,8 @@ class SortFirst : public SortPoint {
     // The first frame on a scene and runtime hands every PE its initial share; each PE keeps
     // that share, so a later loss of coherence (below) starts again from it at no cost.
     const bool firstFrame = distribution_.firstFrame(f.scene, rt);
-    if (firstFrame) distributeShares(rt, f.scene, "sort-first distribute");
+    if (firstFrame) distribute(f, rt);
+    prepareShading(f, rt);
     FrameAssembly frame(rt, image, pool_);
     if (grid.dynamic()) {
       previous_.reset();  // no owner to keep primitives on between frames
@@ -150,7 +146,7 @@ class SortFirst : public SortPoint {
 
     par::PerPe<Tally> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
-    par::Channel<std::vector<uint32_t>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
+    par::Channel<std::vector<PrimitiveRecord>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
@@ -160,14 +156,13 @@ class SortFirst : public SortPoint {
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       Tally& c = counters[p];
-      std::vector<std::vector<uint32_t>> out(pes);
+      std::vector<std::vector<PrimitiveRecord>> out(pes);
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
       const std::vector<uint32_t>& held = held_[p];  // sorted
-      const ReadableScene readable(f, held);
-      const std::vector<Rect> now = primitiveBounds(readable.scene(), f.view, held);
-      const std::vector<Rect> then =
-          previous_ ? primitiveBounds(readable.scene(), previous_->view, held) : std::vector<Rect>();
+      const scene::Scene& geometry = geometryOf(f, p);
+      const std::vector<Rect> now = primitiveBounds(geometry, f.view, held);
+      const std::vector<Rect> then = previous_ ? primitiveBounds(geometry, previous_->view, held) : std::vector<Rect>();
       c.preTransforms += held.size() + then.size();
       for (size_t k = 0; k < held.size(); ++k) {
         const uint32_t id = held[k];
@@ -184,20 +179,17 @@ class SortFirst : public SortPoint {
         for (int o : owners) {
           if (std::binary_search(before.begin(), before.end(), o)) continue;  // already holds it
           if (o == p) continue;
-          out[o].push_back(id);
+          out[o].push_back(primitiveRecord(geometry, id));
           c.sent += 1;
         }
       }
-      for (int o = 0; o < pes; ++o) {
-        if (out[o].empty()) continue;
-        const size_t bytes = out[o].size() * kPrimitiveBytes;  // the primitives' data (see the top)
-        primitives.sendDeclared(pe, o, std::move(out[o]), bytes);
-      }
+      for (int o = 0; o < pes; ++o)
+        if (!out[o].empty()) primitives.send(pe, o, std::move(out[o]));
     });
 
-    std::vector<std::vector<uint32_t>> received(pes);
+    std::vector<std::vector<PrimitiveRecord>> received(pes);
     for (int p = 0; p < pes; ++p)
-      for (std::vector<uint32_t>& m : primitives.drain(p)) received[p].insert(received[p].end(), m.begin(), m.end());
+      for (std::vector<PrimitiveRecord>& m : primitives.drain(p)) received[p].insert(received[p].end(), m.begin(), m.end());
 
     // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
     // it holds, then rasterize and shade.
@@ -205,14 +197,15 @@ class SortFirst : public SortPoint {
     rt.runOnEachPe("sort-first render", [&](par::Pe& pe) {
       const int p = pe.id();
       std::vector<uint32_t>& mine = kept[p];
-      mine.insert(mine.end(), received[p].begin(), received[p].end());
+      install(p, received[p]);
+      const std::vector<uint32_t> got = idsOf(received[p]);
+      mine.insert(mine.end(), got.begin(), got.end());
       std::sort(mine.begin(), mine.end());
       mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
       std::vector<ScreenTriangle> tris;
-      const ReadableScene readable(f, mine);
-      transformPrimitives(readable.scene(), f.view, mine, tris);
+      transformPrimitives(geometryOf(f, p), f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
-      drawers_[p].draw(pe, readable.shading(ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
+      drawers_[p].draw(pe, shadingOf(p, ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
 
     held_ = std::move(kept);
@@ -223,28 +216,71 @@ class SortFirst : public SortPoint {
   }
 
  private:
-  // Dynamic regions: each PE pre-transforms its contiguous share and keeps the ids binned per
-  // tile; tiles are handed out on demand and the PE taking a tile pulls the ids from every PE
-  // and runs the whole pipeline on that tile (so a primitive's geometry runs once per tile).
+  // The first frame: the shares leave PE 0 as records. A PE with geometry of its own (every PE
+  // across ranks, or every PE under the poison check) starts from a copy of the scene in which
+  // only its share is intact: PE 0's from the scene it loaded, the others' from the message.
+  void distribute(const FrameInputs& f, par::Runtime& rt) {
+    std::vector<std::vector<PrimitiveRecord>> shares = distributeShares(rt, f.scene, "sort-first distribute");
+    views_.clear();
+    views_.resize(size_t(rt.pes()));
+    if (rt.ranks() == 1 && !f.options.poisonForeignGeometry) return;
+    const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p) {
+      std::vector<uint32_t> own;
+      if (p == 0) {
+        const auto [lo, hi] = primitiveShare(total, 0, rt.pes());
+        for (uint32_t i = lo; i < hi; ++i) own.push_back(i);
+      }
+      views_[size_t(p)] = scene::poisonedView(f.scene, own);
+      install(p, shares[size_t(p)]);
+    }
+  }
+
+  // The scene as PE p may read it: its own copy, or the scene the PEs share.
+  const scene::Scene& geometryOf(const FrameInputs& f, int p) const {
+    return views_.size() > size_t(p) && views_[size_t(p)] ? *views_[size_t(p)] : f.scene;
+  }
+  const ShadingContext& shadingOf(int p, const ShadingContext& shared) const {
+    return shading_.size() > size_t(p) && shading_[size_t(p)] ? *shading_[size_t(p)] : shared;
+  }
+  // Shading reads vertex attributes (deferred): over the PE's own copy where it has one. Made
+  // on the controlling thread; installing later primitives writes vertices in place.
+  void prepareShading(const FrameInputs& f, par::Runtime& rt) {
+    shading_.clear();
+    shading_.resize(size_t(rt.pes()));
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p)
+      if (views_.size() > size_t(p) && views_[size_t(p)])
+        shading_[size_t(p)].emplace(makeShadingContext(*views_[size_t(p)], f.view, f.options.effects, f.options.headlight));
+  }
+  // What PE p received goes into its copy of the scene (on p, or between stages).
+  void install(int p, std::span<const PrimitiveRecord> records) {
+    if (views_.size() <= size_t(p) || !views_[size_t(p)]) return;
+    for (const PrimitiveRecord& r : records) installPrimitive(*views_[size_t(p)], r);
+  }
+
+  // Dynamic regions: each PE pre-transforms its contiguous share and keeps the primitives
+  // binned per tile; tiles are handed out on demand and the PE taking a tile pulls them from
+  // every PE and runs the whole pipeline on that tile (so a primitive's geometry runs once per
+  // tile).
   void renderDynamic(const FrameInputs& f, par::Runtime& rt, const RegionGrid& grid, const ShadingContext& ctx,
                      FrameAssembly& frame) {
     const int pes = rt.pes();
     const int tiles = grid.regionCount();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     par::PerPe<Tally> counters(pes);
-    std::vector<std::vector<std::vector<uint32_t>>> bins(pes, std::vector<std::vector<uint32_t>>(tiles));
+    std::vector<std::vector<std::vector<PrimitiveRecord>>> bins(pes, std::vector<std::vector<PrimitiveRecord>>(tiles));
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       Tally& c = counters[p];
       const auto [lo, hi] = primitiveShare(total, p, pes);
       std::vector<uint32_t> held(hi - lo);
       std::iota(held.begin(), held.end(), lo);
-      const std::vector<Rect> bounds = primitiveBounds(ReadableScene(f, held).scene(), f.view, held);
+      const scene::Scene& geometry = geometryOf(f, p);
+      const std::vector<Rect> bounds = primitiveBounds(geometry, f.view, held);
       for (size_t k = 0; k < held.size(); ++k) {
-        const uint32_t id = held[k];
         uint64_t n = 0;
         grid.forEachOverlapped(bounds[k], [&](int r) {
-          bins[p][r].push_back(id);
+          bins[p][r].push_back(primitiveRecord(geometry, held[k]));
           ++n;
         });
         c.preTransforms += 1;
@@ -255,16 +291,16 @@ class SortFirst : public SortPoint {
 
     drawers_.resize(pes);
     {
-      TilePull<uint32_t> pull(rt, "sort-first tile", bins, kPrimitiveBytes);  // ids counted as their data
+      TilePull<PrimitiveRecord> pull(rt, "sort-first tile", bins);
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
-        std::vector<uint32_t> ids = pull.gather(pe, static_cast<int>(t));
-        std::sort(ids.begin(), ids.end());  // arrival order -> id order, for runs of ids
+        const std::vector<PrimitiveRecord> records = pull.gather(pe, static_cast<int>(t));
+        install(pe.id(), records);
+        const std::vector<uint32_t> ids = idsOf(records);  // id order, for runs of ids
         std::vector<ScreenTriangle> tris;
-        const ReadableScene readable(f, ids);
-        transformPrimitives(readable.scene(), f.view, ids, tris);
+        transformPrimitives(geometryOf(f, pe.id()), f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();
-        drawers_[pe.id()].drawOne(pe, readable.shading(ctx), tris, grid.region(static_cast<int>(t)), frame);
+        drawers_[pe.id()].drawOne(pe, shadingOf(pe.id(), ctx), tris, grid.region(static_cast<int>(t)), frame);
       });
       for (int p = 0; p < pes; ++p) counters[p].sent += pull.itemsSent(p);
     }
@@ -278,6 +314,10 @@ class SortFirst : public SortPoint {
   par::PerPe<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
   RegionBufferPool pool_;              // region message storage, kept between frames
   SceneDistribution distribution_;
+  // Per PE of this rank, its own copy of the scene (see the top), kept between frames; null
+  // where the PEs share the scene.
+  std::vector<std::unique_ptr<scene::Scene>> views_;
+  std::vector<std::optional<ShadingContext>> shading_;  // per PE, over its copy, this frame
   // Between frames: the primitives each PE holds, and the view and regions they were sorted by.
   std::vector<std::vector<uint32_t>> held_;
   std::optional<Previous> previous_;

@@ -19,24 +19,17 @@ template <class Item>
 class TilePull {
  public:
   // bins[pe][tile]: what PE pe binned for each tile; a PE reads and moves out its own only.
-  // declaredItemBytes: 0 to count a reply as its encoding, else what one item is counted as
-  // (sort-first counts a primitive id as the primitive's data, kPrimitiveBytes).
-  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins,
-           size_t declaredItemBytes = 0)
+  // A reply is counted as its encoding.
+  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins)
       : runtime_(runtime),
         bins_(bins),
         name_(name),
-        declaredItemBytes_(declaredItemBytes),
         sent_(runtime.pes(), 0),
         replies_(runtime, name + " replies", par::MessageKind::Primitives),
         requests_(runtime, name + " requests", par::MessageKind::Requests, [this](par::Pe& pe, Request&& r) {
           std::vector<Item>& bin = bins_[pe.id()][r.tile];
           sent_[pe.id()] += bin.size();
-          const size_t declared = bin.size() * declaredItemBytes_;
-          if (declaredItemBytes_ > 0)
-            replies_.sendDeclared(pe, r.pe, std::move(bin), declared);
-          else
-            replies_.send(pe, r.pe, std::move(bin));
+          replies_.send(pe, r.pe, std::move(bin));
         }) {}
 
   // Inside the task for `tile` on pe: its own bin plus every other PE's, in PE order. While it
@@ -68,7 +61,6 @@ class TilePull {
   par::Runtime& runtime_;
   std::vector<std::vector<std::vector<Item>>>& bins_;
   std::string name_;
-  size_t declaredItemBytes_;
   std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
   par::Channel<std::vector<Item>> replies_;
   par::Channel<Request> requests_;

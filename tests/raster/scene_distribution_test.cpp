@@ -5,7 +5,12 @@
 // traffic and sort-middle's screen triangles are both measured in bytes and comparable.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <memory>
+
 #include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
+#include "common/scene/poisoned_view.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/gltf_loader.h"
 #include "common/util/log.h"
@@ -51,7 +56,7 @@ TEST_CASE("SceneDistribution: sort-middle and sort-last replicate the whole scen
 
 TEST_CASE("SceneDistribution: sort-first sends each PE its share and broadcasts the shading data") {
   // Three triangles on three PEs: one each; PE 0 keeps triangle 0 and sends PEs 1 and 2 one
-  // message of one primitive each (116 bytes) in the distribute stage.
+  // message of one primitive each (kPrimitiveBytes) in the distribute stage.
   const scene::Scene s = test::threeTriangles();
   par::Runtime rt(3, "balanced");
   SortOptions options;
@@ -69,6 +74,34 @@ TEST_CASE("SceneDistribution: sort-first sends each PE its share and broadcasts 
     CHECK(test::counterTotal(rt.record(), "Scene/primitives_held", p) == 1);
     CHECK(test::counterTotal(rt.record(), "Scene/geometry_bytes_held", p) == double(kPrimitiveBytes));
   }
+}
+
+// A primitive's record carries everything the stages read of it: installed into a copy of the
+// scene in which every vertex is NaN, the triangle's vertices are the scene's again.
+TEST_CASE("SceneDistribution: a primitive record installed into a poisoned copy restores that primitive's vertices") {
+  scene::Scene s = cornell();
+  for (size_t v = 0; v < s.positions.size(); ++v) {  // every attribute present, each vertex its own
+    s.colors.push_back(glm::vec4(float(v), 0.5f, 0.25f, 1.0f));
+    s.tangents.push_back(glm::vec4(1.0f, 0.0f, float(v), -1.0f));
+  }
+  const uint32_t id = uint32_t(s.triangles.size() / 2);
+  std::unique_ptr<scene::Scene> view = scene::poisonedView(s, {});
+  const uint32_t v0 = s.triangles[id].v[0];
+  CHECK(std::isnan(view->positions[v0].x));
+  const PrimitiveRecord r = par::decodeMessage<PrimitiveRecord>(par::encodeMessage(primitiveRecord(s, id)));
+  CHECK(par::wireSize(r) == kPrimitiveBytes);
+  installPrimitive(*view, r);
+  for (uint32_t v : s.triangles[id].v) {
+    CHECK(view->positions[v] == s.positions[v]);
+    CHECK(view->normals[v] == s.normals[v]);
+    CHECK(view->uvs[v] == s.uvs[v]);
+    CHECK(view->colors[v] == s.colors[v]);
+    CHECK(view->tangents[v] == s.tangents[v]);
+  }
+  // A record naming a triangle the scene does not have is refused, not written.
+  PrimitiveRecord bad = r;
+  bad.id = uint32_t(s.triangles.size());
+  CHECK_THROWS(installPrimitive(*view, bad));
 }
 
 TEST_CASE("SceneDistribution: sort-first and sort-middle primitive traffic are both counted in bytes") {

@@ -118,6 +118,19 @@ TEST_CASE("RenderRanks: object partitioning across R = 2, 3 ranks of 1 and 2 PEs
   }
 }
 
+// Sort-first: primitives cross ranks as their data, installed into the receiving PE's own copy
+// of the scene, in which every vertex it was not given is NaN (its share came from PE 0 the
+// same way); dynamic regions pull a tile's primitives from every rank. Two orbit frames, so the
+// second sends only the primitives that changed owner.
+TEST_CASE("RenderRanks: sort-first across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
+  for (const char* regions : {"static-tiles", "dynamic"}) {
+    CAPTURE(regions);
+    checkEqualsOneProcess(std::string("sort_first_") + regions, "sort-first",
+                          join({"--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ", regions}),
+                          {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
+  }
+}
+
 // Sort-middle: screen triangles cross ranks to the regions' owners (static tiles and strips), or
 // a tile's bins are pulled from every rank by the PE the demand-driven pool gave it (dynamic);
 // the finished regions go to the assembler on rank 0.
@@ -144,8 +157,8 @@ TEST_CASE("RenderRanks: sort-last across R = 2, 3, 4 ranks of 1 and 2 PEs equals
 // Static regions and compositing strips are decided alike on every rank, so the sort points
 // send the same messages, of the same encoded sizes, whether the two PEs are threads or ranks;
 // the Sort/ counters agree PE by PE.
-TEST_CASE("RenderRanks: sort-middle and sort-last on 2 ranks of one PE send what the thread runtime at P = 2 sends") {
-  for (const char* method : {"sort-middle", "sort-last"}) {
+TEST_CASE("RenderRanks: the sort points on 2 ranks of one PE send what the thread runtime at P = 2 sends") {
+  for (const char* method : {"sort-first", "sort-middle", "sort-last"}) {
     CAPTURE(method);
     const auto records = threadsAndRanksRecords(pr::test::scratchDir(std::string("render_ranks_record_") + method), method,
                                                 "--width 64 --height 48 --tile 16 --regions static-tiles");
@@ -226,10 +239,10 @@ TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and th
 }
 
 TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {
-  const CommandResult sortFirst = mpiParrender(2, join({"render ", cornell(), " -m sort-first --width 8 --height 8 -o /tmp/never.png"}));
-  CHECK(sortFirst.exitStatus == 2);
-  CHECK(occurrences(sortFirst.output, "method sort-first does not run across processes yet") == 1);
-  CHECK(sortFirst.output.find("image-space, object-space, object, sort-middle, sort-last") != std::string::npos);
+  const CommandResult cached = mpiParrender(2, join({"render ", cornell(), " -m image-space-cached --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(cached.exitStatus == 2);
+  CHECK(occurrences(cached.output, "method image-space-cached does not run across processes yet") == 1);
+  CHECK(cached.output.find("image-space, object-space, object, sort-first, sort-middle, sort-last") != std::string::npos);
   const CommandResult photons = mpiParrender(2, join({"render ", cornell(), " --integrator photonmap --width 8 --height 8 -o /tmp/never.png"}));
   CHECK(photons.exitStatus == 2);
   CHECK(occurrences(photons.output, "--integrator photonmap does not run across processes yet") == 1);

@@ -33,11 +33,12 @@ TEST_CASE("SortFirst: three triangles on two PEs route and count exactly") {
   CHECK(c["Sort/primitives_duplicated"] == 1);
   CHECK(c["Sort/primitives_migrated"] == 0);
   CHECK(c["Sort/geometry_repeated"] == 4);  // PE 0 transforms {0, 2} again, PE 1 {1, 2}
-  // The one primitive sent travels as its data: id, index triple + material, three vertices.
+  // The one primitive sent travels as its data: id, index triple + material, and its three
+  // vertices' position, normal, uv, colour and tangent.
   const test::StageTraffic sort = test::stageTraffic(rt.record(), "sort-first pre-transform");
   CHECK(sort.messagesSent == 1);
   CHECK(sort.bytesSent == kPrimitiveBytes);
-  CHECK(kPrimitiveBytes == 116u);  // 4 + 16 + 3 * (12 + 12 + 8)
+  CHECK(kPrimitiveBytes == 212u);  // 4 + 16 + 3 * (12 + 12 + 8 + 16 + 16)
   CHECK(sort.bytesReceived == sort.bytesSent);
   // The initial distribution: PE 0 sends PE 1 its share {1, 2}, 2 primitives in one message.
   const test::StageTraffic distribute = test::stageTraffic(rt.record(), "sort-first distribute");
@@ -154,9 +155,10 @@ TEST_CASE("SortFirst: a camera move that takes one triangle from the top strip t
 }
 
 TEST_CASE("SortFirst: with every PE's foreign geometry poisoned an orbit still gives the sequential frames") {
-  // Each PE reads geometry (pre-transform, geometry again, deferred shading) from a scene copy
-  // whose vertices of primitives it neither holds nor was sent are NaN: any read of another
-  // PE's primitives outside a counted message would change the frame.
+  // Each PE reads geometry (pre-transform, geometry again, deferred shading) from its own scene
+  // copy, whose vertices of primitives it neither holds nor was sent are NaN and into which
+  // what it receives is installed from the messages: any read of another PE's primitives
+  // outside a counted message, or a message without the data, would change the frame.
   const scene::Scene s = ring();
   const scene::Camera start = test::lookAtCamera({0.0f, 4.0f, 9.0f}, {0.0f, 0.0f, 0.0f});
   for (RegionStrategy regions : {RegionStrategy::StaticTiles, RegionStrategy::StaticStrips, RegionStrategy::Dynamic}) {
