@@ -1,6 +1,7 @@
 // The scene's distribution to the raster PEs: sizes, shares and the first-frame records.
 #include "raster/scene_distribution.h"
 
+#include <numeric>
 #include <stdexcept>
 #include <string>
 
@@ -72,26 +73,33 @@ void installPrimitive(scene::Scene& view, const PrimitiveRecord& r) {
   }
 }
 
-std::vector<std::vector<PrimitiveRecord>> distributeShares(par::Runtime& rt, const scene::Scene& s,
-                                                           std::string_view stage) {
+PrimitiveRecord PrimitiveBatch::record(size_t i) const {
+  return source ? primitiveRecord(*source, ids[i]) : records[i];
+}
+
+void installPrimitives(scene::Scene& view, const PrimitiveBatch& batch) {
+  for (size_t i = 0; i < batch.size(); ++i) installPrimitive(view, batch.record(i));
+}
+
+std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage) {
   const uint32_t total = static_cast<uint32_t>(s.triangles.size());
   rt.recordBroadcast(shadingDataBytes(s));
-  par::Channel<std::vector<PrimitiveRecord>> shares(rt, "scene geometry", par::MessageKind::Data);
+  par::Channel<PrimitiveBatch> shares(rt, "scene geometry", par::MessageKind::Data);
   rt.runOnEachPe(stage, [&](par::Pe& pe) {
     if (pe.id() != 0) return;
     for (int p = 1; p < rt.pes(); ++p) {
       const auto [first, end] = primitiveShare(total, p, rt.pes());
       if (end == first) continue;
-      std::vector<PrimitiveRecord> share;
-      share.reserve(end - first);
-      for (uint32_t id = first; id < end; ++id) share.push_back(primitiveRecord(s, id));
+      PrimitiveBatch share{&s, {}, {}};
+      share.ids.resize(end - first);
+      std::iota(share.ids.begin(), share.ids.end(), first);
       shares.send(pe, p, std::move(share));
     }
   });
-  std::vector<std::vector<PrimitiveRecord>> received(size_t(rt.pes()));
+  std::vector<PrimitiveBatch> received(size_t(rt.pes()));
   for (int p = 0; p < rt.pes(); ++p) {
-    for (std::vector<PrimitiveRecord>& m : shares.drain(p))
-      received[size_t(p)].insert(received[size_t(p)].end(), m.begin(), m.end());
+    std::vector<PrimitiveBatch> messages = shares.drain(p);  // one at most
+    if (!messages.empty()) received[size_t(p)] = std::move(messages.front());
     const auto [first, end] = primitiveShare(total, p, rt.pes());
     rt.addCounter("Scene/geometry_bytes_held", p, double(uint64_t(end - first) * kPrimitiveBytes));
     rt.addCounter("Scene/primitives_held", p, double(end - first));
@@ -100,3 +108,18 @@ std::vector<std::vector<PrimitiveRecord>> distributeShares(par::Runtime& rt, con
 }
 
 }  // namespace pr::raster
+
+namespace pr::par {
+
+void Wire<raster::PrimitiveBatch>::encode(const raster::PrimitiveBatch& b, WireWriter& w) {
+  w.reserve(size(b));
+  for (size_t i = 0; i < b.size(); ++i) w.value(b.record(i));
+}
+
+raster::PrimitiveBatch Wire<raster::PrimitiveBatch>::decode(WireReader& r) {
+  raster::PrimitiveBatch b;
+  b.records = r.elements<raster::PrimitiveRecord>();
+  return b;
+}
+
+}  // namespace pr::par

@@ -16,6 +16,7 @@
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
 #include "common/scene/scene.h"
 
 namespace pr::raster {
@@ -44,6 +45,24 @@ PrimitiveRecord primitiveRecord(const scene::Scene& s, uint32_t id);
 // array the view has.
 void installPrimitive(scene::Scene& view, const PrimitiveRecord& r);
 
+// A message of primitives (sort-first). Inside a rank it names them: their ids in `source`,
+// the scene as the sender's rank loaded it, which every PE of that rank shares and nobody
+// writes, so the message stays a move and a receiver reads the very bytes it is counted as.
+// What leaves a rank is their data, a PrimitiveRecord each (Wire<PrimitiveBatch>), which the
+// receiver installs into its own copy of the scene. Counted as the records either way.
+struct PrimitiveBatch {
+  const scene::Scene* source = nullptr;  // inside a rank: where ids are read
+  std::vector<uint32_t> ids;             // with source
+  std::vector<PrimitiveRecord> records;  // without: arrived from another rank
+
+  size_t size() const { return source ? ids.size() : records.size(); }
+  uint32_t id(size_t i) const { return source ? ids[i] : records[i].id; }
+  PrimitiveRecord record(size_t i) const;
+};
+
+// Every primitive of the batch, the same.
+void installPrimitives(scene::Scene& view, const PrimitiveBatch& batch);
+
 // The scene's geometry arrays (vertices, triangles, objects) and everything else (shading data).
 uint64_t geometryBytes(const scene::Scene& s);
 uint64_t shadingDataBytes(const scene::Scene& s);
@@ -67,10 +86,19 @@ class SceneDistribution {
 void distributeReplicated(par::Runtime& rt, const scene::Scene& s);
 
 // Sort-first: the shading data as a broadcast, then stage `stage` in which PE 0 (where the
-// scene was loaded) sends every other PE its primitiveShare as one message of records (channel
-// "scene geometry", kind data); PE 0 keeps its own share. Returns, per PE of this rank, the
-// records it received (empty for PE 0 and for PEs of other ranks).
-std::vector<std::vector<PrimitiveRecord>> distributeShares(par::Runtime& rt, const scene::Scene& s,
-                                                           std::string_view stage);
+// scene was loaded) sends every other PE its primitiveShare as one message (channel "scene
+// geometry", kind data); PE 0 keeps its own share. Returns, per PE of this rank, what it
+// received (empty for PE 0 and for PEs of other ranks).
+std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage);
 
 }  // namespace pr::raster
+
+namespace pr::par {
+template <>
+struct Wire<raster::PrimitiveBatch> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const raster::PrimitiveBatch& b) { return b.size() * raster::kPrimitiveBytes; }
+  static void encode(const raster::PrimitiveBatch& b, WireWriter& w);
+  static raster::PrimitiveBatch decode(WireReader& r);
+};
+}  // namespace pr::par

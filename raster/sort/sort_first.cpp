@@ -93,14 +93,12 @@ void recordTallies(par::Runtime& rt, const par::PerPe<Tally>& tallies) {
   }
 }
 
-// The ids of records, sorted and without repeats.
-std::vector<uint32_t> idsOf(std::span<const PrimitiveRecord> records) {
-  std::vector<uint32_t> ids;
-  ids.reserve(records.size());
-  for (const PrimitiveRecord& r : records) ids.push_back(r.id);
+// The ids of the primitives of batches, appended to ids, then sorted and without repeats.
+void addIds(std::span<const PrimitiveBatch> batches, std::vector<uint32_t>& ids) {
+  for (const PrimitiveBatch& b : batches)
+    for (size_t i = 0; i < b.size(); ++i) ids.push_back(b.id(i));
   std::sort(ids.begin(), ids.end());
   ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
-  return ids;
 }
 
 class SortFirst : public SortPoint {
@@ -146,7 +144,7 @@ class SortFirst : public SortPoint {
 
     par::PerPe<Tally> counters(pes);
     std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
-    par::Channel<std::vector<PrimitiveRecord>> primitives(rt, "scene primitives", par::MessageKind::Primitives);
+    par::Channel<PrimitiveBatch> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
@@ -156,7 +154,7 @@ class SortFirst : public SortPoint {
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       Tally& c = counters[p];
-      std::vector<std::vector<PrimitiveRecord>> out(pes);
+      std::vector<PrimitiveBatch> out(pes, PrimitiveBatch{&f.scene, {}, {}});
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
       const std::vector<uint32_t>& held = held_[p];  // sorted
@@ -179,17 +177,16 @@ class SortFirst : public SortPoint {
         for (int o : owners) {
           if (std::binary_search(before.begin(), before.end(), o)) continue;  // already holds it
           if (o == p) continue;
-          out[o].push_back(primitiveRecord(geometry, id));
+          out[o].ids.push_back(id);
           c.sent += 1;
         }
       }
       for (int o = 0; o < pes; ++o)
-        if (!out[o].empty()) primitives.send(pe, o, std::move(out[o]));
+        if (out[o].size() > 0) primitives.send(pe, o, std::move(out[o]));
     });
 
-    std::vector<std::vector<PrimitiveRecord>> received(pes);
-    for (int p = 0; p < pes; ++p)
-      for (std::vector<PrimitiveRecord>& m : primitives.drain(p)) received[p].insert(received[p].end(), m.begin(), m.end());
+    std::vector<std::vector<PrimitiveBatch>> received(pes);
+    for (int p = 0; p < pes; ++p) received[p] = primitives.drain(p);
 
     // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
     // it holds, then rasterize and shade.
@@ -198,10 +195,7 @@ class SortFirst : public SortPoint {
       const int p = pe.id();
       std::vector<uint32_t>& mine = kept[p];
       install(p, received[p]);
-      const std::vector<uint32_t> got = idsOf(received[p]);
-      mine.insert(mine.end(), got.begin(), got.end());
-      std::sort(mine.begin(), mine.end());
-      mine.erase(std::unique(mine.begin(), mine.end()), mine.end());
+      addIds(received[p], mine);
       std::vector<ScreenTriangle> tris;
       transformPrimitives(geometryOf(f, p), f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
@@ -220,7 +214,7 @@ class SortFirst : public SortPoint {
   // across ranks, or every PE under the poison check) starts from a copy of the scene in which
   // only its share is intact: PE 0's from the scene it loaded, the others' from the message.
   void distribute(const FrameInputs& f, par::Runtime& rt) {
-    std::vector<std::vector<PrimitiveRecord>> shares = distributeShares(rt, f.scene, "sort-first distribute");
+    std::vector<PrimitiveBatch> shares = distributeShares(rt, f.scene, "sort-first distribute");
     views_.clear();
     views_.resize(size_t(rt.pes()));
     if (rt.ranks() == 1 && !f.options.poisonForeignGeometry) return;
@@ -232,7 +226,7 @@ class SortFirst : public SortPoint {
         for (uint32_t i = lo; i < hi; ++i) own.push_back(i);
       }
       views_[size_t(p)] = scene::poisonedView(f.scene, own);
-      install(p, shares[size_t(p)]);
+      install(p, std::span(&shares[size_t(p)], 1));
     }
   }
 
@@ -253,9 +247,9 @@ class SortFirst : public SortPoint {
         shading_[size_t(p)].emplace(makeShadingContext(*views_[size_t(p)], f.view, f.options.effects, f.options.headlight));
   }
   // What PE p received goes into its copy of the scene (on p, or between stages).
-  void install(int p, std::span<const PrimitiveRecord> records) {
+  void install(int p, std::span<const PrimitiveBatch> batches) {
     if (views_.size() <= size_t(p) || !views_[size_t(p)]) return;
-    for (const PrimitiveRecord& r : records) installPrimitive(*views_[size_t(p)], r);
+    for (const PrimitiveBatch& b : batches) installPrimitives(*views_[size_t(p)], b);
   }
 
   // Dynamic regions: each PE pre-transforms its contiguous share and keeps the primitives
@@ -268,19 +262,18 @@ class SortFirst : public SortPoint {
     const int tiles = grid.regionCount();
     const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
     par::PerPe<Tally> counters(pes);
-    std::vector<std::vector<std::vector<PrimitiveRecord>>> bins(pes, std::vector<std::vector<PrimitiveRecord>>(tiles));
+    std::vector<std::vector<PrimitiveBatch>> bins(pes, std::vector<PrimitiveBatch>(tiles, PrimitiveBatch{&f.scene, {}, {}}));
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       Tally& c = counters[p];
       const auto [lo, hi] = primitiveShare(total, p, pes);
       std::vector<uint32_t> held(hi - lo);
       std::iota(held.begin(), held.end(), lo);
-      const scene::Scene& geometry = geometryOf(f, p);
-      const std::vector<Rect> bounds = primitiveBounds(geometry, f.view, held);
+      const std::vector<Rect> bounds = primitiveBounds(geometryOf(f, p), f.view, held);
       for (size_t k = 0; k < held.size(); ++k) {
         uint64_t n = 0;
         grid.forEachOverlapped(bounds[k], [&](int r) {
-          bins[p][r].push_back(primitiveRecord(geometry, held[k]));
+          bins[p][r].ids.push_back(held[k]);
           ++n;
         });
         c.preTransforms += 1;
@@ -291,12 +284,13 @@ class SortFirst : public SortPoint {
 
     drawers_.resize(pes);
     {
-      TilePull<PrimitiveRecord> pull(rt, "sort-first tile", bins);
+      TilePull<PrimitiveBatch> pull(rt, "sort-first tile", bins);
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-first render", set, [&](par::Pe& pe, par::TaskId t) {
-        const std::vector<PrimitiveRecord> records = pull.gather(pe, static_cast<int>(t));
-        install(pe.id(), records);
-        const std::vector<uint32_t> ids = idsOf(records);  // id order, for runs of ids
+        const std::vector<PrimitiveBatch> parts = pull.gather(pe, static_cast<int>(t));
+        install(pe.id(), parts);
+        std::vector<uint32_t> ids;
+        addIds(parts, ids);  // id order, for runs of ids
         std::vector<ScreenTriangle> tris;
         transformPrimitives(geometryOf(f, pe.id()), f.view, ids, tris);
         counters[pe.id()].geometryRepeated += ids.size();

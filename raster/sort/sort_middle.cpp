@@ -154,10 +154,12 @@ class SortMiddle : public SortPoint {
 
     drawers_.resize(pes);
     {
-      TilePull<ScreenTriangle> pull(rt, "sort-middle tile", bins);
+      TilePull<std::vector<ScreenTriangle>> pull(rt, "sort-middle tile", bins);
       const par::TaskSet set = grid.regionTasks();
       rt.runStage("sort-middle rasterize", set, [&](par::Pe& pe, par::TaskId t) {
-        const std::vector<ScreenTriangle> tris = pull.gather(pe, static_cast<int>(t));
+        std::vector<std::vector<ScreenTriangle>> parts = pull.gather(pe, static_cast<int>(t));
+        std::vector<ScreenTriangle> tris = std::move(parts.front());
+        for (size_t i = 1; i < parts.size(); ++i) tris.insert(tris.end(), parts[i].begin(), parts[i].end());
         drawers_[pe.id()].drawOne(pe, ctx, tris, grid.region(static_cast<int>(t)), frame);
       });
       for (int p = 0; p < pes; ++p) counters[p].sent += pull.itemsSent(p);

@@ -15,38 +15,40 @@
 
 namespace pr::raster {
 
-template <class Item>
+// Bin: a tile's bin as one PE holds it and sends it, a message type with size() (its items):
+// std::vector<ScreenTriangle> for sort-middle, PrimitiveBatch for sort-first.
+template <class Bin>
 class TilePull {
  public:
   // bins[pe][tile]: what PE pe binned for each tile; a PE reads and moves out its own only.
   // A reply is counted as its encoding.
-  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<std::vector<Item>>>& bins)
+  TilePull(par::Runtime& runtime, const std::string& name, std::vector<std::vector<Bin>>& bins)
       : runtime_(runtime),
         bins_(bins),
         name_(name),
         sent_(runtime.pes(), 0),
         replies_(runtime, name + " replies", par::MessageKind::Primitives),
         requests_(runtime, name + " requests", par::MessageKind::Requests, [this](par::Pe& pe, Request&& r) {
-          std::vector<Item>& bin = bins_[pe.id()][r.tile];
+          Bin& bin = bins_[pe.id()][r.tile];
           sent_[pe.id()] += bin.size();
           replies_.send(pe, r.pe, std::move(bin));
         }) {}
 
-  // Inside the task for `tile` on pe: its own bin plus every other PE's, in PE order. While it
+  // Inside the task for `tile` on pe: its own bin, then every other PE's as they arrive. While it
   // waits for replies the PE answers the requests sent to it, so PEs waiting on each other
   // always make progress. When another PE's task fails the runtime aborts the stage and that
   // PE never replies: gather throws instead of waiting forever (the runtime keeps the first
   // error, so the original failure is what runStage rethrows).
-  std::vector<Item> gather(par::Pe& pe, int tile) {
+  std::vector<Bin> gather(par::Pe& pe, int tile) {
     const int pes = runtime_.pes();
-    std::vector<std::vector<Item>> parts(pes);
-    parts[pe.id()] = std::move(bins_[pe.id()][tile]);
+    std::vector<Bin> parts;
+    parts.reserve(size_t(pes));
+    parts.push_back(std::move(bins_[pe.id()][tile]));
     for (int p = 0; p < pes; ++p)
       if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()});
     const std::string what = "'" + name_ + "': the bins of tile " + std::to_string(tile);
-    for (int got = 0; got < pes - 1; ++got)
-      for (Item& item : par::awaitReply(pe, replies_, requests_, what)) parts[pe.id()].push_back(std::move(item));
-    return std::move(parts[pe.id()]);
+    for (int got = 0; got < pes - 1; ++got) parts.push_back(par::awaitReply(pe, replies_, requests_, what));
+    return parts;
   }
 
   // Items each PE sent to another PE (sum over its replies).
@@ -59,10 +61,10 @@ class TilePull {
   };
 
   par::Runtime& runtime_;
-  std::vector<std::vector<std::vector<Item>>>& bins_;
+  std::vector<std::vector<Bin>>& bins_;
   std::string name_;
   std::vector<uint64_t> sent_;  // per PE, written by that PE's handler only
-  par::Channel<std::vector<Item>> replies_;
+  par::Channel<Bin> replies_;
   par::Channel<Request> requests_;
 };
 

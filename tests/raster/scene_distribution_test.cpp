@@ -76,9 +76,10 @@ TEST_CASE("SceneDistribution: sort-first sends each PE its share and broadcasts 
   }
 }
 
-// A primitive's record carries everything the stages read of it: installed into a copy of the
-// scene in which every vertex is NaN, the triangle's vertices are the scene's again.
-TEST_CASE("SceneDistribution: a primitive record installed into a poisoned copy restores that primitive's vertices") {
+// A primitive's record carries everything the stages read of it: decoded on another rank and
+// installed into a copy of the scene in which every vertex is NaN, the triangle's vertices are
+// the scene's again. Bad bytes are refused.
+TEST_CASE("SceneDistribution: a primitive message that left its rank, installed into a poisoned copy, restores that primitive's vertices") {
   scene::Scene s = cornell();
   for (size_t v = 0; v < s.positions.size(); ++v) {  // every attribute present, each vertex its own
     s.colors.push_back(glm::vec4(float(v), 0.5f, 0.25f, 1.0f));
@@ -88,9 +89,15 @@ TEST_CASE("SceneDistribution: a primitive record installed into a poisoned copy 
   std::unique_ptr<scene::Scene> view = scene::poisonedView(s, {});
   const uint32_t v0 = s.triangles[id].v[0];
   CHECK(std::isnan(view->positions[v0].x));
-  const PrimitiveRecord r = par::decodeMessage<PrimitiveRecord>(par::encodeMessage(primitiveRecord(s, id)));
-  CHECK(par::wireSize(r) == kPrimitiveBytes);
-  installPrimitive(*view, r);
+  // A batch inside a rank names the primitive; what leaves a rank is its record.
+  const PrimitiveBatch named{&s, {id}, {}};
+  CHECK(par::wireSize(named) == kPrimitiveBytes);
+  const PrimitiveBatch arrived = par::decodeMessage<PrimitiveBatch>(par::encodeMessage(named));
+  REQUIRE(arrived.size() == 1);
+  CHECK(arrived.id(0) == id);
+  CHECK(arrived.source == nullptr);
+  const PrimitiveRecord r = arrived.records[0];
+  installPrimitives(*view, arrived);
   for (uint32_t v : s.triangles[id].v) {
     CHECK(view->positions[v] == s.positions[v]);
     CHECK(view->normals[v] == s.normals[v]);
@@ -102,6 +109,9 @@ TEST_CASE("SceneDistribution: a primitive record installed into a poisoned copy 
   PrimitiveRecord bad = r;
   bad.id = uint32_t(s.triangles.size());
   CHECK_THROWS(installPrimitive(*view, bad));
+  par::Bytes shortened = par::encodeMessage(named);
+  shortened.pop_back();
+  CHECK_THROWS_AS(par::decodeMessage<PrimitiveBatch>(shortened), par::WireError);
 }
 
 TEST_CASE("SceneDistribution: sort-first and sort-middle primitive traffic are both counted in bytes") {

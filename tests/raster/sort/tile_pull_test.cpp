@@ -29,15 +29,22 @@ Bins numberedBins(int pes, int tiles) {
   return bins;
 }
 
+// What gather returned, one list: the parts' items in order.
+std::vector<int> flatten(const std::vector<std::vector<int>>& parts) {
+  std::vector<int> all;
+  for (const std::vector<int>& part : parts) all.insert(all.end(), part.begin(), part.end());
+  return all;
+}
+
 TEST_CASE("TilePull: every PE's bin of a tile reaches the PE that takes it") {
   test::runWithTimeout(
       [] {
         par::Runtime rt(2, "demand");
         Bins bins = numberedBins(2, 4);
         std::vector<std::vector<int>> gathered(4);
-        TilePull<int> pull(rt, "test tile", bins);
+        TilePull<std::vector<int>> pull(rt, "test tile", bins);
         rt.runStage("pull", par::TaskSet::uniform(4), [&](par::Pe& pe, par::TaskId t) {
-          gathered[t] = pull.gather(pe, static_cast<int>(t));
+          gathered[t] = flatten(pull.gather(pe, static_cast<int>(t)));
           std::sort(gathered[t].begin(), gathered[t].end());
         });
         for (int t = 0; t < 4; ++t) CHECK(gathered[t] == std::vector<int>{t, 10 + t});
@@ -52,7 +59,7 @@ TEST_CASE("TilePull: a task failing on one PE ends the stage with its error, not
         Bins bins = numberedBins(2, 2);
         std::string error;
         {
-          TilePull<int> pull(rt, "test tile", bins);
+          TilePull<std::vector<int>> pull(rt, "test tile", bins);
           // Task 0 on PE 0 gathers tile 0 and waits for PE 1's reply; task 1 on PE 1 fails
           // without ever answering. A PE answers requests between its tasks or inside gather,
           // so PE 0 sends its request only once PE 1 is inside its task.
@@ -80,10 +87,10 @@ TEST_CASE("TilePull: a task failing on one PE ends the stage with its error, not
 
         // The runtime is usable again: the next stage (a fresh TilePull) gathers every bin.
         Bins again = numberedBins(2, 2);
-        TilePull<int> pull(rt, "test tile again", again);
+        TilePull<std::vector<int>> pull(rt, "test tile again", again);
         std::vector<std::vector<int>> gathered(2);
         rt.runStage("pull again", par::TaskSet::uniform(2), [&](par::Pe& pe, par::TaskId t) {
-          gathered[t] = pull.gather(pe, static_cast<int>(t));
+          gathered[t] = flatten(pull.gather(pe, static_cast<int>(t)));
           std::sort(gathered[t].begin(), gathered[t].end());
         });
         CHECK(gathered[0] == std::vector<int>{0, 10});
@@ -100,12 +107,12 @@ TEST_CASE("TilePull: the time a PE waits inside its task for a reply is waiting,
         // it, so PE 0's task lasts about 40 ms, nearly all of it spent waiting for the reply.
         par::Runtime rt(2, "demand");
         Bins bins = numberedBins(2, 2);
-        TilePull<int> pull(rt, "test tile", bins);
+        TilePull<std::vector<int>> pull(rt, "test tile", bins);
         std::atomic<bool> sleeping{false};
         rt.runPinned("pull", par::TaskSet::uniform(2), {0, 1}, [&](par::Pe& pe, par::TaskId) {
           if (pe.id() == 0) {
             while (!sleeping.load()) std::this_thread::yield();
-            CHECK(pull.gather(pe, 0).size() == 2);
+            CHECK(flatten(pull.gather(pe, 0)).size() == 2);
             return;
           }
           sleeping.store(true);
