@@ -292,7 +292,10 @@ void Runtime::driveRankStage(int stage) {
     // Debian's Open MPI moves messages only inside MPI calls (no asynchronous progress), so
     // this thread polls; it backs off to short sleeps when nothing happens, to leave the cores
     // to the PEs, which also pump between their tasks.
-    if (pumpRankStage()) {
+    // A send that has not left moves only while this rank calls MPI: no sleeping until it has
+    // (eight orbit frames of sort-middle on the hot-spot scene at 2 ranks: 0.22 s
+    // with the back-off, 0.16 s without).
+    if (pumpRankStage() || options_.transport->sending()) {
       idle = 0;
     } else if (++idle < 64) {
       std::this_thread::yield();

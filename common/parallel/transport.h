@@ -33,6 +33,9 @@ class Transport {
   virtual std::optional<Envelope> poll(int tag) = 0;
   // Waits (bounded by `seconds`) for every send to have left; false if some had not.
   virtual bool flush(double seconds) = 0;
+  // Whether a send has not left yet (it moves only while some thread of this rank calls the
+  // transport, without asynchronous progress). Any thread.
+  virtual bool sending() { return false; }
   // Ends the transport on this rank (after flush); the last call made on it.
   virtual void finalize() = 0;
   // Ends every rank of the run at once with `status` (a rank that cannot finish cleanly).

@@ -4,7 +4,9 @@
 # of one PE (mpirun on this machine) against the thread runtime at P = 2 in the same run, each
 # the fastest of --rounds rounds taking turns. The figure is the run record's wall time (first
 # stage start to last stage end: the render, not the processes' start-up). Target: within
-# 1.25x for image-space and the sort points. Methods that do not run across ranks yet say so.
+# 1.25x for image-space and the sort points. The sort points render an orbit of RANKS_FRAMES
+# frames (default 8; the first frame distributes the scene), as an animation would. Methods
+# that do not run across ranks yet say so.
 # Usage: tools/bench/ranks.sh [build-dir] [rounds]   (RANKS_METHODS="m1 m2 ..." picks methods)
 set -euo pipefail
 
@@ -32,6 +34,7 @@ for scene in "${scenes[@]}"; do
   for method in ${RANKS_METHODS:-image-space image-space-cached object-space object sort-first sort-middle sort-last}; do
     for schedule in demand balanced; do
       args=(render "$scene" -m "$method" --width 512 --height 512 --schedule "$schedule" --quiet -o "$out/image.png")
+      [[ "$method" == sort-* ]] && args+=(--frames "${RANKS_FRAMES:-8}" --orbit)
       best_threads=""
       best_ranks=""
       refused=""

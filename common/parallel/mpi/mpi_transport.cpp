@@ -55,6 +55,12 @@ class MpiTransport final : public Transport {
     return e;
   }
 
+  bool sending() override {
+    std::lock_guard lock(mutex_);
+    completeSends();
+    return !pending_.empty();
+  }
+
   // A large message moves in fragments, each only while this rank is inside MPI (no
   // asynchronous progress): test without sleeping for the first second, then every 200 us.
   bool flush(double seconds) override {
