@@ -207,8 +207,9 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
   tracer.trace(probes, kProbeTilePx);
   std::vector<double> probesPerPe(std::size_t(pes), 0.0);
   for (int p = 0; p < pes; ++p) probesPerPe[std::size_t(p)] = double(probes->perPe()[std::size_t(p)].items.size());
+  // (Across ranks rank 0 sends them on to every other rank: every rank chooses the same records.)
   std::vector<std::vector<ProbeHit>> found =
-      par::gatherToRoot(rt, "irradiance-cache probe merge", "probes", par::MessageKind::Data, takeAll(probes->perPe()), sizeof(ProbeHit));
+      par::gatherToAll(rt, "irradiance-cache probe merge", "probes", par::MessageKind::Data, takeAll(probes->perPe()), sizeof(ProbeHit));
   // Every probe, by pixel and within a pixel in the order its ray met them (one, or more
   // through partly diffuse glass): an order that does not depend on which PE found which.
   // Probes of pixel i: ordered[firstProbe[i] .. firstProbe[i + 1]).
@@ -245,13 +246,17 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     // Which of them no record of the coarser levels covers (read-only cache, every PE).
     std::vector<char> uncovered(candidates.size(), 0);
     const std::size_t tasks = (candidates.size() + kPerTask - 1) / kPerTask;
+    std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
     if (tasks > 0)
       rt.runStage("irradiance-cache coverage" + level, par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId t) {
+        ranHere[std::size_t(t)] = 1;
         for (std::size_t i = std::size_t(t) * kPerTask; i < std::min(candidates.size(), std::size_t(t + 1) * kPerTask); ++i) {
           const rt::ShadingFrame sf(candidates[i]->si);
           uncovered[i] = cache.covers(candidates[i]->si.position, sf.ns) ? 0 : 1;
         }
       });
+    par::shareWrittenAcrossRanks(rt, "irradiance-cache coverage merge" + level, "coverage", uncovered,
+                                 [&](std::size_t i) { return ranHere[i / kPerTask] != 0; });
     std::vector<const ProbeHit*> chosen;
     for (std::size_t i = 0; i < candidates.size(); ++i)
       if (uncovered[i]) chosen.push_back(candidates[i]);
@@ -265,7 +270,7 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     const auto gather = std::make_shared<const GatherProgram>(scene, camera, gw, gh, chosen, global, options.gather, pes);
     tracer.trace(gather, kGatherTilePx);
     for (int p = 0; p < pes; ++p) gatherHitsPerPe[std::size_t(p)] += double(gather->perPe()[std::size_t(p)].items.size());
-    std::vector<std::vector<GatherDeposit>> samples = par::gatherToRoot(
+    std::vector<std::vector<GatherDeposit>> samples = par::gatherToAll(
         rt, "irradiance-cache gather merge" + level, "gather samples", par::MessageKind::Data, takeAll(gather->perPe()),
         sizeof(GatherDeposit));
     std::vector<GatherDeposit> all;
@@ -283,7 +288,9 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     // The records, computed in parallel, inserted in pixel order.
     std::vector<IrradianceRecord> made(chosen.size());
     const std::size_t combineTasks = (chosen.size() + kPerTask - 1) / kPerTask;
+    std::vector<char> madeHere(combineTasks, 0);
     rt.runStage("irradiance-cache records" + level, par::TaskSet::uniform(combineTasks), [&](par::Pe&, par::TaskId t) {
+      madeHere[std::size_t(t)] = 1;
       for (std::size_t i = std::size_t(t) * kPerTask; i < std::min(chosen.size(), std::size_t(t + 1) * kPerTask); ++i) {
         const ProbeHit& p = *chosen[i];
         const rt::ShadingFrame sf(p.si);
@@ -301,6 +308,8 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
         made[i] = r;
       }
     });
+    par::shareWrittenAcrossRanks(rt, "irradiance-cache records merge" + level, "records", made,
+                                 [&](std::size_t i) { return madeHere[i / kPerTask] != 0; });
     const std::size_t before = cache.bytes();
     for (const IrradianceRecord& r : made) cache.insert(r);
     records += double(made.size());

@@ -118,6 +118,14 @@ KdTree KdTree::build(std::vector<Photon> photons, par::Runtime& runtime) {
   // README, bench_runtime): one thread builds it.
   constexpr std::size_t kMinParallelPhotons = std::size_t{1} << 15;
   if (runtime.pes() == 1 || photons.size() < kMinParallelPhotons) return build(std::move(photons));
+  if (runtime.ranks() > 1) {
+    // Across ranks every rank holds the photons (gathered to all) and a PE writes only its own
+    // rank's memory: each rank builds the whole tree on its first PE, a replicated
+    // computation (one task per rank in the record), the trees alike bit for bit.
+    KdTree tree;
+    runtime.runOncePerRank("photon-kd-build", [&](par::Pe&) { tree = build(std::move(photons)); });
+    return tree;
+  }
   KdTree tree;
   tree.nodes_.resize(photons.size());
   // Enough subtrees for the demand-driven schedule to even out the PEs (about 4 per PE; the

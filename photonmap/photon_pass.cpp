@@ -131,9 +131,10 @@ PhotonLists tracePhotonMessages(const scene::Scene& scene, const scene::Camera& 
     out.stats.tasks = std::size_t(((kWidth + kTilePx - 1) / kTilePx) * ((height + kTilePx - 1) / kTilePx));
   }
   recordPhotonCounters(rt, counts, out.stats);
-  // The stored photons travel to PE 0, which puts them in photon order.
+  // The stored photons travel to PE 0, which puts them in photon order (across ranks rank 0
+  // then sends them to every other rank, where the same maps are built from them).
   std::vector<std::vector<StoredPhoton>> merged =
-      par::gatherToRoot(rt, "photon merge", "photons", par::MessageKind::Data, std::move(perPe), kStoredBytes);
+      par::gatherToAll(rt, "photon merge", "photons", par::MessageKind::Data, std::move(perPe), kStoredBytes);
   std::vector<StoredPhoton> all;
   for (std::vector<StoredPhoton>& v : merged) all.insert(all.end(), v.begin(), v.end());
   std::sort(all.begin(), all.end(), [](const StoredPhoton& a, const StoredPhoton& b) { return a.key < b.key; });

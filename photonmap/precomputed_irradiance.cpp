@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "common/parallel/gather_to_root.h"
 #include "common/parallel/runtime.h"
 
 namespace pr::pm {
@@ -23,20 +24,22 @@ PrecomputedIrradiance PrecomputedIrradiance::build(const std::vector<Photon>& ph
   const std::size_t count = std::min(photons.size(), normals.size()) == 0 ? 0 : (photons.size() + step - 1) / step;
   if (count == 0 || normals.size() != photons.size()) return out;
   const std::size_t tasks = (count + kPointsPerTask - 1) / kPointsPerTask;
-  std::vector<std::vector<Photon>> chunks(tasks);
+  std::vector<Photon> points(count);
+  std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
   runtime.runStage("precompute irradiance", par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId task) {
     NearestPhotons scratch;
-    std::vector<Photon>& chunk = chunks[std::size_t(task)];
+    ranHere[std::size_t(task)] = 1;
     const std::size_t begin = std::size_t(task) * kPointsPerTask, end = std::min(count, begin + kPointsPerTask);
     for (std::size_t i = begin; i < end; ++i) {
       const Photon& p = photons[i * step];
       const glm::vec3& n = normals[i * step];
       const DensityEstimate e = estimateIrradiance(global, p.position, n, density, scratch);
-      chunk.push_back(Photon::make(p.position, e.irradiance, n));
+      points[i] = Photon::make(p.position, e.irradiance, n);
     }
   });
-  std::vector<Photon> points;
-  for (const std::vector<Photon>& c : chunks) points.insert(points.end(), c.begin(), c.end());
+  // Across ranks each rank computed its PEs' points: every rank gets them all.
+  par::shareWrittenAcrossRanks(runtime, "precomputed irradiance merge", "irradiance points", points,
+                               [&](std::size_t i) { return ranHere[i / kPointsPerTask] != 0; });
   out.points_ = KdTree::build(std::move(points), runtime);
   return out;
 }

@@ -89,15 +89,12 @@ std::string defaultOutput(const std::string& scene, const std::string& method) {
   return std::filesystem::path(scene).stem().string() + "_" + method + ".png";
 }
 
-// Under mpirun: the method and integrator must run across ranks (the others say so, exit 2).
-void checkAcrossRanks(const RenderMethod& method, const RenderArgs& a, int ranks) {
+// Under mpirun: the method must run across ranks (the others say so, exit 2).
+void checkAcrossRanks(const RenderMethod& method, int ranks) {
   if (ranks == 1) return;
   if (!runsAcrossRanks(method))
     throw InputError("method " + method.name + " does not run across processes yet (launched as " + std::to_string(ranks) +
                      " ranks by mpirun; methods that do: " + methodsAcrossRanks() + "); run it without mpirun, with --threads P");
-  if (a.settings.ray.integrator == "photonmap")
-    throw InputError("--integrator photonmap does not run across processes yet (launched as " + std::to_string(ranks) +
-                     " ranks by mpirun); run it without mpirun, with --threads P");
 }
 
 void run(RenderArgs& a) {
@@ -105,7 +102,7 @@ void run(RenderArgs& a) {
   checkFamilyOptions(method, a.family);
   // Under mpirun, --threads is each rank's: P = R x T PEs, and rank 0 writes and prints.
   par::ProcessGroup& group = par::ProcessGroup::get();
-  checkAcrossRanks(method, a, group.ranks());
+  checkAcrossRanks(method, group.ranks());
   const bool writes = group.rank() == 0;
   const int pes = group.ranks() * a.threads;
   checkRenderMemory(method, a.width, a.height, a.threads, samplesPerPixel(a.settings.ray));

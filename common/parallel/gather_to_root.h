@@ -70,4 +70,52 @@ std::vector<std::vector<T>> gatherToRoot(Runtime& rt, std::string_view stage, st
   return out;
 }
 
+// gatherToRoot to PE 0, then, across ranks, the lists rank 0 holds are sent to every other rank
+// in a stage of their own (`stage` + " share": a real broadcast of their bytes, from rank 0 to
+// each rank's first PE), so every rank returns the lists indexed by source PE: what a pre-pass
+// needs where every rank then builds the same thing from them. On one rank it is gatherToRoot.
+template <class T>
+  requires std::is_trivially_copyable_v<T>
+std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std::string channel, MessageKind kind,
+                                        std::vector<std::vector<T>> perPe, std::size_t bytesPerItem) {
+  std::vector<std::vector<T>> out = gatherToRoot(rt, stage, std::move(channel), kind, std::move(perPe), bytesPerItem);
+  if (rt.ranks() == 1) return out;
+  rt.runOncePerRank(std::string(stage) + " share", [&](Pe& pe) {
+    Bytes bytes;
+    if (rt.rank() == 0) {
+      WireWriter w(bytes);
+      for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
+    }
+    rt.shareFromRank0(pe, bytes);
+    if (rt.rank() == 0) return;
+    WireReader r(bytes);
+    for (std::vector<T>& list : out) list = r.sequence<T>();
+    if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
+  });
+  return out;
+}
+
+// Across ranks, after a stage in which the task that owns index i wrote values[i] on whichever
+// rank ran it: every rank gets every value (the indices this rank wrote, mine(i), gathered to
+// rank 0 and shared, gatherToAll). On one rank every value is in place already: nothing moves.
+template <class T, class Mine>
+  requires std::is_trivially_copyable_v<T>
+void shareWrittenAcrossRanks(Runtime& rt, std::string_view stage, std::string channel, std::vector<T>& values,
+                             Mine&& mine) {
+  if (rt.ranks() == 1) return;
+  struct At {
+    std::uint32_t index;
+    T value;
+  };
+  std::vector<std::vector<At>> perPe(std::size_t(rt.pes()));
+  std::vector<At>& list = perPe[std::size_t(rt.firstLocalPe())];
+  for (std::size_t i = 0; i < values.size(); ++i)
+    if (mine(i)) list.push_back({std::uint32_t(i), values[i]});
+  for (const std::vector<At>& from : gatherToAll(rt, stage, std::move(channel), MessageKind::Data, std::move(perPe), sizeof(At)))
+    for (const At& a : from) {
+      if (a.index >= values.size()) throw WireError("a shared value's index is out of range");
+      values[a.index] = a.value;
+    }
+}
+
 }  // namespace pr::par
