@@ -58,3 +58,43 @@ TEST_CASE("GatherToRoot: across ranks the lists reach the root's rank by source 
   for (int r = 1; r < kRanks; ++r)
     for (const std::vector<int>& l : got[size_t(r)]) CHECK(l.empty());
 }
+
+// gatherToAll: every rank ends with every PE's list, as root's rank holds them.
+TEST_CASE("GatherToRoot: gatherToAll gives every rank every PE's list, by source PE") {
+  constexpr int kRanks = 3, kThreads = 2, kPes = kRanks * kThreads;
+  std::vector<std::vector<int>> expected(kPes);
+  for (int p = 0; p < kPes; ++p)
+    for (int i = 0; i < (p == 4 ? 0 : 3 + p); ++i) expected[size_t(p)].push_back(100 * p + i);  // PE 4 has none
+  std::vector<std::vector<std::vector<int>>> got(kRanks);
+  const auto errors = pr::test::runOnRanks(kRanks, kThreads, "demand", [&](par::Runtime& rt) {
+    std::vector<std::vector<int>> lists(kPes);
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p) lists[size_t(p)] = expected[size_t(p)];
+    got[size_t(rt.rank())] = par::gatherToAll(rt, "merge", "items", par::MessageKind::Data, std::move(lists), 4);
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  for (int r = 0; r < kRanks; ++r) CHECK(got[size_t(r)] == expected);
+}
+
+// shareWrittenAcrossRanks: each rank wrote the values of the tasks its PEs ran (here: index i
+// on rank i mod R, the others left at -1); afterwards every rank holds every value. On one
+// rank nothing moves and nothing is counted.
+TEST_CASE("GatherToRoot: values written where their tasks ran reach every rank") {
+  constexpr int kRanks = 3, kThreads = 1, kValues = 17;
+  std::vector<std::vector<double>> got(kRanks);
+  const auto errors = pr::test::runOnRanks(kRanks, kThreads, "demand", [&](par::Runtime& rt) {
+    std::vector<double> values(kValues, -1.0);
+    for (int i = 0; i < kValues; ++i)
+      if (i % kRanks == rt.rank()) values[size_t(i)] = 0.5 * i;
+    par::shareWrittenAcrossRanks(rt, "share", "values", values,
+                                 [&](std::size_t i) { return int(i) % kRanks == rt.rank(); });
+    got[size_t(rt.rank())] = values;
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  for (int r = 0; r < kRanks; ++r)
+    for (int i = 0; i < kValues; ++i) CHECK(got[size_t(r)][size_t(i)] == 0.5 * i);
+  par::Runtime one(2, "demand");
+  std::vector<double> values{1.0, 2.0};
+  par::shareWrittenAcrossRanks(one, "share", "values", values, [](std::size_t) { return true; });
+  CHECK(values == std::vector<double>{1.0, 2.0});
+  CHECK(one.record().stages.empty());
+}
