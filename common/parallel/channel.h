@@ -89,6 +89,11 @@ class Channel : public ChannelBase {
     return all;
   }
 
+  // For a message type whose decoding needs what only the receiver has (the scene an item's
+  // BVH is tested against): how a message from another rank is decoded, instead of Wire<T>.
+  // Set before the stage whose messages need it.
+  void decodeWith(std::function<T(WireReader&)> decoder) { decoder_ = std::move(decoder); }
+
   bool pending(int pe) const override { return boxes_[pe]->size.load(std::memory_order_acquire) > 0; }
 
   bool handleOne(Pe& pe) override {
@@ -103,7 +108,7 @@ class Channel : public ChannelBase {
 
   void deliver(int from, int to, std::span<const std::byte> encoding, std::size_t counted) override {
     if constexpr (HasWire<T>) {
-      T message = decodeMessage<T>(encoding);
+      T message = decoder_ ? decodeWithDecoder(encoding) : decodeMessage<T>(encoding);
       (void)from;
       runtime_.countReceived(to, counted);
       if (handler_) runtime_.outstanding().add();
@@ -142,6 +147,13 @@ class Channel : public ChannelBase {
     }
   }
 
+  T decodeWithDecoder(std::span<const std::byte> encoding) const {
+    WireReader r(encoding);
+    T message = decoder_(r);
+    if (r.remaining() != 0) throw WireError(std::to_string(r.remaining()) + " bytes left over after a message");
+    return message;
+  }
+
   bool pop(int pe, std::optional<T>& out) {
     Mailbox& box = *boxes_[pe];
     if (box.size.load(std::memory_order_acquire) == 0) return false;
@@ -155,6 +167,7 @@ class Channel : public ChannelBase {
 
   Runtime& runtime_;
   Handler handler_;
+  std::function<T(WireReader&)> decoder_;
   std::vector<std::unique_ptr<Mailbox>> boxes_;
 };
 

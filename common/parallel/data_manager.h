@@ -119,6 +119,35 @@ class DataCache {
   std::unordered_map<ItemId, typename std::list<Entry>::iterator> index_;
 };
 
+// The reply to a fetch request: the item and when it is usable (runtime time of the requester,
+// for the simulated latency).
+template <class T>
+struct ItemReply {
+  ItemId item = 0;
+  T value{};
+  double readyAt = 0.0;
+};
+
+// On the wire: item id, readyAt, then the item as Wire<T> encodes it.
+template <class T>
+  requires HasWire<T>
+struct Wire<ItemReply<T>> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const ItemReply<T>& r) { return sizeof r.item + sizeof r.readyAt + Wire<T>::size(r.value); }
+  static void encode(const ItemReply<T>& r, WireWriter& w) {
+    w.value(r.item);
+    w.value(r.readyAt);
+    Wire<T>::encode(r.value, w);
+  }
+  static ItemReply<T> decode(WireReader& r) {
+    ItemReply<T> reply;
+    reply.item = r.value<ItemId>();
+    reply.readyAt = r.value<double>();
+    reply.value = Wire<T>::decode(r);
+    return reply;
+  }
+};
+
 // Items of a partition move only as messages: a PE that misses sends a request ("<name>
 // requests", kind requests) to the item's owner, whose PE serves it in a message handler from
 // its own partition and sends the item back ("<name> items", kind data). The requesting PE
@@ -149,6 +178,18 @@ class DataManager {
   }
 
   int owner(ItemId item) const { return owners_.owner(item); }
+
+  // Across ranks, for an item type whose decoding needs the receiver's context (the scene):
+  // how an item that arrived from another rank is made from its encoding. Between stages.
+  void decodeItemsWith(std::function<T(WireReader&)> decode) {
+    items_.decodeWith([decode = std::move(decode)](WireReader& r) {
+      Reply reply;
+      reply.item = r.value<ItemId>();
+      reply.readyAt = r.value<double>();
+      reply.value = decode(r);
+      return reply;
+    });
+  }
 
   // A simulated one-way network latency for requests and replies: a reply is usable no sooner
   // than 2 x latency after its request was sent (later when the owner was busy). Between
@@ -266,11 +307,7 @@ class DataManager {
     int requester;
     double sentAt = 0.0;  // runtime time, for the simulated latency
   };
-  struct Reply {
-    ItemId item = 0;
-    T value{};
-    double readyAt = 0.0;  // usable from this runtime time on (simulated latency)
-  };
+  using Reply = ItemReply<T>;
   // Per PE: the requests of tryAcquire still out, the replies received but still travelling
   // (simulated latency), and the last arrival the cache could not hold.
   struct Async {
@@ -285,7 +322,11 @@ class DataManager {
   // On the owner's PE, in the request handler: the item from its own partition, sent back.
   void serve(Pe& owner, const Request& r) {
     const double now = owner.runtime().now();
-    Reply reply{r.item, load_(owner, r.item), std::max(now, r.sentAt + latency_) + latency_};
+    // A requester on another rank reads readyAt on its own clock: its request's time plus the
+    // two latencies (the owner's busy time there is real, not simulated).
+    const double readyAt = owner.runtime().isLocal(r.requester) ? std::max(now, r.sentAt + latency_) + latency_
+                                                                 : r.sentAt + 2.0 * latency_;
+    Reply reply{r.item, load_(owner, r.item), readyAt};
     const std::size_t bytes = bytes_ ? bytes_(reply.value) : sizeof(T);
     items_.sendDeclared(owner, r.requester, std::move(reply), bytes);
   }

@@ -152,6 +152,8 @@ class Bvh {
   // used). decode throws par::WireError on bytes that are not one BVH.
   void encode(par::WireWriter& w) const;
   static Bvh decode(par::WireReader& r, std::shared_ptr<const AlphaTest> alpha);
+  // The size of that encoding, without making it.
+  std::size_t encodedBytes() const;
 
  private:
   void build(std::span<const glm::vec3> positions, std::span<const scene::Triangle> triangles,

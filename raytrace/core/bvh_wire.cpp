@@ -12,9 +12,13 @@ namespace pr::rt {
 static_assert(std::is_trivially_copyable_v<BvhNode> && std::is_trivially_copyable_v<BvhLeafBlock>);
 static_assert(std::is_trivially_copyable_v<scene::Bounds> && std::is_trivially_copyable_v<BvhStats>);
 
+std::size_t Bvh::encodedBytes() const {
+  return sizeof root_ + sizeof bounds_ + sizeof magnitude_ + sizeof stats_ + 2 * sizeof(uint64_t) +
+         nodes_.size() * sizeof(BvhNode) + leafBlocks_.size() * sizeof(BvhLeafBlock);
+}
+
 void Bvh::encode(par::WireWriter& w) const {
-  w.reserve(sizeof root_ + sizeof bounds_ + sizeof magnitude_ + sizeof stats_ + 2 * sizeof(uint64_t) +
-            nodes_.size() * sizeof(BvhNode) + leafBlocks_.size() * sizeof(BvhLeafBlock));
+  w.reserve(encodedBytes());
   w.value(root_);
   w.value(bounds_);
   w.value(magnitude_);

@@ -15,14 +15,19 @@
 // fourth pixel of each tile through the data manager first: its rays per tile are the costs,
 // and each PE keeps the items its pre-pass tiles used as the start of its profile.
 //
-// A fetched item is the owner's immutable item handed over by reference and counted as its
-// bytes (the copy a distributed machine would send); the cache bounds how many bytes of other
-// PEs' items a PE may use without asking again.
+// A fetched item is the owner's immutable item: inside a rank handed over by reference, to
+// another rank sent as its encoding (the BVH's nodes and leaf blocks, the piece's vertex data
+// and triangles; Wire<ItemRef> below), counted as that encoding's size either way; the cache
+// bounds how many bytes of other PEs' items a PE may use without asking again. Across ranks
+// every rank makes the assignment and the item directory alike; the owners build their items
+// from their own view of the scene, and the items' sizes are summed across ranks, so every PE
+// knows every item's size as in one process.
 #include "raytrace/partition/cached_image_space.h"
 
 #include <algorithm>
 #include <atomic>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -57,6 +62,72 @@ struct GeometryItem {
 };
 using ItemRef = std::shared_ptr<const GeometryItem>;
 
+// The size of an item's encoding: its BVH's, then each vertex array and the two triangle lists
+// as sequences (a count, then the elements).
+std::size_t encodedBytes(const GeometryItem& g) {
+  const scene::Scene& l = g.local;
+  const auto seq = [](std::size_t n, std::size_t element) { return sizeof(uint64_t) + n * element; };
+  return g.bvh.encodedBytes() + seq(l.positions.size(), sizeof(glm::vec3)) + seq(l.normals.size(), sizeof(glm::vec3)) +
+         seq(l.uvs.size(), sizeof(glm::vec2)) + seq(l.colors.size(), sizeof(glm::vec4)) +
+         seq(l.tangents.size(), sizeof(glm::vec4)) + seq(l.triangles.size(), sizeof(scene::Triangle)) +
+         seq(g.triangles.size(), sizeof(uint32_t));
+}
+
+void encodeItem(const GeometryItem& g, par::WireWriter& w) {
+  const scene::Scene& l = g.local;
+  w.reserve(g.bytes);
+  g.bvh.encode(w);
+  w.sequence(std::span<const glm::vec3>(l.positions));
+  w.sequence(std::span<const glm::vec3>(l.normals));
+  w.sequence(std::span<const glm::vec2>(l.uvs));
+  w.sequence(std::span<const glm::vec4>(l.colors));
+  w.sequence(std::span<const glm::vec4>(l.tangents));
+  w.sequence(std::span<const scene::Triangle>(l.triangles));
+  w.sequence(std::span<const uint32_t>(g.triangles));
+}
+
+// An item that arrived from another rank, completed from the receiver's own copy of the
+// scene: its materials (replicated) and the alpha test its BVH cuts surfaces with.
+ItemRef decodeItem(par::WireReader& r, const scene::Scene& s, std::shared_ptr<const AlphaTest> alpha) {
+  auto item = std::make_shared<GeometryItem>();
+  item->bvh = Bvh::decode(r, std::move(alpha));
+  scene::Scene& l = item->local;
+  l.positions = r.sequence<glm::vec3>();
+  l.normals = r.sequence<glm::vec3>();
+  l.uvs = r.sequence<glm::vec2>();
+  l.colors = r.sequence<glm::vec4>();
+  l.tangents = r.sequence<glm::vec4>();
+  l.triangles = r.sequence<scene::Triangle>();
+  item->triangles = r.sequence<uint32_t>();
+  for (const scene::Triangle& t : l.triangles)
+    for (uint32_t v : t.v)
+      if (v >= l.positions.size()) throw par::WireError("a geometry item's triangle names a vertex it does not hold");
+  if (item->triangles.size() != l.triangles.size()) throw par::WireError("a geometry item's triangle lists differ in length");
+  l.materials = s.materials;
+  item->bytes = encodedBytes(*item);
+  return item;
+}
+
+}  // namespace
+}  // namespace pr::rt
+
+namespace pr::par {
+// Decoding needs the receiver's scene: the data manager decodes items with decodeItem
+// (DataManager::decodeItemsWith); Wire gives the size and the encoding.
+template <>
+struct Wire<rt::ItemRef> {
+  static constexpr bool kBytewise = false;
+  static std::size_t size(const rt::ItemRef& item) { return item ? item->bytes : 0; }
+  static void encode(const rt::ItemRef& item, WireWriter& w) { rt::encodeItem(*item, w); }
+  static rt::ItemRef decode(WireReader&) {
+    throw std::logic_error("a geometry item is decoded against the receiver's scene (DataManager::decodeItemsWith)");
+  }
+};
+}  // namespace pr::par
+
+namespace pr::rt {
+namespace {
+
 // The item of piece `tris` from scene s (the owner's view of the scene).
 ItemRef makeItem(const scene::Scene& s, std::span<const uint32_t> tris, const BvhBuildOptions& options) {
   auto item = std::make_shared<GeometryItem>();
@@ -80,7 +151,7 @@ ItemRef makeItem(const scene::Scene& s, std::span<const uint32_t> tris, const Bv
     for (uint32_t& v : tri.v) v = copyVertex(v);
     l.triangles.push_back(tri);
   }
-  item->bytes = item->bvh.stats().memoryBytes + tris.size() * kTriangleVertexBytes;
+  item->bytes = encodedBytes(*item);
   return item;
 }
 
@@ -141,6 +212,11 @@ class CachedImageSpaceFrame {
           itemBytes_[i] = items_[i]->bytes;
         }
     });
+    // Across ranks a rank built its own PEs' items: every item's size, summed across ranks,
+    // is known everywhere (the directory's sizes: replicated, as in one process).
+    std::vector<double> sizes(itemBytes_.begin(), itemBytes_.end());
+    rt_.sumAcrossRanks(sizes);
+    for (size_t i = 0; i < sizes.size(); ++i) itemBytes_[i] = std::size_t(sizes[i]);
 
     std::vector<int> owners;
     for (const ItemSpec& item : specs_) owners.push_back(item.owner);
@@ -152,6 +228,7 @@ class CachedImageSpaceFrame {
         },
         [](const ItemRef& item) { return item->bytes; }, job_.options.cacheBytes);
     data.setLatency(job_.options.dataLatencySeconds);
+    data.decodeItemsWith([this](par::WireReader& r) { return decodeItem(r, job_.scene, bvhOptions_.alpha); });
     data_ = &data;
 
     const std::vector<PixelRect> tiles = cameraTiles(job_.width, job_.height, job_.options.tileSizePx);
@@ -189,8 +266,8 @@ class CachedImageSpaceFrame {
       uint64_t bytes = 0, owned = 0, largest = 0;
       for (size_t i = 0; i < specs_.size(); ++i)
         if (specs_[i].owner == p) {
-          bytes += items_[i]->bytes;
-          largest = std::max<uint64_t>(largest, items_[i]->bytes);
+          bytes += itemBytes_[i];
+          largest = std::max<uint64_t>(largest, itemBytes_[i]);
           ++owned;
         }
       rt_.addCounter("Cache/largest_item_bytes", p, double(largest));

@@ -26,6 +26,7 @@ namespace pr::rt {
 class CachedImageSpacePartition final : public Partition {
  public:
   std::string_view name() const override { return "image-space-cached"; }
+  bool runsAcrossRanks() const override { return true; }
   TraceResult render(const TraceJob& job, par::Runtime& rt) override;
 };
 
