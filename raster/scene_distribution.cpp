@@ -2,7 +2,6 @@
 #include "raster/scene_distribution.h"
 
 #include <numeric>
-#include <stdexcept>
 #include <string>
 
 #include "common/parallel/channel.h"
@@ -39,48 +38,6 @@ void distributeReplicated(par::Runtime& rt, const scene::Scene& s) {
   }
 }
 
-PrimitiveRecord primitiveRecord(const scene::Scene& s, uint32_t id) {
-  PrimitiveRecord r;
-  r.id = id;
-  r.triangle = s.triangles[id];
-  for (int k = 0; k < 3; ++k) {
-    const uint32_t v = r.triangle.v[k];
-    r.position[k] = s.positions[v];
-    if (v < s.normals.size()) r.normal[k] = s.normals[v];
-    if (v < s.uvs.size()) r.uv[k] = s.uvs[v];
-    if (v < s.colors.size()) r.colour[k] = s.colors[v];
-    if (v < s.tangents.size()) r.tangent[k] = s.tangents[v];
-  }
-  return r;
-}
-
-void installPrimitive(scene::Scene& view, const PrimitiveRecord& r) {
-  // A message from another rank is checked, not trusted: what it names must exist.
-  if (r.id >= view.triangles.size())
-    throw std::out_of_range("a primitive message names triangle " + std::to_string(r.id) + " of " +
-                            std::to_string(view.triangles.size()));
-  view.triangles[r.id] = r.triangle;
-  for (int k = 0; k < 3; ++k) {
-    const uint32_t v = r.triangle.v[k];
-    if (v >= view.positions.size())
-      throw std::out_of_range("a primitive message names vertex " + std::to_string(v) + " of " +
-                              std::to_string(view.positions.size()));
-    view.positions[v] = r.position[k];
-    if (v < view.normals.size()) view.normals[v] = r.normal[k];
-    if (v < view.uvs.size()) view.uvs[v] = r.uv[k];
-    if (v < view.colors.size()) view.colors[v] = r.colour[k];
-    if (v < view.tangents.size()) view.tangents[v] = r.tangent[k];
-  }
-}
-
-PrimitiveRecord PrimitiveBatch::record(size_t i) const {
-  return source ? primitiveRecord(*source, ids[i]) : records[i];
-}
-
-void installPrimitives(scene::Scene& view, const PrimitiveBatch& batch) {
-  for (size_t i = 0; i < batch.size(); ++i) installPrimitive(view, batch.record(i));
-}
-
 std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage) {
   const uint32_t total = static_cast<uint32_t>(s.triangles.size());
   rt.recordBroadcast(shadingDataBytes(s));
@@ -108,18 +65,3 @@ std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scen
 }
 
 }  // namespace pr::raster
-
-namespace pr::par {
-
-void Wire<raster::PrimitiveBatch>::encode(const raster::PrimitiveBatch& b, WireWriter& w) {
-  w.reserve(size(b));
-  for (size_t i = 0; i < b.size(); ++i) w.value(b.record(i));
-}
-
-raster::PrimitiveBatch Wire<raster::PrimitiveBatch>::decode(WireReader& r) {
-  raster::PrimitiveBatch b;
-  b.records = r.elements<raster::PrimitiveRecord>();
-  return b;
-}
-
-}  // namespace pr::par

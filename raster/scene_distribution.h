@@ -16,52 +16,14 @@
 #include <glm/glm.hpp>
 
 #include "common/parallel/runtime.h"
-#include "common/parallel/wire.h"
+#include "common/scene/primitive_batch.h"
 #include "common/scene/scene.h"
 
 namespace pr::raster {
 
-// One primitive as a distributed sort-first holds and sends it: its id, its index triple and
-// material (scene::Triangle) and what the raster stages read of its three vertices: position,
-// normal, uv, colour and tangent (zero where the scene has none of an attribute). A message of
-// primitives is a vector of these, its encoding their bytes: 4 + 16 + 3 * (12 + 12 + 8 + 16 +
-// 16) = 212 bytes each.
-struct PrimitiveRecord {
-  uint32_t id = 0;
-  scene::Triangle triangle{};
-  glm::vec3 position[3]{};
-  glm::vec3 normal[3]{};
-  glm::vec2 uv[3]{};
-  glm::vec4 colour[3]{};
-  glm::vec4 tangent[3]{};
-};
-inline constexpr size_t kPrimitiveBytes = sizeof(PrimitiveRecord);
-static_assert(kPrimitiveBytes == 212, "PrimitiveRecord has padding: its bytes would not all be data");
-
-// The record of scene triangle id, read from s.
-PrimitiveRecord primitiveRecord(const scene::Scene& s, uint32_t id);
-// Writes what r carries into view, a copy of the scene (the same arrays, indices and
-// materials) in which the PE may hold only some primitives: the vertices' attributes of every
-// array the view has.
-void installPrimitive(scene::Scene& view, const PrimitiveRecord& r);
-
-// A message of primitives (sort-first). Inside a rank it names them: their ids in `source`,
-// the scene as the sender's rank loaded it, which every PE of that rank shares and nobody
-// writes, so the message stays a move and a receiver reads the very bytes it is counted as.
-// What leaves a rank is their data, a PrimitiveRecord each (Wire<PrimitiveBatch>), which the
-// receiver installs into its own copy of the scene. Counted as the records either way.
-struct PrimitiveBatch {
-  const scene::Scene* source = nullptr;  // inside a rank: where ids are read
-  std::vector<uint32_t> ids;             // with source
-  std::vector<PrimitiveRecord> records;  // without: arrived from another rank
-
-  size_t size() const { return source ? ids.size() : records.size(); }
-  uint32_t id(size_t i) const { return source ? ids[i] : records[i].id; }
-  PrimitiveRecord record(size_t i) const;
-};
-
-// Every primitive of the batch, the same.
-void installPrimitives(scene::Scene& view, const PrimitiveBatch& batch);
+using scene::PrimitiveBatch;
+using scene::PrimitiveRecord;
+using scene::kPrimitiveBytes;
 
 // The scene's geometry arrays (vertices, triangles, objects) and everything else (shading data).
 uint64_t geometryBytes(const scene::Scene& s);
@@ -92,13 +54,3 @@ void distributeReplicated(par::Runtime& rt, const scene::Scene& s);
 std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage);
 
 }  // namespace pr::raster
-
-namespace pr::par {
-template <>
-struct Wire<raster::PrimitiveBatch> {
-  static constexpr bool kBytewise = false;
-  static std::size_t size(const raster::PrimitiveBatch& b) { return b.size() * raster::kPrimitiveBytes; }
-  static void encode(const raster::PrimitiveBatch& b, WireWriter& w);
-  static raster::PrimitiveBatch decode(WireReader& r);
-};
-}  // namespace pr::par

@@ -199,13 +199,18 @@ class CachedImageSpaceFrame {
         bvhOptions_(withAlpha(job.options.bvh, job.scene)),
         items_(specs_.size()),
         itemBytes_(specs_.size(), 0),
-        views_(job, rt.pes()),
+        views_(job, rt),
         state_(size_t(rt.pes())) {}
 
   TraceResult run() {
     const int pes = rt_.pes();
+    // Each owner's triangles leave PE 0 as messages; an owner builds its items from them.
+    const auto heldBy = [&](int p) {
+      return std::vector<uint32_t>(assignment_.triangles(p).begin(), assignment_.triangles(p).end());
+    };
+    const std::vector<scene::PrimitiveBatch> received = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
-      views_.build(pe.id(), assignment_.triangles(pe.id()), integrator_->context().lights());
+      views_.build(pe.id(), heldBy(pe.id()), integrator_->context().lights(), received[size_t(pe.id())]);
       for (size_t i = 0; i < specs_.size(); ++i)
         if (specs_[i].owner == pe.id()) {
           items_[i] = makeItem(views_.of(pe.id()), specs_[i].triangles, bvhOptions_);

@@ -107,7 +107,7 @@ class ObjectFrame {
         films_(makeFilms(job, rt, integrator_->options().spp, kAssemblerPe)),
         bvhs_(rt.pes()),
         replicas_(rt.pes()),
-        views_(job, rt.pes()),
+        views_(job, rt),
         state_(rt.pes()) {}
 
   TraceResult run() {
@@ -128,15 +128,23 @@ class ObjectFrame {
     });
     std::vector<std::vector<float>> nearest(static_cast<size_t>(pes));  // per PE: its probe hits
     std::vector<float> shared;  // the replicated pieces' probe hits, on the controller's PE
-    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
-      const int p = pe.id();
-      if (!assignment_.triangles(p).empty())
-        bvhs_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.triangles(p), job_.options.bvh);
-      if (!assignment_.replicated().empty())
-        replicas_[size_t(p)] = Bvh(job_.scene.positions, job_.scene.triangles, assignment_.replicated(), job_.options.bvh);
+    // Each owner's pieces, and the replicated ones, leave PE 0 as messages; an owner builds
+    // from what it received.
+    const auto heldBy = [&](int p) {
       std::vector<uint32_t> held(assignment_.triangles(p).begin(), assignment_.triangles(p).end());
       held.insert(held.end(), assignment_.replicated().begin(), assignment_.replicated().end());
-      views_.build(p, held, integrator_->context().lights());
+      std::sort(held.begin(), held.end());
+      return held;
+    };
+    const std::vector<scene::PrimitiveBatch> received = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
+    rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
+      const int p = pe.id();
+      views_.build(p, heldBy(p), integrator_->context().lights(), received[size_t(p)]);
+      const scene::Scene& view = views_.of(p);
+      if (!assignment_.triangles(p).empty())
+        bvhs_[size_t(p)] = Bvh(view.positions, view.triangles, assignment_.triangles(p), job_.options.bvh);
+      if (!assignment_.replicated().empty())
+        replicas_[size_t(p)] = Bvh(view.positions, view.triangles, assignment_.replicated(), job_.options.bvh);
       if (probes.empty()) return;
       nearest[size_t(p)] = nearestHits(bvhs_[size_t(p)], probes);
       if (p == kAssemblerPe && !assignment_.replicated().empty()) shared = nearestHits(replicas_[size_t(p)], probes);

@@ -91,7 +91,7 @@ class ObjectSpaceFrame {
         films_(makeFilms(job, rt, integrator_->options().spp, kAssemblerPe)),
         bvhs_(rt.pes()),
         held_(rt.pes()),
-        views_(job, rt.pes()),
+        views_(job, rt),
         state_(rt.pes()) {}
 
   TraceResult run() {
@@ -109,6 +109,8 @@ class ObjectSpaceFrame {
       }
       shareSplit(pe, preferred);
     });
+    // Each owner's triangles leave PE 0 as messages; an owner builds from what it received.
+    received_ = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), [this](int p) { return trianglesOf(p); });
 
     const auto total = int64_t(tiles.size());
     const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
@@ -191,12 +193,21 @@ class ObjectSpaceFrame {
 
   // On PE pe, before it traces anything: one BVH over its voxels' triangles (a triangle
   // straddling two of them once) and its view of the scene.
-  void buildOwnBvh(par::Pe& pe) {
-    std::vector<uint32_t>& held = held_[size_t(pe.id())];
+  // The triangles of PE p's voxels, sorted, a triangle straddling several of them once.
+  std::vector<uint32_t> trianglesOf(int p) const {
+    std::vector<uint32_t> held;
     for (int v = 0; v < split_.voxels(); ++v)
-      if (owners_[v] == pe.id()) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
+      if (owners_[v] == p) held.insert(held.end(), split_.triangles(v).begin(), split_.triangles(v).end());
     std::sort(held.begin(), held.end());
     held.erase(std::unique(held.begin(), held.end()), held.end());
+    return held;
+  }
+
+  void buildOwnBvh(par::Pe& pe) {
+    std::vector<uint32_t>& held = held_[size_t(pe.id())];
+    held = trianglesOf(pe.id());
+    views_.build(pe.id(), held, integrator_->context().lights(), received_[size_t(pe.id())]);
+    const scene::Scene& view = views_.of(pe.id());
     // The BVH also holds the PE's copy of the emitters (replicated for light sampling), so
     // that the PE spawning a shadow ray tests it against every emitter. A closest hit on one
     // outside this PE's voxels lies outside its runs, which are the only spans it traces.
@@ -205,8 +216,7 @@ class ObjectSpaceFrame {
     std::vector<uint32_t> traced;
     traced.reserve(held.size() + emitters.size());
     std::set_union(held.begin(), held.end(), emitters.begin(), emitters.end(), std::back_inserter(traced));
-    if (!traced.empty()) bvhs_[size_t(pe.id())] = Bvh(job_.scene.positions, job_.scene.triangles, traced, job_.options.bvh);
-    views_.build(pe.id(), held, integrator_->context().lights());
+    if (!traced.empty()) bvhs_[size_t(pe.id())] = Bvh(view.positions, view.triangles, traced, job_.options.bvh);
   }
 
   // Per tile, the owner of the first voxel with content that most of its probe rays reach
@@ -370,6 +380,7 @@ class ObjectSpaceFrame {
   std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles and the emitters
   std::vector<std::vector<uint32_t>> held_;  // per PE: those triangles, ascending
   SceneViews views_;
+  std::vector<scene::PrimitiveBatch> received_;  // per PE of this rank: the share PE 0 sent it
   std::vector<PeState> state_;
   par::BatchedChannel<TravellingRay>* rays_ = nullptr;
 };

@@ -32,11 +32,13 @@ double counterTotal(const par::RunRecord& record, const char* name) {
   return sum;
 }
 
-uint64_t channelMessages(const par::RunRecord& record, const char* kind) {
+// Messages on the channel named `name`: the data manager's "geometry items" (replies) and
+// "geometry requests", and the owners' shares of the scene, "scene geometry".
+uint64_t channelMessages(const par::RunRecord& record, const char* name) {
   uint64_t n = 0;
   for (const par::StageRecord& st : record.stages)
     for (const par::ChannelTraffic& c : st.channels)
-      if (c.kind == kind) n += c.messages;
+      if (c.name == name) n += c.messages;
   return n;
 }
 
@@ -72,11 +74,13 @@ TEST_CASE("CachedImageSpace: the sequential image for P = 1, 2, 3 and every cach
         CHECK(run.image.pixels == reference.pixels);
         CHECK(counterMax(run.record, "Cache/bytes_held_at_end") <= double(bytes));
         if (bytes == 0) CHECK(counterTotal(run.record, "Cache/hits") == 0.0);  // no cache: every use fetches
-        if (pes == 1) CHECK(channelMessages(run.record, "data") == 0u);
+        if (pes == 1) CHECK(channelMessages(run.record, "geometry items") == 0u);
+        // PE 0 sent every other PE its share of the scene, one message each.
+        CHECK(channelMessages(run.record, "scene geometry") == uint64_t(pes - 1));
         // Every miss and every prefetch is one request and one reply.
         const double fetches = counterTotal(run.record, "Cache/misses") + counterTotal(run.record, "Cache/prefetches");
-        CHECK(double(channelMessages(run.record, "data")) == fetches);
-        CHECK(double(channelMessages(run.record, "requests")) == fetches);
+        CHECK(double(channelMessages(run.record, "geometry items")) == fetches);
+        CHECK(double(channelMessages(run.record, "geometry requests")) == fetches);
       }
       opt.cacheBytes = rt::kDefaultCacheBytes;
     }
@@ -113,7 +117,7 @@ TEST_CASE("CachedImageSpace: each PE holds only its own items, P = 1 moves nothi
       triangles += run.figures.triangles[size_t(p)];
     }
     CHECK(triangles == s.triangles.size());  // every triangle in exactly one item
-    if (pes == 1) CHECK(channelMessages(run.record, "data") == 0u);
+    if (pes == 1) CHECK(channelMessages(run.record, "geometry items") == 0u);
   }
 }
 
@@ -141,7 +145,7 @@ TEST_CASE("CachedImageSpace: latency hiding and a simulated latency keep the seq
           CHECK(run.image.pixels == sequential.image.pixels);
           CHECK(run.result.rays.total() == sequential.rays.total());
           const double fetches = counterTotal(run.record, "Cache/misses") + counterTotal(run.record, "Cache/prefetches");
-          CHECK(double(channelMessages(run.record, "data")) == fetches);
+          CHECK(double(channelMessages(run.record, "geometry items")) == fetches);
           CHECK(counterMax(run.record, "Cache/bytes_held_at_end") <= double(bytes));
         }
 }
@@ -167,7 +171,7 @@ TEST_CASE("CachedImageSpace: profiling predicts a tile's items from its neighbou
     const double prefetches = counterTotal(run.record, "Cache/prefetches");
     const double fromProfile = counterTotal(run.record, "Cache/prefetches_from_profile");
     const double used = counterTotal(run.record, "Cache/prefetches_used");
-    CHECK(double(channelMessages(run.record, "data")) == counterTotal(run.record, "Cache/misses") + prefetches);
+    CHECK(double(channelMessages(run.record, "geometry items")) == counterTotal(run.record, "Cache/misses") + prefetches);
     CHECK(used <= prefetches);
     if (mode == Prefetch::None) CHECK(prefetches == 0.0);
     if (mode == Prefetch::CameraRays) CHECK(fromProfile == 0.0);
