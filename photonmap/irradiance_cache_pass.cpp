@@ -244,19 +244,15 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
           for (std::uint32_t k = firstProbe[i]; k < firstProbe[i + 1]; ++k) candidates.push_back(&ordered[k]);
       }
     // Which of them no record of the coarser levels covers (read-only cache, every PE).
+    // (Across ranks every rank then holds every flag.)
     std::vector<char> uncovered(candidates.size(), 0);
-    const std::size_t tasks = (candidates.size() + kPerTask - 1) / kPerTask;
-    std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
-    if (tasks > 0)
-      rt.runStage("irradiance-cache coverage" + level, par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId t) {
-        ranHere[std::size_t(t)] = 1;
+    par::runStageSharingResults(rt, "irradiance-cache coverage" + level, "irradiance-cache coverage merge" + level, "coverage",
+                                uncovered, kPerTask, [&](par::Pe&, par::TaskId t) {
         for (std::size_t i = std::size_t(t) * kPerTask; i < std::min(candidates.size(), std::size_t(t + 1) * kPerTask); ++i) {
           const rt::ShadingFrame sf(candidates[i]->si);
           uncovered[i] = cache.covers(candidates[i]->si.position, sf.ns) ? 0 : 1;
         }
       });
-    par::shareWrittenAcrossRanks(rt, "irradiance-cache coverage merge" + level, "coverage", uncovered,
-                                 [&](std::size_t i) { return ranHere[i / kPerTask] != 0; });
     std::vector<const ProbeHit*> chosen;
     for (std::size_t i = 0; i < candidates.size(); ++i)
       if (uncovered[i]) chosen.push_back(candidates[i]);
@@ -286,11 +282,10 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
     }
 
     // The records, computed in parallel, inserted in pixel order.
+    // (Across ranks every rank then holds every record.)
     std::vector<IrradianceRecord> made(chosen.size());
-    const std::size_t combineTasks = (chosen.size() + kPerTask - 1) / kPerTask;
-    std::vector<char> madeHere(combineTasks, 0);
-    rt.runStage("irradiance-cache records" + level, par::TaskSet::uniform(combineTasks), [&](par::Pe&, par::TaskId t) {
-      madeHere[std::size_t(t)] = 1;
+    par::runStageSharingResults(rt, "irradiance-cache records" + level, "irradiance-cache records merge" + level, "records",
+                                made, kPerTask, [&](par::Pe&, par::TaskId t) {
       for (std::size_t i = std::size_t(t) * kPerTask; i < std::min(chosen.size(), std::size_t(t + 1) * kPerTask); ++i) {
         const ProbeHit& p = *chosen[i];
         const rt::ShadingFrame sf(p.si);
@@ -308,8 +303,6 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
         made[i] = r;
       }
     });
-    par::shareWrittenAcrossRanks(rt, "irradiance-cache records merge" + level, "records", made,
-                                 [&](std::size_t i) { return madeHere[i / kPerTask] != 0; });
     const std::size_t before = cache.bytes();
     for (const IrradianceRecord& r : made) cache.insert(r);
     records += double(made.size());

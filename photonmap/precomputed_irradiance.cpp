@@ -23,12 +23,11 @@ PrecomputedIrradiance PrecomputedIrradiance::build(const std::vector<Photon>& ph
   const std::size_t step = std::size_t(std::max(1, stride));
   const std::size_t count = std::min(photons.size(), normals.size()) == 0 ? 0 : (photons.size() + step - 1) / step;
   if (count == 0 || normals.size() != photons.size()) return out;
-  const std::size_t tasks = (count + kPointsPerTask - 1) / kPointsPerTask;
   std::vector<Photon> points(count);
-  std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
-  runtime.runStage("precompute irradiance", par::TaskSet::uniform(tasks), [&](par::Pe&, par::TaskId task) {
+  // Across ranks each rank computes its PEs' points: every rank gets them all.
+  par::runStageSharingResults(runtime, "precompute irradiance", "precomputed irradiance merge", "irradiance points", points,
+                              kPointsPerTask, [&](par::Pe&, par::TaskId task) {
     NearestPhotons scratch;
-    ranHere[std::size_t(task)] = 1;
     const std::size_t begin = std::size_t(task) * kPointsPerTask, end = std::min(count, begin + kPointsPerTask);
     for (std::size_t i = begin; i < end; ++i) {
       const Photon& p = photons[i * step];
@@ -37,9 +36,6 @@ PrecomputedIrradiance PrecomputedIrradiance::build(const std::vector<Photon>& ph
       points[i] = Photon::make(p.position, e.irradiance, n);
     }
   });
-  // Across ranks each rank computed its PEs' points: every rank gets them all.
-  par::shareWrittenAcrossRanks(runtime, "precomputed irradiance merge", "irradiance points", points,
-                               [&](std::size_t i) { return ranHere[i / kPointsPerTask] != 0; });
   out.points_ = KdTree::build(std::move(points), runtime);
   return out;
 }

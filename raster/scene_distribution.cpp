@@ -4,7 +4,6 @@
 #include <numeric>
 #include <string>
 
-#include "common/parallel/channel.h"
 
 namespace pr::raster {
 
@@ -41,22 +40,13 @@ void distributeReplicated(par::Runtime& rt, const scene::Scene& s) {
 std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage) {
   const uint32_t total = static_cast<uint32_t>(s.triangles.size());
   rt.recordBroadcast(shadingDataBytes(s));
-  par::Channel<PrimitiveBatch> shares(rt, "scene geometry", par::MessageKind::Data);
-  rt.runOnEachPe(stage, [&](par::Pe& pe) {
-    if (pe.id() != 0) return;
-    for (int p = 1; p < rt.pes(); ++p) {
-      const auto [first, end] = primitiveShare(total, p, rt.pes());
-      if (end == first) continue;
-      PrimitiveBatch share{&s, {}, {}};
-      share.ids.resize(end - first);
-      std::iota(share.ids.begin(), share.ids.end(), first);
-      shares.send(pe, p, std::move(share));
-    }
+  std::vector<PrimitiveBatch> received = scene::sendPrimitiveShares(rt, s, stage, [&](int p) {
+    const auto [first, end] = primitiveShare(total, p, rt.pes());
+    std::vector<uint32_t> ids(end - first);
+    std::iota(ids.begin(), ids.end(), first);
+    return ids;
   });
-  std::vector<PrimitiveBatch> received(size_t(rt.pes()));
   for (int p = 0; p < rt.pes(); ++p) {
-    std::vector<PrimitiveBatch> messages = shares.drain(p);  // one at most
-    if (!messages.empty()) received[size_t(p)] = std::move(messages.front());
     const auto [first, end] = primitiveShare(total, p, rt.pes());
     rt.addCounter("Scene/geometry_bytes_held", p, double(uint64_t(end - first) * kPrimitiveBytes));
     rt.addCounter("Scene/primitives_held", p, double(end - first));

@@ -93,7 +93,7 @@ std::string defaultOutput(const std::string& scene, const std::string& method) {
 void checkAcrossRanks(const RenderMethod& method, int ranks) {
   if (ranks == 1) return;
   if (!runsAcrossRanks(method))
-    throw InputError("method " + method.name + " does not run across processes yet (launched as " + std::to_string(ranks) +
+    throw InputError("method " + method.name + " does not run across processes (launched as " + std::to_string(ranks) +
                      " ranks by mpirun; methods that do: " + methodsAcrossRanks() + "); run it without mpirun, with --threads P");
 }
 

@@ -51,9 +51,9 @@ class Channel : public ChannelBase {
     sendDeclared(from, to, std::move(message), encodedBytes);
   }
 
-  // A message whose counted size the sender states instead of its encoding: for the messages
-  // that do not yet carry what they are counted as (sort-first's primitive ids counted as the
-  // primitives' data, the data manager's items, a share's range counted as its primitives).
+  // A message whose counted size the sender states instead of its encoding: the data manager's
+  // requests and items (counted as the simulator charges them: 16 bytes a request, an item's
+  // encoding without the reply's header) and gatherToRoot's lists (their items).
   void sendDeclared(Pe& from, int to, T message, std::size_t bytes) {
     PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name() + "': destination PE out of range");
     const SendReceiveTimer timer(from);

@@ -321,6 +321,10 @@ class DataManager {
 
   // On the owner's PE, in the request handler: the item from its own partition, sent back.
   void serve(Pe& owner, const Request& r) {
+    // A request from another rank is checked, not trusted.
+    if (r.requester < 0 || r.requester >= owner.runtime().pes() || r.item >= owners_.size() ||
+        owners_.owner(r.item) != owner.id())
+      throw WireError("a data request for an item this PE does not own, or from no PE");
     const double now = owner.runtime().now();
     // A requester on another rank reads readyAt on its own clock: its request's time plus the
     // two latencies (the owner's busy time there is real, not simulated).

@@ -110,12 +110,35 @@ void shareWrittenAcrossRanks(Runtime& rt, std::string_view stage, std::string ch
   std::vector<std::vector<At>> perPe(std::size_t(rt.pes()));
   std::vector<At>& list = perPe[std::size_t(rt.firstLocalPe())];
   for (std::size_t i = 0; i < values.size(); ++i)
-    if (mine(i)) list.push_back({std::uint32_t(i), values[i]});
+    if (mine(i)) {
+      At a{};  // zeroed, padding included: every byte that travels is defined
+      a.index = std::uint32_t(i);
+      a.value = values[i];
+      list.push_back(a);
+    }
   for (const std::vector<At>& from : gatherToAll(rt, stage, std::move(channel), MessageKind::Data, std::move(perPe), sizeof(At)))
     for (const At& a : from) {
       if (a.index >= values.size()) throw WireError("a shared value's index is out of range");
       values[a.index] = a.value;
     }
+}
+
+// A stage of one task per `perTask` consecutive values, task t writing values[i] for its own
+// indices (work(pe, t)); across ranks every rank then holds every value (shareWrittenAcrossRanks,
+// in stage `mergeStage`). Nothing runs for no values.
+template <class T, class Work>
+  requires std::is_trivially_copyable_v<T>
+void runStageSharingResults(Runtime& rt, const std::string& stage, const std::string& mergeStage, std::string channel,
+                            std::vector<T>& values, std::size_t perTask, Work&& work) {
+  if (values.empty()) return;
+  const std::size_t tasks = (values.size() + perTask - 1) / perTask;
+  std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
+  rt.runStage(stage, TaskSet::uniform(tasks), [&](Pe& pe, TaskId t) {
+    ranHere[std::size_t(t)] = 1;
+    work(pe, t);
+  });
+  shareWrittenAcrossRanks(rt, mergeStage, std::move(channel), values,
+                          [&](std::size_t i) { return ranHere[i / perTask] != 0; });
 }
 
 }  // namespace pr::par

@@ -1,8 +1,9 @@
-// A check for the partitioned methods: the copy of a scene that one PE may read when it holds
-// only some triangles. Every vertex that no held triangle uses is NaN (position, normal, uv,
-// colour), so a read of geometry another PE holds, outside a counted message or broadcast,
-// changes the image. Used by the partitioned ray tracers (TraceOptions::poisonForeignGeometry)
-// and sort-first (SortOptions::poisonForeignGeometry); tests turn it on, renders never do.
+// The copy of a scene that one PE of a partitioned method may read when it holds only some
+// triangles. Every vertex that no held triangle uses is NaN (position, normal, uv, colour), so
+// a read of geometry another PE holds, outside a counted message or broadcast, changes the
+// image. Every PE of the partitioned ray tracers and of sort-first reads one across ranks (its
+// share installed from messages: primitive_batch.h); in one process the tests turn it on
+// (TraceOptions / SortOptions::poisonForeignGeometry), renders do not.
 #pragma once
 
 #include <cstdint>

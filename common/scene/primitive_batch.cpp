@@ -1,8 +1,10 @@
 // Primitive records and batches: made from a scene, installed into a PE's copy of it, encoded.
 #include "common/scene/primitive_batch.h"
 
-#include <stdexcept>
 #include <string>
+
+#include "common/parallel/channel.h"
+#include "common/scene/poisoned_view.h"
 
 namespace pr::scene {
 
@@ -24,14 +26,17 @@ PrimitiveRecord primitiveRecord(const Scene& s, uint32_t id) {
 void installPrimitive(Scene& view, const PrimitiveRecord& r) {
   // A message from another rank is checked, not trusted: what it names must exist.
   if (r.id >= view.triangles.size())
-    throw std::out_of_range("a primitive message names triangle " + std::to_string(r.id) + " of " +
-                            std::to_string(view.triangles.size()));
+    throw par::WireError("a primitive message names triangle " + std::to_string(r.id) + " of " +
+                         std::to_string(view.triangles.size()));
+  if (r.triangle.material >= view.materials.size())
+    throw par::WireError("a primitive message names material " + std::to_string(r.triangle.material) + " of " +
+                         std::to_string(view.materials.size()));
   view.triangles[r.id] = r.triangle;
   for (int k = 0; k < 3; ++k) {
     const uint32_t v = r.triangle.v[k];
     if (v >= view.positions.size())
-      throw std::out_of_range("a primitive message names vertex " + std::to_string(v) + " of " +
-                              std::to_string(view.positions.size()));
+      throw par::WireError("a primitive message names vertex " + std::to_string(v) + " of " +
+                           std::to_string(view.positions.size()));
     view.positions[v] = r.position[k];
     if (v < view.normals.size()) view.normals[v] = r.normal[k];
     if (v < view.uvs.size()) view.uvs[v] = r.uv[k];
@@ -46,6 +51,29 @@ PrimitiveRecord PrimitiveBatch::record(size_t i) const {
 
 void installPrimitives(Scene& view, const PrimitiveBatch& batch) {
   for (size_t i = 0; i < batch.size(); ++i) installPrimitive(view, batch.record(i));
+}
+
+std::vector<PrimitiveBatch> sendPrimitiveShares(par::Runtime& rt, const Scene& s, std::string_view stage,
+                                                const std::function<std::vector<uint32_t>(int)>& held) {
+  par::Channel<PrimitiveBatch> shares(rt, "scene geometry", par::MessageKind::Data);
+  rt.runOnEachPe(stage, [&](par::Pe& pe) {
+    if (pe.id() != 0) return;
+    for (int p = 1; p < rt.pes(); ++p) {
+      PrimitiveBatch share{&s, held(p), {}};
+      if (share.size() > 0) shares.send(pe, p, std::move(share));
+    }
+  });
+  std::vector<PrimitiveBatch> received(size_t(rt.pes()));
+  for (int p = 0; p < rt.pes(); ++p)
+    for (PrimitiveBatch& m : shares.drain(p)) received[size_t(p)] = std::move(m);  // one at most
+  return received;
+}
+
+std::unique_ptr<Scene> shareView(const Scene& s, int pe, std::span<const uint32_t> held,
+                                 std::span<const uint32_t> alsoHeld, const PrimitiveBatch& received) {
+  std::unique_ptr<Scene> view = poisonedView(s, pe == 0 ? held : std::span<const uint32_t>(), alsoHeld);
+  installPrimitives(*view, received);
+  return view;
 }
 
 }  // namespace pr::scene

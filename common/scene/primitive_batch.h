@@ -7,10 +7,15 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
+#include <memory>
+#include <span>
+#include <string_view>
 #include <vector>
 
 #include <glm/glm.hpp>
 
+#include "common/parallel/runtime.h"
 #include "common/parallel/wire.h"
 #include "common/scene/scene.h"
 
@@ -56,6 +61,19 @@ struct PrimitiveBatch {
 
 // Every primitive of the batch, the same.
 void installPrimitives(Scene& view, const PrimitiveBatch& batch);
+
+// Stage `stage`: PE 0, where the scene was loaded, sends every other PE the primitives it will
+// hold (held(p)), one message each on "scene geometry" (kind data), counted as their records:
+// sort-first's initial shares and the partitioned tracers' geometry. Returns, per PE of this
+// rank, what it received (empty for PE 0 and for other ranks' PEs).
+std::vector<PrimitiveBatch> sendPrimitiveShares(par::Runtime& rt, const Scene& s, std::string_view stage,
+                                                const std::function<std::vector<uint32_t>(int)>& held);
+
+// PE pe's own copy of the scene s (poisoned_view.h): NaN but for alsoHeld (replicated, such as
+// the emitters), on PE 0 its share `held` (it loaded the scene), and the share it received,
+// installed from the message. What the PE reads of geometry it was not given shows as NaN.
+std::unique_ptr<Scene> shareView(const Scene& s, int pe, std::span<const uint32_t> held,
+                                 std::span<const uint32_t> alsoHeld, const PrimitiveBatch& received);
 
 }  // namespace pr::scene
 

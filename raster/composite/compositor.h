@@ -61,6 +61,9 @@ struct Wire<raster::PixelMessage> {
     m.keys = r.elements<uint64_t>();
     if (m.keys.size() != static_cast<size_t>(m.rect.area()))
       throw WireError("a pixel message's keys do not fill its rectangle");
+    // The receiver reads keys where `drawn` meets its buffer, indexed within rect.
+    if (!m.drawn.empty() && !(raster::intersect(m.drawn, m.rect) == m.drawn))
+      throw WireError("a pixel message's drawn part lies outside its rectangle");
     return m;
   }
 };

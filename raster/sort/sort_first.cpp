@@ -6,11 +6,12 @@
 // assembler (frame_assembly.h).
 //
 // What a primitive message carries. A distributed sort-first holds only its share of the
-// geometry, so sending a primitive means sending its data: a message is a vector of
-// PrimitiveRecords (its id, index triple and material, and everything the stages read of its
-// three vertices; scene_distribution.h), counted as their bytes, and the first frame sends
-// each PE its initial share the same way (distributeShares) besides the replicated shading
-// data. A PE whose geometry is its own (every PE under mpirun, and every PE under
+// geometry, so sending a primitive means sending its data: a message is a PrimitiveBatch, which
+// leaves a rank as PrimitiveRecords (its id, index triple and material, and everything the
+// stages read of its three vertices; common/scene/primitive_batch.h) and inside a rank names the
+// primitives in the scene the rank loaded; it is counted as the records either way. The first
+// frame sends each PE its initial share the same way (distributeShares) besides the replicated
+// shading data. A PE whose geometry is its own (every PE under mpirun, and every PE under
 // SortOptions::poisonForeignGeometry) reads only its copy of the scene, in which every vertex
 // it was not given is NaN: its initial share, then each primitive it receives, installed from
 // the message. In one process otherwise the PEs read the scene they share, in which the
@@ -218,16 +219,11 @@ class SortFirst : public SortPoint {
     views_.clear();
     views_.resize(size_t(rt.pes()));
     if (rt.ranks() == 1 && !f.options.poisonForeignGeometry) return;
-    const uint32_t total = static_cast<uint32_t>(f.scene.triangles.size());
-    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p) {
-      std::vector<uint32_t> own;
-      if (p == 0) {
-        const auto [lo, hi] = primitiveShare(total, 0, rt.pes());
-        for (uint32_t i = lo; i < hi; ++i) own.push_back(i);
-      }
-      views_[size_t(p)] = scene::poisonedView(f.scene, own);
-      install(p, std::span(&shares[size_t(p)], 1));
-    }
+    const auto [lo, hi] = primitiveShare(static_cast<uint32_t>(f.scene.triangles.size()), 0, rt.pes());
+    std::vector<uint32_t> share0(hi - lo);
+    std::iota(share0.begin(), share0.end(), lo);
+    for (int p = rt.firstLocalPe(); p < rt.firstLocalPe() + rt.localPes(); ++p)
+      views_[size_t(p)] = scene::shareView(f.scene, p, share0, {}, shares[size_t(p)]);
   }
 
   // The scene as PE p may read it: its own copy, or the scene the PEs share.

@@ -29,8 +29,9 @@ struct SortOptions {
   uint32_t batchSize = 4096;                             // scene triangles per geometry task
   std::string compositor = "direct-send";                // sort-last: --compositor
   bool sparse = false;                                   // sort-last: --sparse (covered pixels only)
-  // A check for tests (common/scene/poisoned_view.h): sort-first PEs read geometry from a scene
-  // copy holding only the primitives they hold or were sent, so an uncounted read shows.
+  // A check for tests in one process (common/scene/poisoned_view.h): sort-first PEs read
+  // geometry from a scene copy holding only the primitives they hold or were sent, so an
+  // uncounted read shows. Across ranks every sort-first PE reads such a copy anyway.
   bool poisonForeignGeometry = false;
   // The RenderPlan's effects: shading skips textures, emission or direct light when they are
   // off, and the work not done is put in the run record (Plan/texture_evaluations_skipped,

@@ -99,10 +99,16 @@ ItemRef decodeItem(par::WireReader& r, const scene::Scene& s, std::shared_ptr<co
   l.tangents = r.sequence<glm::vec4>();
   l.triangles = r.sequence<scene::Triangle>();
   item->triangles = r.sequence<uint32_t>();
-  for (const scene::Triangle& t : l.triangles)
+  // Checked, not trusted: what the interaction reads must be there.
+  for (const std::size_t n : {l.normals.size(), l.uvs.size(), l.colors.size(), l.tangents.size()})
+    if (n != 0 && n != l.positions.size()) throw par::WireError("a geometry item's vertex arrays differ in length");
+  for (const scene::Triangle& t : l.triangles) {
+    if (t.material >= s.materials.size()) throw par::WireError("a geometry item's triangle names a material the scene lacks");
     for (uint32_t v : t.v)
       if (v >= l.positions.size()) throw par::WireError("a geometry item's triangle names a vertex it does not hold");
-  if (item->triangles.size() != l.triangles.size()) throw par::WireError("a geometry item's triangle lists differ in length");
+  }
+  if (item->triangles.size() != l.triangles.size() || !std::is_sorted(item->triangles.begin(), item->triangles.end()))
+    throw par::WireError("a geometry item's scene triangle list is not one ascending entry per triangle");
   l.materials = s.materials;
   item->bytes = encodedBytes(*item);
   return item;
@@ -208,7 +214,7 @@ class CachedImageSpaceFrame {
     const auto heldBy = [&](int p) {
       return std::vector<uint32_t>(assignment_.triangles(p).begin(), assignment_.triangles(p).end());
     };
-    const std::vector<scene::PrimitiveBatch> received = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
+    const std::vector<scene::PrimitiveBatch> received = scene::sendPrimitiveShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       views_.build(pe.id(), heldBy(pe.id()), integrator_->context().lights(), received[size_t(pe.id())]);
       for (size_t i = 0; i < specs_.size(); ++i)
@@ -397,6 +403,7 @@ class CachedImageSpaceFrame {
   // the render's: they are not in the ray counters.
   void profilePrePass(const std::vector<PixelRect>& tiles, par::TaskSet& tasks) {
     const std::unique_ptr<par::Scheduler> balanced = par::makeScheduler("balanced");
+    std::vector<double> costs(tiles.size(), 0.0);
     rt_.runStage(job_.stage("profile pre-pass"), par::TaskSet::uniform(tiles.size()), *balanced,
                  [&](par::Pe& pe, par::TaskId id) {
                    PeState& st = state_[size_t(pe.id())];
@@ -414,8 +421,11 @@ class CachedImageSpaceFrame {
                    st.touched.clear();
                    traceTile(pe, st, scratch, stats);
                    noteProfile(st, size_t(id), false);
-                   tasks.tasks[size_t(id)].costEstimate = tileCostEstimate(stats.total(), rect, sampled);
+                   costs[size_t(id)] = tileCostEstimate(stats.total(), rect, sampled);
                  });
+    // Across ranks a rank estimated its own PEs' tiles: summed, every rank deals the same tasks.
+    rt_.sumAcrossRanks(costs);
+    for (size_t i = 0; i < costs.size(); ++i) tasks.tasks[i].costEstimate = costs[i];
   }
 
   // A ray of the tile, with its walk through the item directory so far: parked at an item that

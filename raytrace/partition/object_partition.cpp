@@ -136,7 +136,7 @@ class ObjectFrame {
       std::sort(held.begin(), held.end());
       return held;
     };
-    const std::vector<scene::PrimitiveBatch> received = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
+    const std::vector<scene::PrimitiveBatch> received = scene::sendPrimitiveShares(rt_, job_.scene, job_.stage("distribute"), heldBy);
     rt_.runOnEachPe(job_.stage("build"), [&](par::Pe& pe) {
       const int p = pe.id();
       views_.build(p, heldBy(p), integrator_->context().lights(), received[size_t(p)]);
@@ -178,10 +178,9 @@ class ObjectFrame {
     queries_ = &queries;
     hits_ = &hits;
     // Materials, textures, lights and the owner directory are replicated on every PE, and so
-    // are the emitters (area-light sampling) and the replicated pieces; other geometry is not.
-    if (!job_.sceneResident)
-      recordReplicatedData(rt_, job_.scene, integrator_->context().lights(),
-                           directory_.bytes() + assignment_.replicated().size() * kTriangleVertexBytes);
+    // are the emitters (area-light sampling); the geometry, the replicated pieces included,
+    // reached the PEs as messages (the distribute stage).
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
     rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();

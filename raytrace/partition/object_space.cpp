@@ -110,7 +110,7 @@ class ObjectSpaceFrame {
       shareSplit(pe, preferred);
     });
     // Each owner's triangles leave PE 0 as messages; an owner builds from what it received.
-    received_ = sendGeometryShares(rt_, job_.scene, job_.stage("distribute"), [this](int p) { return trianglesOf(p); });
+    received_ = scene::sendPrimitiveShares(rt_, job_.scene, job_.stage("distribute"), [this](int p) { return trianglesOf(p); });
 
     const auto total = int64_t(tiles.size());
     const par::TaskSet tasks = tileTaskSet(tiles, job_.options.tileSizePx, preferred);
@@ -191,8 +191,6 @@ class ObjectSpaceFrame {
         });
   }
 
-  // On PE pe, before it traces anything: one BVH over its voxels' triangles (a triangle
-  // straddling two of them once) and its view of the scene.
   // The triangles of PE p's voxels, sorted, a triangle straddling several of them once.
   std::vector<uint32_t> trianglesOf(int p) const {
     std::vector<uint32_t> held;
@@ -203,6 +201,8 @@ class ObjectSpaceFrame {
     return held;
   }
 
+  // On PE pe, before it traces anything: its view of the scene, from the share PE 0 sent it,
+  // and one BVH over its voxels' triangles.
   void buildOwnBvh(par::Pe& pe) {
     std::vector<uint32_t>& held = held_[size_t(pe.id())];
     held = trianglesOf(pe.id());

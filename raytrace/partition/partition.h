@@ -54,10 +54,11 @@ struct TraceOptions {
   // A BVH already built over the whole scene with these options, reused by the world-model
   // tracers (sequential, image-space) instead of building one; nullptr = build it.
   const Bvh* worldBvh = nullptr;
-  // A check of the partitioned tracers (object-space, object partitioning), for tests: each PE
-  // shades from its own copy of the scene in which the vertices of every triangle it does not
-  // hold (and that is no emitter, which every PE holds a counted copy of) are NaN, so reading
-  // another PE's geometry outside a message changes the image. Costs a scene copy per PE.
+  // A check of the partitioned tracers (object-space, object partitioning, image-space-cached),
+  // for tests in one process: each PE shades from its own copy of the scene in which the
+  // vertices of every triangle it was not sent (and that is no emitter, which every PE holds a
+  // counted copy of) are NaN, so reading another PE's geometry outside a message changes the
+  // image. Costs a scene copy per PE; across ranks every PE reads such a copy anyway.
   bool poisonForeignGeometry = false;
   // Called after each task with (tasks done, tasks total), from the PE that ran it (a
   // single-task tracer may report finer units, e.g. rows): must be thread-safe and cheap.

@@ -14,7 +14,6 @@
 #include <string_view>
 #include <vector>
 
-#include "common/parallel/channel.h"
 #include "common/parallel/runtime.h"
 #include "common/parallel/task.h"
 #include "common/parallel/wire.h"
@@ -83,32 +82,12 @@ inline void countStartRays(TraceStats& stats, std::span<const RayMessage> rays) 
     ++(m.kind == RayKind::Camera ? stats.cameraRays : m.kind == RayKind::Shadow ? stats.shadowRays : stats.continuationRays);
 }
 
-// Stage `stage`: PE 0, where the scene was loaded, sends every other PE the triangles it will
-// hold (held(p), sorted), one message each on "scene geometry" (kind data), counted as their
-// records (common/scene/primitive_batch.h): the partitioned tracers' geometry distribution.
-// Returns, per PE of this rank, what it received (empty for PE 0 and other ranks' PEs).
-inline std::vector<scene::PrimitiveBatch> sendGeometryShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage,
-                                                             const std::function<std::vector<uint32_t>(int)>& held) {
-  par::Channel<scene::PrimitiveBatch> shares(rt, "scene geometry", par::MessageKind::Data);
-  rt.runOnEachPe(stage, [&](par::Pe& pe) {
-    if (pe.id() != 0) return;
-    for (int p = 1; p < rt.pes(); ++p) {
-      scene::PrimitiveBatch share{&s, held(p), {}};
-      if (share.size() > 0) shares.send(pe, p, std::move(share));
-    }
-  });
-  std::vector<scene::PrimitiveBatch> received(size_t(rt.pes()));
-  for (int p = 0; p < rt.pes(); ++p)
-    for (scene::PrimitiveBatch& m : shares.drain(p)) received[size_t(p)] = std::move(m);  // one at most
-  return received;
-}
-
 // The scene a PE shades and builds from: the shared one, or a view of its own, in which every
 // vertex but the emitters' (replicated) and those of the triangles it holds is NaN. A PE has
 // its own view across ranks (every rank loaded the scene, but a PE reads only its share) and
 // under the poison check of the tests; PE 0 keeps its share from the scene it loaded, every
-// other PE installs the share PE 0 sent it (sendGeometryShares), so a read of geometry that
-// did not arrive as a message shows in the image.
+// other PE installs the share PE 0 sent it (scene::sendPrimitiveShares, scene::shareView), so
+// a read of geometry that did not arrive as a message shows in the image.
 class SceneViews {
  public:
   SceneViews(const TraceJob& job, const par::Runtime& rt)
@@ -116,9 +95,7 @@ class SceneViews {
   // On PE p, in its build (a stage, or the trace stage's set-up): its view, from the triangles
   // it holds and the share it received.
   void build(int p, std::span<const uint32_t> held, const LightSampler& lights, const scene::PrimitiveBatch& received) {
-    if (views_.empty()) return;
-    views_[size_t(p)] = scene::poisonedView(job_.scene, p == 0 ? held : std::span<const uint32_t>(), lights.emitters());
-    scene::installPrimitives(*views_[size_t(p)], received);
+    if (!views_.empty()) views_[size_t(p)] = scene::shareView(job_.scene, p, held, lights.emitters(), received);
   }
   const scene::Scene& of(int p) const { return views_.empty() ? job_.scene : *views_[size_t(p)]; }
 

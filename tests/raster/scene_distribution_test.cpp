@@ -108,7 +108,10 @@ TEST_CASE("SceneDistribution: a primitive message that left its rank, installed 
   // A record naming a triangle the scene does not have is refused, not written.
   PrimitiveRecord bad = r;
   bad.id = uint32_t(s.triangles.size());
-  CHECK_THROWS(installPrimitive(*view, bad));
+  CHECK_THROWS_AS(installPrimitive(*view, bad), par::WireError);
+  PrimitiveRecord badMaterial = r;
+  badMaterial.triangle.material = uint32_t(s.materials.size());
+  CHECK_THROWS_AS(installPrimitive(*view, badMaterial), par::WireError);
   par::Bytes shortened = par::encodeMessage(named);
   shortened.pop_back();
   CHECK_THROWS_AS(par::decodeMessage<PrimitiveBatch>(shortened), par::WireError);

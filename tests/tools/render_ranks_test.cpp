@@ -127,8 +127,10 @@ TEST_CASE("RenderRanks: object partitioning across R = 2, 3 ranks of 1 and 2 PEs
 TEST_CASE("RenderRanks: image-space-cached across R = 2, 3 ranks of 1 and 2 PEs equals the single-process image") {
   checkEqualsOneProcess("cached", "image-space-cached", "--integrator path --width 40 --height 32 --spp 2 --tile-size 8 --cache-mb 0.05",
                         {{2, 1}, {2, 2}, {3, 1}});
+  // A static schedule from the cost pre-pass's estimates: every rank must deal the same tiles
+  // (each tile traced once), so the estimates are summed across ranks.
   checkEqualsOneProcess("cached_blocking", "image-space-cached",
-                        "--integrator whitted --width 40 --height 32 --spp 1 --tile-size 8 --no-latency-hiding --schedule hot-spots",
+                        "--integrator whitted --width 40 --height 32 --spp 1 --tile-size 8 --no-latency-hiding --schedule unbalanced",
                         {{2, 1}, {3, 1}});
 }
 
@@ -261,8 +263,13 @@ TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and th
   CHECK(split->pes[1].tasks == 1);
 }
 
-TEST_CASE("RenderRanks: what does not run across ranks yet exits 2 with one message from rank 0, and so do --help and bad options") {
-
+TEST_CASE("RenderRanks: what does not run across ranks exits 2 with one message from rank 0, and so do --help and bad options") {
+  // The sequential tracer is the one-PE reference: it has no ranks to run on.
+  const CommandResult sequential = mpiParrender(2, join({"render ", cornell(), " -m sequential --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(sequential.exitStatus == 2);
+  CHECK(occurrences(sequential.output, "method sequential does not run across processes") == 1);
+  CHECK(sequential.output.find("image-space, image-space-cached, object-space, object, sort-first, sort-middle, sort-last") !=
+        std::string::npos);
   // CLI11's output is rank 0's alone, and every rank ends through the group.
   const CommandResult help = mpiParrender(2, "--help");
   CHECK(help.exitStatus == 0);
@@ -284,9 +291,11 @@ TEST_CASE("RenderRanks: a rank interrupted during a render ends every rank, with
   const std::filesystem::path out = dir / "interrupted.png";
   const std::string render = join({quoted(PARRENDER_EXE), " render ", cornell(), " -m image-space --integrator path --spp 4096 "
                                    "--width 256 --height 256 --threads 1 --quiet -o ", quoted(out)});
+  // Waits (up to 30 s) until both ranks run, then interrupts the second one found.
+  const std::string ranks = "pgrep -f -- '^" + std::string(PARRENDER_EXE) + " render .*interrupted.png'";
   const std::string script = pr::test::kMpiEnv + " timeout 90 mpirun --oversubscribe -np 2 " + render +
-                             " & m=$!; sleep 4; kill -TERM $(pgrep -f -- '^" + std::string(PARRENDER_EXE) +
-                             " render .*interrupted.png' | tail -1); wait $m; echo status=$?";
+                             " & m=$!; for i in $(seq 300); do [ $(" + ranks + " | wc -l) -ge 2 ] && break; sleep 0.1; done; "
+                             "sleep 1; kill -TERM $(" + ranks + " | tail -1); wait $m; echo status=$?";
   const std::filesystem::path scriptFile = dir / "interrupt.sh";
   std::ofstream(scriptFile) << script << "\n";
   const CommandResult r = pr::test::runCommand("bash " + quoted(scriptFile));

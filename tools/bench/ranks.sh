@@ -5,8 +5,8 @@
 # the fastest of --rounds rounds taking turns. The figure is the run record's wall time (first
 # stage start to last stage end: the render, not the processes' start-up). Target: within
 # 1.25x for image-space and the sort points. The sort points render an orbit of RANKS_FRAMES
-# frames (default 8; the first frame distributes the scene), as an animation would. Methods
-# that do not run across ranks yet say so.
+# frames (default 8; the first frame distributes the scene), as an animation would. A method
+# that does not run across ranks says so.
 # Usage: tools/bench/ranks.sh [build-dir] [rounds]   (RANKS_METHODS="m1 m2 ..." picks methods)
 set -euo pipefail
 
@@ -42,7 +42,7 @@ for scene in "${scenes[@]}"; do
         "$parrender" "${args[@]}" --threads 2 --metrics "$out/threads.json" >/dev/null
         if ! mpirun --oversubscribe -np 2 "$parrender" "${args[@]}" --threads 1 --metrics "$out/ranks.json" \
             >"$out/ranks.txt" 2>&1; then
-          refused="$(grep -o "does not run across processes yet" "$out/ranks.txt" | head -1 || true)"
+          refused="$(grep -o "does not run across processes" "$out/ranks.txt" | head -1 || true)"
           [ -n "$refused" ] || { cat "$out/ranks.txt" >&2; exit 1; }
           break
         fi
@@ -52,7 +52,7 @@ for scene in "${scenes[@]}"; do
         best_ranks=$(python3 -c "print(min(float('$r'), float('${best_ranks:-inf}')))")
       done
       if [ -n "$refused" ]; then
-        printf "%-14s %-20s %-9s %s\n" "$name" "$method" "$schedule" "does not run across ranks yet"
+        printf "%-14s %-20s %-9s %s\n" "$name" "$method" "$schedule" "does not run across ranks"
         break
       fi
       ratio=$(python3 -c "print(f'{$best_ranks / $best_threads:.2f}')")

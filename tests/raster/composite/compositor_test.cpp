@@ -47,6 +47,9 @@ TEST_CASE("Compositor: full and sparse messages carry the same pixels, sparse on
     par::Bytes truncated = par::encodeMessage(m);
     truncated.resize(truncated.size() - kPixelBytes);  // a key short of the rectangle
     CHECK_THROWS_AS(par::decodeMessage<PixelMessage>(truncated), par::WireError);
+    PixelMessage outside = m;
+    outside.drawn = Rect{0, 0, 9, 9};  // beyond the rectangle its keys cover
+    CHECK_THROWS_AS(par::decodeMessage<PixelMessage>(par::encodeMessage(outside)), par::WireError);
     RegionFramebuffer dst(Rect{0, 0, 6, 4});
     Rect dstDrawn{5, 0, 6, 1};
     mergePixels(m, dst, dstDrawn);
