@@ -139,11 +139,15 @@ struct Wire<ItemReply<T>> {
     w.value(r.readyAt);
     Wire<T>::encode(r.value, w);
   }
-  static ItemReply<T> decode(WireReader& r) {
+  static ItemReply<T> decode(WireReader& r) { return decode(r, Wire<T>::decode); }
+  // The same with the item decoded by `value` (an item type whose decoding needs the receiver's
+  // context: DataManager::decodeItemsWith).
+  template <class DecodeValue>
+  static ItemReply<T> decode(WireReader& r, DecodeValue&& value) {
     ItemReply<T> reply;
     reply.item = r.value<ItemId>();
     reply.readyAt = r.value<double>();
-    reply.value = Wire<T>::decode(r);
+    reply.value = value(r);
     return reply;
   }
 };
@@ -182,13 +186,7 @@ class DataManager {
   // Across ranks, for an item type whose decoding needs the receiver's context (the scene):
   // how an item that arrived from another rank is made from its encoding. Between stages.
   void decodeItemsWith(std::function<T(WireReader&)> decode) {
-    items_.decodeWith([decode = std::move(decode)](WireReader& r) {
-      Reply reply;
-      reply.item = r.value<ItemId>();
-      reply.readyAt = r.value<double>();
-      reply.value = decode(r);
-      return reply;
-    });
+    items_.decodeWith([decode = std::move(decode)](WireReader& r) { return Wire<Reply>::decode(r, decode); });
   }
 
   // A simulated one-way network latency for requests and replies: a reply is usable no sooner
