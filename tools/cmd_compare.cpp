@@ -15,6 +15,7 @@
 
 #include "common/image/codec_loader.h"
 #include "common/image/image_io.h"
+#include "common/parallel/process_group.h"
 #include "common/parallel/run_options.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
@@ -62,7 +63,10 @@ std::string fileStem(const Combination& c) {
 void run(CompareArgs& a) {
   if (a.methods.empty())
     for (std::string_view m : renderMethods().names()) a.methods.emplace_back(m);
-  if (a.threads.empty()) a.threads = defaultThreadCounts();
+  // Under mpirun, --threads is each rank's PEs (default one) and rank 0 prints and writes.
+  const int ranks = par::ProcessGroup::get().ranks();
+  const bool writes = holdsResults();
+  if (a.threads.empty()) a.threads = ranks > 1 ? std::vector<int>{1} : defaultThreadCounts();
   ComparisonSpec spec;
   spec.methods = a.methods;
   spec.schedules = a.schedules;
@@ -77,7 +81,7 @@ void run(CompareArgs& a) {
   spec.reference = !a.noReference;
   spec.referenceSettings = ReferenceSettings{a.scene, a.camera, a.effects, a.lighting, a.referenceSpp, a.referenceDepth,
                                              a.settings.ray.seed, a.referenceDir, a.noCache, "image-space",
-                                             *std::max_element(a.threads.begin(), a.threads.end()), {}};
+                                             everyRank(*std::max_element(a.threads.begin(), a.threads.end())), {}};
 
   // Options of one family given to a comparison with methods of the other: they apply where
   // they can and are noted for the rest.
@@ -106,16 +110,20 @@ void run(CompareArgs& a) {
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
-  if (!a.images.empty()) {
+  if (!a.images.empty() && writes) {
     std::filesystem::create_directories(a.images);
     image::imageCodec();  // opened before the first timed render, never beside it
   }
 
   const Comparison c = runComparison(spec, RenderInput{scene, camera, plan, a.width, a.height});
+  if (!writes) return;
 
   std::printf("compare %s, %dx%d, %d run%s per combination (median wall time, spread = (max - min) / 2 / median; messages and bytes of every kind)\n",
               a.scene.c_str(), a.width, a.height, a.repeat, a.repeat == 1 ? "" : "s");
   std::printf("%s\n", lighting.c_str());
+  if (ranks > 1)
+    std::printf("across %d ranks launched by mpirun: P = %d x PEs per rank (--threads); P = 1 on rank 0 alone while "
+                "the others waited\n", ranks, ranks);
   std::printf("T1/Tn against the same combination at P=1, Ts/Tn against the family's sequential run (else its fastest "
               "at P=1)");
   if (!c.reference.image.empty())
@@ -164,7 +172,8 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--methods", a->methods, "render methods, comma-separated (default: all):\n" + describeRenderMethods())
       ->delimiter(',')
       ->check(CLI::Validator([](std::string& v) { return renderMethods().problem(v); }, "METHOD"));
-  cmd->add_option("--threads", a->threads, "values of P, comma-separated (default: 1, 2, 4, ... and this machine's cores)")
+  cmd->add_option("--threads", a->threads, "values of P, comma-separated (default: 1, 2, 4, ... and this machine's cores); under mpirun, PEs per rank "
+                "(P = ranks x each, default 1) and P = 1 on rank 0 alone")
       ->delimiter(',')
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--schedules", a->schedules, "schedules, comma-separated:\n" + par::describeSchedules())
@@ -206,10 +215,7 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--images", a->images, "folder for each row's image (PNG) and its x8 difference from the reference");
   cmd->add_flag("--quiet", a->quiet, "no progress lines");
   addLightingOptions(*cmd, a->lighting);
-  cmd->callback([a] {
-    requireOneRank("compare");
-    run(*a);
-  });
+  cmd->callback([a] { run(*a); });
 }
 
 }  // namespace pr::cli

@@ -17,6 +17,7 @@
 #include <CLI/CLI.hpp>
 
 #include "common/image/codec_loader.h"
+#include "common/parallel/process_group.h"
 #include "common/parallel/simulator.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
@@ -82,11 +83,17 @@ std::string methodsIntro(const report::ReportSpec& spec) {
          report::table({"schedule", "computational model", "task management"}, rows, "text");
 }
 
-void build(const ReportArgs& a, const std::filesystem::path& dir) {
+// The report's files but the scenes' sections, into dir (made).
+void prepare(const std::filesystem::path& dir) {
+  std::filesystem::create_directories(dir);
   copyScripts(dir);
   writeFileAtomically(dir / "page.js", report::pageScript(), "report script");
   writeFileAtomically(dir / kReportMarker, "a report written by parrender report; the next report into this folder replaces it\n",
                       "report marker");
+}
+
+// Every scene's renders (every rank takes part) and section; index.html written by rank 0.
+void build(const ReportArgs& a, const std::filesystem::path& dir) {
   std::string body = "<h1>parrender: parallel rendering methods compared</h1>\n" + methodsIntro(a.spec);
   body += "<p>Scenes:";
   for (const std::string& s : a.scenes) {
@@ -98,17 +105,22 @@ void build(const ReportArgs& a, const std::filesystem::path& dir) {
     const std::string stem = std::filesystem::path(s).stem().string();
     body += "<a id=\"" + report::escape(stem) + "\"></a>" + report::sceneReport(s, a.spec, dir / stem, stem);
   }
-  writeFileAtomically(dir / "index.html", report::page("parrender report", body), "report page");
+  par::ProcessGroup::get().onRank0Alone("rank 0 writing the report's page", [&] {
+    writeFileAtomically(dir / "index.html", report::page("parrender report", body), "report page");
+    return par::Bytes();
+  });
 }
 
 void run(ReportArgs& a) {
   for (const std::string& m : a.spec.methods) report::classifyMethod(m);
   for (const std::string& s : a.spec.schedules) report::classifySchedule(s);
   par::networkByName(a.spec.network);
-  if (a.spec.threads.empty()) a.spec.threads = defaultThreadCounts();
-  if (std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
+  // Under mpirun, --threads is each rank's PEs (default one); P = 1 runs on rank 0 alone, and
+  // rank 0 alone reads and writes the report's folder while the other ranks wait.
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  if (a.spec.threads.empty()) a.spec.threads = group.ranks() > 1 ? std::vector<int>{1} : defaultThreadCounts();
+  if (group.ranks() == 1 && std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
     throw InputError("--threads must include 1: speed-up and efficiency are measured against P = 1");
-  image::imageCodec();  // opened before the first timed render, never beside it
   for (const std::string& scene : a.scenes) {
     const std::string stem = std::filesystem::path(scene).stem().string();
     if (stem == "lib" || stem == "index.html" || stem == "page.js" || stem == kReportMarker || stem.empty() || stem[0] == '.')
@@ -118,44 +130,60 @@ void run(ReportArgs& a) {
     for (std::size_t j = 0; j < i; ++j)
       if (std::filesystem::path(a.scenes[i]).stem() == std::filesystem::path(a.scenes[j]).stem())
         throw InputError("scenes " + a.scenes[j] + " and " + a.scenes[i] + " share the name of their report folder");
-  std::filesystem::path out = std::filesystem::absolute(a.output).lexically_normal();
-  if (!out.has_filename()) out = out.parent_path();  // "report/" or "."
-  if (!out.has_filename() || out == out.root_path())
-    throw InputError("report: " + a.output + " cannot be a report's folder (it must name a folder below another)");
-  const std::filesystem::path parent = out.parent_path();
-  std::error_code made;
-  std::filesystem::create_directories(parent, made);
-  if (!std::filesystem::is_directory(parent))
-    throw InputError("report: cannot make the folder " + parent.string() + (made ? " (" + made.message() + ")" : std::string()));
-  if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
-    throw InputError("report: " + out.string() + " exists and is not a folder");
-  // Only a report (or an empty folder) is replaced: never a folder of someone's files.
-  if (std::filesystem::is_directory(out) && !std::filesystem::is_empty(out) && !std::filesystem::exists(out / kReportMarker))
-    throw InputError("report: " + out.string() + " holds files that are not a parrender report (no " +
-                     std::string(kReportMarker) + " inside); choose another folder");
-  const std::string pid = std::to_string(getpid());
-  const std::filesystem::path fresh = parent / ("." + out.filename().string() + ".new-" + pid);
-  const std::filesystem::path old = parent / ("." + out.filename().string() + ".old-" + pid);
-  std::filesystem::remove_all(fresh);
-  std::filesystem::remove_all(old);
-  std::filesystem::create_directories(fresh);
+  std::filesystem::path out, fresh, old;
+  group.onRank0Alone("rank 0's preparation of the report's folder", [&] {
+    out = std::filesystem::absolute(a.output).lexically_normal();
+    if (!out.has_filename()) out = out.parent_path();  // "report/" or "."
+    if (!out.has_filename() || out == out.root_path())
+      throw InputError("report: " + a.output + " cannot be a report's folder (it must name a folder below another)");
+    const std::filesystem::path parent = out.parent_path();
+    std::error_code made;
+    std::filesystem::create_directories(parent, made);
+    if (!std::filesystem::is_directory(parent))
+      throw InputError("report: cannot make the folder " + parent.string() + (made ? " (" + made.message() + ")" : std::string()));
+    if (std::filesystem::exists(out) && !std::filesystem::is_directory(out))
+      throw InputError("report: " + out.string() + " exists and is not a folder");
+    // Only a report (or an empty folder) is replaced: never a folder of someone's files.
+    if (std::filesystem::is_directory(out) && !std::filesystem::is_empty(out) && !std::filesystem::exists(out / kReportMarker))
+      throw InputError("report: " + out.string() + " holds files that are not a parrender report (no " +
+                       std::string(kReportMarker) + " inside); choose another folder");
+    const std::string pid = std::to_string(getpid());
+    fresh = parent / ("." + out.filename().string() + ".new-" + pid);
+    old = parent / ("." + out.filename().string() + ".old-" + pid);
+    std::filesystem::remove_all(fresh);
+    std::filesystem::remove_all(old);
+    try {
+      image::imageCodec();  // opened before the first timed render, never beside it
+      prepare(fresh);
+    } catch (...) {
+      std::error_code ignored;
+      std::filesystem::remove_all(fresh, ignored);
+      throw;
+    }
+    return par::Bytes();
+  });
+  const bool writes = group.rank() == 0;
   try {
     build(a, fresh);
     // The earlier report steps aside only once the new one is whole, and comes back if the
     // new one cannot take its place.
-    const bool earlier = std::filesystem::exists(out);
-    if (earlier) std::filesystem::rename(out, old);
-    try {
-      std::filesystem::rename(fresh, out);
-    } catch (...) {
-      if (earlier) std::filesystem::rename(old, out);
-      throw;
-    }
+    group.onRank0Alone("rank 0 putting the report in place", [&] {
+      const bool earlier = std::filesystem::exists(out);
+      if (earlier) std::filesystem::rename(out, old);
+      try {
+        std::filesystem::rename(fresh, out);
+      } catch (...) {
+        if (earlier) std::filesystem::rename(old, out);
+        throw;
+      }
+      return par::Bytes();
+    });
   } catch (...) {
     std::error_code ignored;
-    std::filesystem::remove_all(fresh, ignored);
+    if (writes) std::filesystem::remove_all(fresh, ignored);
     throw;
   }
+  if (!writes) return;
   std::error_code ignored;
   std::filesystem::remove_all(old, ignored);
   std::printf("report: %s\n", (out / "index.html").string().c_str());
@@ -174,7 +202,8 @@ void addReportCommand(CLI::App& app) {
   cmd->add_option("--methods", s.methods, "render methods, comma-separated (default: all)")
       ->delimiter(',')
       ->check(CLI::Validator([](std::string& v) { return renderMethods().problem(v); }, "METHOD"));
-  cmd->add_option("--threads", s.threads, "values of P, comma-separated, with 1 (default: 1, 2, 4, ... and this machine's cores)")
+  cmd->add_option("--threads", s.threads, "values of P, comma-separated, with 1 (default: 1, 2, 4, ... and this machine's cores); under mpirun, "
+                "PEs per rank (P = ranks x each, default 1), and P = 1 on rank 0 alone")
       ->delimiter(',')
       ->check(CLI::Range(1, 4096));
   cmd->add_option("--schedules", s.schedules, "schedules, comma-separated")
@@ -219,10 +248,7 @@ void addReportCommand(CLI::App& app) {
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
   addLightingOptions(*cmd, s.lighting);
-  cmd->callback([a] {
-    requireOneRank("report");
-    run(*a);
-  });
+  cmd->callback([a] { run(*a); });
 }
 
 }  // namespace pr::cli

@@ -35,14 +35,20 @@ struct SweepArgs : SweepSpec {
 };
 
 void run(SweepArgs& a) {
-  image::imageCodec();  // the cached reference and the images; opened before the first timed render
+  // Under mpirun, --threads is each rank's PEs; rank 0 prints and writes.
+  const bool writes = holdsResults();
+  if (writes) image::imageCodec();  // the cached reference and the images; opened before the first timed render
   const SweepResult result = runSweep(a);
+  if (!writes) return;
   const std::vector<SweepRow>& rows = result.rows;
   const double target = result.targetRmse;
   const bool cached = result.reference.cached;
   const double referenceCpu = result.reference.cpuSeconds;
-  std::printf("sweep of %s, %dx%d, method %s, P %d; reference: path tracing, %d spp%s\n", a.scene.c_str(), a.width,
-              a.height, a.method.c_str(), a.threads, a.referenceSpp, cached ? " (cached)" : "");
+  const Placement where = everyRank(a.threads);
+  std::printf("sweep of %s, %dx%d, method %s, P %d%s; reference: path tracing, %d spp%s\n", a.scene.c_str(), a.width,
+              a.height, a.method.c_str(), where.pes,
+              where.ranks > 1 ? (" (" + std::to_string(where.ranks) + " ranks x " + std::to_string(a.threads) + " PEs)").c_str() : "",
+              a.referenceSpp, cached ? " (cached)" : "");
   std::printf("%-10s %-8s %10s %9s %9s %10s %10s %9s %12s\n", "integrator", "setting", "value", "cpu_s", "wall_s", "rmse",
               "rel_mse", "max_err", "caustic_rmse");
   for (const SweepRow& r : rows)
@@ -69,7 +75,7 @@ void run(SweepArgs& a) {
     writeFileAtomically(a.csv, out.str(), "CSV file");
   }
   if (!a.json.empty()) {
-    nlohmann::json j = {{"scene", a.scene}, {"method", a.method}, {"threads", a.threads}, {"width", a.width},
+    nlohmann::json j = {{"scene", a.scene}, {"method", a.method}, {"threads", a.threads}, {"pes", everyRank(a.threads).pes}, {"width", a.width},
                         {"height", a.height}, {"vary", a.vary}, {"targetRmse", target}, {"cpuSecondsToTarget", toTarget},
                         {"reference", {{"integrator", "path"}, {"spp", a.referenceSpp}, {"maxDepth", a.referenceDepth},
                                        {"cached", bool(cached)}, {"cpuSeconds", referenceCpu}}},
@@ -108,7 +114,7 @@ void addSweepCommand(CLI::App& app) {
   cmd->add_option("--width", a->width, "image width")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--height", a->height, "image height")->check(CLI::Range(1, 16384))->capture_default_str();
   cmd->add_option("--camera", a->camera, "camera: index, name, or 'auto'");
-  cmd->add_option("--threads", a->threads, "P, the number of PEs of every render")->check(CLI::Range(1, 4096))->capture_default_str();
+  cmd->add_option("--threads", a->threads, "P, the number of PEs of every render (under mpirun: PEs per rank, P = ranks x threads)")->check(CLI::Range(1, 4096))->capture_default_str();
   cmd->add_option("--spp", a->spp, "photonmap: samples per pixel (unless varied)")->check(CLI::Range(1, rt::kMaxSpp))->capture_default_str();
   cmd->add_option("--max-depth", a->maxDepth, "surface interactions per path")->check(CLI::Range(1, rt::kMaxDepthLimit))->capture_default_str();
   cmd->add_option("--seed", a->seed, "random seed of the series")->capture_default_str();
@@ -138,7 +144,6 @@ void addSweepCommand(CLI::App& app) {
   par::addScheduleOptions(*cmd, a->schedule);
   addLightingOptions(*cmd, a->lighting);
   cmd->callback([a, pathSpp] {
-    requireOneRank("sweep");
     a->pathSppGiven = pathSpp->count() > 0;
     run(*a);
   });

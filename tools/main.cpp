@@ -21,7 +21,7 @@ void requireOneRank(std::string_view command) {
   const int ranks = par::ProcessGroup::get().ranks();
   if (ranks > 1)
     throw InputError("launched as " + std::to_string(ranks) + " ranks by mpirun, but '" + std::string(command) +
-                     "' does not run across processes: under mpirun, 'render' runs across ranks (methods: " +
+                     "' does not run across processes: under mpirun, render, compare, sweep and report run across ranks (methods: " +
                      methodsAcrossRanks() + "); run " + std::string(command) + " without mpirun, with --threads P");
 }
 

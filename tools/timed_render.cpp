@@ -6,6 +6,9 @@
 #include <chrono>
 #include <utility>
 
+#include "common/parallel/process_group.h"
+#include "common/util/error.h"
+
 namespace pr::cli {
 
 double processCpuSeconds() {
@@ -14,9 +17,20 @@ double processCpuSeconds() {
   return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
 }
 
-TimedRender timedRender(const RenderMethod& method, const RenderInput& input, const RenderSettings& settings, int pes,
-                        const par::ScheduleOptions& schedule, std::function<void(int64_t, int64_t)> progress) {
-  par::Runtime runtime(par::RuntimeOptions{pes, schedule.schedule, schedule.params, true});
+Placement everyRank(int threadsPerRank) {
+  const int ranks = par::ProcessGroup::get().ranks();
+  return Placement{ranks * threadsPerRank, ranks};
+}
+
+bool holdsResults() { return par::ProcessGroup::get().rank() == 0; }
+
+namespace {
+
+TimedRender render(const RenderMethod& method, const RenderInput& input, const RenderSettings& settings, Placement where,
+                   const par::ScheduleOptions& schedule, std::function<void(int64_t, int64_t)> progress) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  par::Transport* transport = where.ranks > 1 ? &group.transport() : nullptr;
+  par::Runtime runtime(par::RuntimeOptions{where.pes, schedule.schedule, schedule.params, true, transport});
   const RenderRequest request{input.scene, input.camera, input.width,      input.height,
                               settings,    input.plan,   runtime,          std::move(progress)};
   const double cpu0 = processCpuSeconds();
@@ -24,8 +38,27 @@ TimedRender timedRender(const RenderMethod& method, const RenderInput& input, co
   TimedRender t;
   t.outcome = method.make(method.name, request);
   t.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  t.cpuSeconds = processCpuSeconds() - cpu0;
+  double cpu = processCpuSeconds() - cpu0;
+  runtime.sumAcrossRanks(std::span<double>(&cpu, 1), group.timeoutSeconds());  // every rank's PEs
+  t.cpuSeconds = cpu;
   t.record = runtime.record();
+  return t;
+}
+
+}  // namespace
+
+TimedRender timedRender(const RenderMethod& method, const RenderInput& input, const RenderSettings& settings,
+                        Placement where, const par::ScheduleOptions& schedule,
+                        std::function<void(int64_t, int64_t)> progress) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  PR_CHECK(where.ranks == 1 || (where.ranks == group.ranks() && where.pes % where.ranks == 0),
+           "a render runs on one rank or on every rank, the same number of PEs on each");
+  if (where.ranks > 1 || group.ranks() == 1) return render(method, input, settings, where, schedule, std::move(progress));
+  TimedRender t;
+  group.onRank0Alone(method.name + " on rank 0 alone", [&] {
+    t = render(method, input, settings, where, schedule, std::move(progress));
+    return par::Bytes();
+  });
   return t;
 }
 

@@ -1,6 +1,9 @@
 // One fresh, timed render as the commands that compare renders take it (sweep, compare,
 // report): a new runtime with P PEs and the schedule, the wall clock around the method, the
-// CPU time of the whole process (every PE), the outcome and the run record it left.
+// CPU time of the whole process (every PE; every rank's, across ranks), the outcome and the
+// run record it left. Under mpirun a render runs either across every rank (P = ranks x PEs
+// per rank; its image and whole record on rank 0) or on rank 0 alone while the other ranks
+// wait (the one-PE baselines), whose TimedRender elsewhere is empty.
 #pragma once
 
 #include <functional>
@@ -31,7 +34,21 @@ struct TimedRender {
 // User plus system CPU seconds of this process so far.
 double processCpuSeconds();
 
-TimedRender timedRender(const RenderMethod& method, const RenderInput& input, const RenderSettings& settings, int pes,
-                        const par::ScheduleOptions& schedule, std::function<void(int64_t, int64_t)> progress = {});
+// Where a render runs: `pes` PEs in all, on `ranks` ranks - 1 (this process; under mpirun,
+// rank 0 alone) or every rank of the run (ProcessGroup::ranks(), which must divide pes).
+struct Placement {
+  int pes = 1, ranks = 1;
+};
+
+// T PEs on every rank of the run: P = T without mpirun, R x T under it.
+Placement everyRank(int threadsPerRank);
+
+// Whether the render's figures and image are this process's to use: rank 0's, or any render
+// on one rank without mpirun.
+bool holdsResults();
+
+TimedRender timedRender(const RenderMethod& method, const RenderInput& input, const RenderSettings& settings,
+                        Placement where, const par::ScheduleOptions& schedule,
+                        std::function<void(int64_t, int64_t)> progress = {});
 
 }  // namespace pr::cli

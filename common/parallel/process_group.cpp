@@ -7,10 +7,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <condition_variable>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <thread>
 
+#include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "common/util/module_loader.h"
 
@@ -138,6 +141,61 @@ void ProcessGroup::checkSameCommandLine(int argc, char** argv) {
   if (differs >= 0)
     throw InputError("rank " + std::to_string(differs) +
                      " was started with a different command line from rank 0's: every rank must get the same options");
+}
+
+namespace {
+// The first byte of a message under kAloneTag; a result follows kDone.
+enum class AloneNews : std::uint8_t { kWorking = 0, kDone = 1, kFailed = 2 };
+
+Bytes aloneMessage(AloneNews news, const Bytes& result = {}) {
+  Bytes b(1 + result.size());
+  b[0] = std::byte(news);
+  std::copy(result.begin(), result.end(), b.begin() + 1);
+  return b;
+}
+}  // namespace
+
+Bytes ProcessGroup::onRank0Alone(std::string_view what, const std::function<Bytes()>& work) {
+  if (ranks_ == 1) return work();
+  if (rank_ != 0) {
+    for (;;) {
+      Envelope e = receive(kAloneTag, what);
+      const AloneNews news = e.bytes.empty() ? AloneNews::kFailed : AloneNews(e.bytes[0]);
+      if (news == AloneNews::kWorking) continue;
+      if (news != AloneNews::kDone) throw FailedElsewhere("rank 0 failed while working alone on " + std::string(what));
+      e.bytes.erase(e.bytes.begin());
+      return std::move(e.bytes);
+    }
+  }
+  // Rank 0: a thread sends "still working" well within the others' deadline until work ends.
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  const auto every = std::chrono::duration<double>(std::min(2.0, timeout_ / 4.0));
+  std::thread heartbeat([&] {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!finished.wait_for(lock, every, [&] { return done; }))
+      for (int r = 1; r < ranks_; ++r) transport_->send(r, kAloneTag, aloneMessage(AloneNews::kWorking));
+  });
+  const auto stopHeartbeat = [&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      done = true;
+    }
+    finished.notify_one();
+    heartbeat.join();
+  };
+  Bytes result;
+  try {
+    result = work();
+  } catch (...) {
+    stopHeartbeat();
+    for (int r = 1; r < ranks_; ++r) transport_->send(r, kAloneTag, aloneMessage(AloneNews::kFailed));
+    throw;
+  }
+  stopHeartbeat();
+  for (int r = 1; r < ranks_; ++r) transport_->send(r, kAloneTag, aloneMessage(AloneNews::kDone, result));
+  return result;
 }
 
 int ProcessGroup::finish(int status, const std::string& error) {

@@ -6,6 +6,7 @@
 // rank, so a failure can never hang the run.
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 
@@ -16,7 +17,8 @@ namespace pr::par {
 class ProcessGroup {
  public:
   // Tags of the group's own messages; others use tags from kFirstUserTag on.
-  static constexpr int kCommandLineTag = 101, kVerdictTag = 102, kStatusTag = 103, kFinishTag = 104;
+  static constexpr int kCommandLineTag = 101, kVerdictTag = 102, kStatusTag = 103, kFinishTag = 104,
+                       kAloneTag = 105;
   static constexpr int kFirstUserTag = 1000;
 
   // Creates this process's group (once, first thing in main). Under mpirun, throws
@@ -40,6 +42,14 @@ class ProcessGroup {
   // which compares it with its own and answers. Throws pr::InputError on every rank when one
   // differs (rank 0's message names the first such rank; the others' is empty).
   void checkSameCommandLine(int argc, char** argv);
+
+  // Runs `work` on rank 0 alone while every other rank waits, and returns its result on every
+  // rank (sent from rank 0 to each: a one-PE baseline that commands running across ranks
+  // measure, or a fact only rank 0 can learn, such as whether a file is cached). The wait stays
+  // bounded however long the work takes: rank 0 tells the others it is still working every
+  // few seconds, and a rank that hears nothing for timeoutSeconds() ends every rank. A failure
+  // of `work` is rethrown on rank 0 and becomes FailedElsewhere on the others. One rank: work().
+  Bytes onRank0Alone(std::string_view what, const std::function<Bytes()>& work);
 
   // Ends the run on this rank with `status` (0, or a failure's exit status with its message)
   // and returns the status the process exits with: the same on every rank. Rank 0 collects

@@ -10,6 +10,7 @@
 #include <thread>
 #include <tuple>
 
+#include "common/parallel/process_group.h"
 #include "common/parallel/schedulers/scheduler.h"
 #include "common/util/error.h"
 #include "raster/composite/compositor.h"
@@ -22,7 +23,8 @@ std::string Combination::label() const {
   std::string out = method + " " + schedule;
   if (integrator != kNotApplicable) out += " " + integrator;
   if (compositor != kNotApplicable) out += " " + compositor;
-  return out + " P=" + std::to_string(pes);
+  out += " P=" + std::to_string(pes);
+  return ranks > 1 ? out + " R=" + std::to_string(ranks) : out;
 }
 
 const std::vector<std::string>& comparisonKinds() {
@@ -84,6 +86,8 @@ std::string whyInvalid(const Combination& c, const ComparisonSpec& spec) {
   if (c.method == "sequential" && c.schedule != spec.schedules.front())
     return "sequential runs one task on one PE: every schedule gives the run measured under " + spec.schedules.front();
   if (c.compositor == "binary-swap" && !isPowerOfTwo(c.pes)) return "binary-swap needs P a power of two";
+  if (c.ranks > 1 && !runsAcrossRanks(findRenderMethod(c.method)))
+    return c.method + " does not run across processes; it ran on rank 0 alone";
   return {};
 }
 
@@ -124,12 +128,17 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   if (spec.threads.empty()) throw InputError("--threads: give at least one value");
   if (spec.repeat < 1) throw InputError("--repeat: at least one run per combination");
 
-  // The combinations, in table order: method, integrator, compositor, schedule, P.
-  std::vector<Combination> combinations;
-  Comparison out;
+  // The combinations, in table order: method, integrator, compositor, schedule, P. Under
+  // mpirun: P = 1 on rank 0 alone first, then R x T across every rank for each T.
+  const int ranks = par::ProcessGroup::get().ranks();
+  std::vector<Placement> placements;
   std::vector<int> threads = spec.threads;
   std::sort(threads.begin(), threads.end());
   threads.erase(std::unique(threads.begin(), threads.end()), threads.end());
+  if (ranks > 1 && spec.oneRankBaseline) placements.push_back(Placement{1, 1});
+  for (int t : threads) placements.push_back(everyRank(t));
+  std::vector<Combination> combinations;
+  Comparison out;
   for (const std::string& name : spec.methods) {
     const RenderMethod& method = findRenderMethod(name);
     const bool ray = method.properties.family == MethodFamily::Ray;
@@ -139,14 +148,14 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
     for (const std::string& integrator : integratorList)
       for (const std::string& compositor : compositorList)
         for (const std::string& schedule : spec.schedules)
-          for (int p : threads) {
-            Combination c{name, method.properties.family, schedule, integrator, compositor, p};
+          for (const Placement where : placements) {
+            Combination c{name, method.properties.family, schedule, integrator, compositor, where.pes, where.ranks};
             std::string reason = whyInvalid(c, spec);
             if (reason.empty()) {
               try {
                 RayOptions rayOptions = spec.settings.ray;
                 if (integrator != kNotApplicable) rayOptions.integrator = integrator;
-                checkRenderMemory(method, input.width, input.height, p, samplesPerPixel(rayOptions));
+                checkRenderMemory(method, input.width, input.height, where.pes / where.ranks, samplesPerPixel(rayOptions));
               } catch (const InputError& e) {
                 reason = e.what();
               }
@@ -162,12 +171,16 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   // One untimed render per family first: the first render of a process pays one-time costs
   // (lazily built tables such as the environment's, first-touch page faults, the allocator's
   // growth) that would otherwise land on whichever combination happens to run first.
-  std::set<MethodFamily> warmed;
+  // Under mpirun, once on rank 0 alone and once across ranks.
+  const bool holds = holdsResults();
+  const bool progress = spec.progress && holds;
+  std::set<std::pair<MethodFamily, int>> warmed;
   for (const Combination& c : combinations) {
-    if (!warmed.insert(c.family).second) continue;
-    if (spec.progress) std::fprintf(stderr, "warm-up (untimed): %s\n", c.label().c_str());
+    if (!warmed.insert({c.family, c.ranks}).second) continue;
+    if (progress) std::fprintf(stderr, "warm-up (untimed): %s\n", c.label().c_str());
     const RenderSettings settings = settingsFor(c, spec);
-    timedRender(findRenderMethod(c.method), input, settings, c.pes, par::ScheduleOptions{c.schedule, spec.scheduleParams});
+    timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks},
+                par::ScheduleOptions{c.schedule, spec.scheduleParams});
   }
 
   const int total = int(combinations.size()) * spec.repeat;
@@ -182,9 +195,10 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
     row.what = c;
     std::vector<TimedRender> runs;
     for (int r = 0; r < spec.repeat; ++r) {
-      TimedRender t = timedRender(method, input, settings, c.pes, schedule);
+      TimedRender t = timedRender(method, input, settings, Placement{c.pes, c.ranks}, schedule);
       ++done;
-      if (spec.progress)
+      if (!holds) continue;  // rank 0 holds the figures and images
+      if (progress)
         std::fprintf(stderr, "[%d/%d] %s run %d/%d: %.3f s\n", done, total, c.label().c_str(), r + 1, spec.repeat,
                      t.wallSeconds);
       // Every repeat renders the same image (the renders are deterministic).
@@ -197,6 +211,7 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
       row.cpuSeconds.push_back(t.cpuSeconds);
       runs.push_back(std::move(t));
     }
+    if (!holds) continue;
     row.wall = median(row.wallSeconds);
     row.wallMin = *std::min_element(row.wallSeconds.begin(), row.wallSeconds.end());
     row.wallMax = *std::max_element(row.wallSeconds.begin(), row.wallSeconds.end());

@@ -31,12 +31,14 @@ struct Combination {
   MethodFamily family = MethodFamily::Ray;
   std::string schedule, integrator, compositor;
   int pes = 1;
-  std::string label() const;  // "object-space demand path P=2"
+  int ranks = 1;  // under mpirun: every rank (P = ranks x PEs per rank), or 1 for rank 0 alone
+  std::string label() const;  // "object-space demand path P=2", "... P=4 R=2" across ranks
 };
 
 struct ComparisonSpec {
   std::vector<std::string> methods, schedules, integrators, compositors;
-  std::vector<int> threads;
+  std::vector<int> threads;  // values of P; under mpirun, PEs per rank (P = ranks x each)
+  bool oneRankBaseline = true;  // under mpirun, also P = 1 on rank 0 alone
   int repeat = 3;
   RenderSettings settings;       // every other option of the renders
   par::ScheduleParams scheduleParams;
@@ -79,7 +81,11 @@ struct Comparison {
 
 // Throws pr::InputError for an empty dimension or an unknown name; a combination that cannot
 // run (sequential at P > 1, binary-swap at P not a power of two, a request over the memory
-// limit) is skipped with the reason.
+// limit) is skipped with the reason. Under mpirun with R ranks, each value T of spec.threads
+// gives a row at P = R x T across every rank, and every combination also runs at P = 1 on
+// rank 0 alone, the other ranks waiting (unless !oneRankBaseline): its T1 and the family's
+// Ts. Every rank runs the same renders; only rank 0's Comparison holds figures and images
+// (holdsResults()).
 Comparison runComparison(const ComparisonSpec& spec, const RenderInput& input);
 
 // The message kinds in the order the table and files list them.

@@ -84,7 +84,9 @@ std::string comparisonTable(const Comparison& c) {
                                      r.what.schedule,
                                      r.what.integrator,
                                      r.what.compositor,
-                                     std::to_string(r.what.pes),
+                                     r.what.ranks > 1 ? std::to_string(r.what.pes) + " (" + std::to_string(r.what.ranks) +
+                                                            "x" + std::to_string(r.what.pes / r.what.ranks) + ")"
+                                                      : std::to_string(r.what.pes),
                                      number(r.wall, "%.4g"),
                                      r.wall > 0.0 ? "±" + number(50.0 * (r.wallMax - r.wallMin) / r.wall, "%.0f") + "%" : "-",
                                      number(r.cpu, "%.4g"),
@@ -122,7 +124,7 @@ std::string comparisonCsv(const Comparison& c) {
   out << "method,family,schedule,integrator,compositor,pes,repeats,wall_seconds,wall_min,wall_max,cpu_seconds,speedup,"
          "speedup_serial,efficiency,load_imbalance,messages,bytes";
   for (const std::string& k : comparisonKinds()) out << "," << k << "_messages," << k << "_bytes";
-  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement\n";
+  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks\n";
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     out << r.what.method << "," << toString(r.what.family) << "," << r.what.schedule << "," << r.what.integrator << ","
@@ -135,7 +137,7 @@ std::string comparisonCsv(const Comparison& c) {
       out << "," << (kt ? kt->messages : 0) << "," << (kt ? kt->bytes : 0);
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
-        << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "\n";
+        << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "," << r.what.ranks << "\n";
   }
   return out.str();
 }
@@ -153,6 +155,7 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"integrator", r.what.integrator},
                     {"compositor", r.what.compositor},
                     {"pes", r.what.pes},
+                    {"ranks", r.what.ranks},
                     {"wallSeconds", r.wallSeconds},
                     {"cpuSeconds", r.cpuSeconds},
                     {"wallMedian", r.wall},

@@ -6,7 +6,6 @@
 #include "common/parallel/metrics.h"
 #include "common/util/memory_limit.h"
 #include "raster/composite/compositor.h"
-#include "tools/compare/comparison.h"
 #include "tools/compare/comparison_output.h"
 #include "tools/report/html.h"
 
@@ -18,8 +17,31 @@ constexpr const char* kMethod = "image-space-cached";
 
 }  // namespace
 
-std::string cacheSweepSection(const ReportSpec& spec, const RenderInput& input, int pes, const image::Image* expected,
-                              const std::filesystem::path& dir, const std::string& relDir) {
+std::vector<CacheRun> runCacheSweep(const ReportSpec& spec, const RenderInput& input, int threads) {
+  std::vector<CacheRun> runs;
+  const Placement where = everyRank(threads);
+  if (where.pes < 2) return runs;
+  for (double mb : spec.cacheMb) {
+    if (holdsResults()) std::fprintf(stderr, "report: %s with a %g MiB cache at P = %d\n", kMethod, mb, where.pes);
+    ComparisonSpec cs;
+    cs.methods = {kMethod};
+    cs.schedules = {spec.schedules.front()};
+    cs.integrators = {"path"};
+    cs.compositors = {raster::compositors().begin()->name};  // unused by a ray tracer, but must name one
+    cs.threads = {threads};
+    cs.oneRankBaseline = false;  // the one P of the figure
+    cs.repeat = spec.repeat;
+    cs.settings = spec.settings;
+    cs.settings.ray.cacheMb = mb;
+    cs.reference = false;
+    cs.progress = false;
+    runs.push_back(CacheRun{mb, runComparison(cs, input)});
+  }
+  return runs;
+}
+
+std::string cacheSweepSection(const ReportSpec& spec, const std::vector<CacheRun>& runs, int pes,
+                              const image::Image* expected, const std::filesystem::path& dir, const std::string& relDir) {
   std::string html = "<h3>Data management: cache hit ratio against cache size</h3>";
   if (pes < 2)
     return html + "<p>Not measured: at P = 1 every data item is the PE's own, so " + std::string(kMethod) +
@@ -27,20 +49,9 @@ std::string cacheSweepSection(const ReportSpec& spec, const RenderInput& input, 
   nlohmann::json data = nlohmann::json::array();
   std::vector<std::vector<std::string>> rows;
   int differing = 0;
-  for (double mb : spec.cacheMb) {
-    std::fprintf(stderr, "report: %s with a %g MiB cache at P = %d\n", kMethod, mb, pes);
-    ComparisonSpec cs;
-    cs.methods = {kMethod};
-    cs.schedules = {spec.schedules.front()};
-    cs.integrators = {"path"};
-    cs.compositors = {raster::compositors().begin()->name};  // unused by a ray tracer, but must name one
-    cs.threads = {pes};
-    cs.repeat = spec.repeat;
-    cs.settings = spec.settings;
-    cs.settings.ray.cacheMb = mb;
-    cs.reference = false;
-    cs.progress = false;
-    const Comparison c = runComparison(cs, input);
+  for (const CacheRun& run : runs) {
+    const double mb = run.cacheMb;
+    const Comparison& c = run.comparison;
     if (c.rows.empty()) {
       rows.push_back({formatNumber(mb, "%.4g"), "skipped: " + (c.skipped.empty() ? std::string("-") : c.skipped.front().reason)});
       continue;

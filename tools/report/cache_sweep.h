@@ -6,16 +6,27 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "common/image/image.h"
+#include "tools/compare/comparison.h"
 #include "tools/report/scene_report.h"
 #include "tools/timed_render.h"
 
 namespace pr::cli::report {
 
-// The section's HTML; its chart's data goes to dir/cache.json. `expected` is the image every
-// cache size must give (the comparison's image-space-cached image), or nullptr.
-std::string cacheSweepSection(const ReportSpec& spec, const RenderInput& input, int pes, const image::Image* expected,
-                              const std::filesystem::path& dir, const std::string& relDir);
+// The renders, one comparison per cache size at `threads` PEs per rank (P = threads without
+// mpirun), on every rank; under mpirun rank 0 holds their figures. None when P < 2.
+struct CacheRun {
+  double cacheMb = 0.0;
+  Comparison comparison;
+};
+std::vector<CacheRun> runCacheSweep(const ReportSpec& spec, const RenderInput& input, int threads);
+
+// The section's HTML from the renders at P = pes; its chart's data goes to dir/cache.json.
+// `expected` is the image every cache size must give (the comparison's image-space-cached
+// image), or nullptr.
+std::string cacheSweepSection(const ReportSpec& spec, const std::vector<CacheRun>& runs, int pes,
+                              const image::Image* expected, const std::filesystem::path& dir, const std::string& relDir);
 
 }  // namespace pr::cli::report

@@ -11,6 +11,7 @@
 
 #include "common/image/image_io.h"
 #include "common/parallel/metrics.h"
+#include "common/parallel/process_group.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
 #include "common/util/atomic_file.h"
@@ -96,33 +97,30 @@ bool onCurve(const ComparisonRow& r, const ReportSpec& spec) {
          (r.what.compositor == kNotApplicable || r.what.compositor == raster::compositors().begin()->name);
 }
 
-}  // namespace
+// What a scene's section is made from: the renders every rank takes part in (under mpirun,
+// rank 0 holds their figures and images).
+struct SceneRuns {
+  std::string sceneFile, stem;
+  const scene::Scene& scene;
+  std::string lighting;
+  const scene::RenderPlan& plan;
+  int maxThreads = 1;  // the largest --threads value: PEs per rank under mpirun
+  Comparison c;
+  std::vector<CacheRun> cacheRuns;
+  SweepResult sw;
+};
 
-std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
-                        const std::string& relDir) {
+// The section's HTML, and its files written under dir: rank 0's part.
+std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::filesystem::path& dir,
+                         const std::string& relDir) {
+  const std::string& sceneFile = r.sceneFile;
+  const std::string& stem = r.stem;
+  const scene::Scene& scene = r.scene;
+  const std::string& lighting = r.lighting;
+  const scene::RenderPlan& plan = r.plan;
+  const Comparison& c = r.c;
+  const SweepResult& sw = r.sw;
   std::filesystem::create_directories(dir / "img");
-  const std::string stem = std::filesystem::path(sceneFile).stem().string();
-  std::fprintf(stderr, "report: %s: loading\n", stem.c_str());
-  scene::Scene scene = loadScene(sceneFile, spec.lighting);
-  const std::string lighting = applyLighting(scene, spec.lighting);
-  const scene::Camera camera = scene::selectCamera(scene, spec.camera, float(spec.width) / float(spec.height));
-  const scene::RenderPlan plan = scene::analyzeEffects(scene, &camera);
-  const RenderInput input{scene, camera, plan, spec.width, spec.height};
-  const int maxP = *std::max_element(spec.threads.begin(), spec.threads.end());
-
-  // The comparison.
-  ComparisonSpec cs;
-  cs.methods = spec.methods;
-  cs.schedules = spec.schedules;
-  cs.integrators = {"path"};
-  cs.compositors = {raster::compositors().begin()->name};
-  cs.threads = spec.threads;
-  cs.repeat = spec.repeat;
-  cs.settings = spec.settings;
-  cs.referenceSettings = ReferenceSettings{sceneFile, spec.camera, "", spec.lighting, spec.referenceSpp, 16,
-                                           spec.settings.ray.seed, spec.referenceDir, false, "image-space", maxP, {}};
-  std::fprintf(stderr, "report: %s: comparison run\n", stem.c_str());
-  const Comparison c = runComparison(cs, input);
   writeFileAtomically(dir / "comparison.csv", comparisonCsv(c), "CSV file");
   writeFileAtomically(dir / "comparison.json", comparisonJson(c).dump(1, ' ', false, nlohmann::json::error_handler_t::replace) + "\n", "JSON file");
 
@@ -131,8 +129,14 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
                      " punctual lights, " + std::to_string(scene.areaLights.size()) + " emissive triangles; " +
                      escape(lighting) + ". " + std::to_string(spec.width) + "&times;" + std::to_string(spec.height) +
                      " pixels, P in {";
-  for (std::size_t i = 0; i < spec.threads.size(); ++i) html += (i ? ", " : "") + std::to_string(spec.threads[i]);
-  html += "}, " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: " + link(relDir + "/comparison.csv", "comparison.csv") + ", " +
+  // The values of P measured (under mpirun: 1 on rank 0 alone, and ranks x each --threads).
+  std::set<int> measuredPes;
+  for (const ComparisonRow& row : c.rows) measuredPes.insert(row.what.pes);
+  for (int p : measuredPes) html += (p == *measuredPes.begin() ? "" : ", ") + std::to_string(p);
+  html += "}";
+  if (const int ranks = par::ProcessGroup::get().ranks(); ranks > 1)
+    html += " across " + std::to_string(ranks) + " ranks launched by mpirun (P = 1 on rank 0 alone)";
+  html += ", " + std::to_string(spec.repeat) + " timed runs per combination (median). Files: " + link(relDir + "/comparison.csv", "comparison.csv") + ", " +
           link(relDir + "/comparison.json", "comparison.json") + ".</p>\n";
 
   // Each method's run at its largest P.
@@ -378,31 +382,10 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   if (std::find(spec.methods.begin(), spec.methods.end(), "image-space-cached") != spec.methods.end()) {
     const auto cached = scaling.find("image-space-cached");
     const image::Image* expected = cached != scaling.end() && cached->second.largest ? &cached->second.largest->image : nullptr;
-    html += cacheSweepSection(spec, input, maxP, expected, dir, relDir);
+    html += cacheSweepSection(spec, r.cacheRuns, everyRank(r.maxThreads).pes, expected, dir, relDir);
   }
 
   // Accuracy against time: the photon map against the path tracer.
-  std::fprintf(stderr, "report: %s: accuracy sweep\n", stem.c_str());
-  SweepSpec sweep;
-  sweep.scene = sceneFile;
-  sweep.width = spec.width;
-  sweep.height = spec.height;
-  sweep.camera = spec.camera;
-  sweep.threads = maxP;
-  sweep.vary = "spp";
-  sweep.values.assign(spec.photonSpp.begin(), spec.photonSpp.end());
-  sweep.integrators = {"photonmap", "path"};
-  sweep.pathSpp = spec.pathSpp;
-  sweep.pathSppGiven = true;
-  sweep.spp = spec.settings.ray.spp;
-  sweep.maxDepth = spec.settings.ray.maxDepth;
-  sweep.seed = spec.settings.ray.seed;
-  sweep.referenceSpp = spec.referenceSpp;
-  sweep.referenceDepth = 16;
-  sweep.referenceDir = spec.referenceDir.string();
-  sweep.lighting = spec.lighting;
-  sweep.photonmap = spec.settings.ray.photonmap;
-  const SweepResult sw = runSweep(sweep);
   nlohmann::json accuracy = nlohmann::json::array();
   for (const SweepRow& r : sw.rows)
     accuracy.push_back({{"integrator", r.integrator}, {"setting", r.setting + " " + formatValue(r.value)},
@@ -428,7 +411,6 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
 
   // The verdict.
   html += "<h3>Verdict</h3><div class=\"verdict\"><ul>";
-  std::set<int> measuredPes(spec.threads.begin(), spec.threads.end());
   for (int p : measuredPes) {
     const ComparisonRow* fastest = nullptr;
     for (const ComparisonRow& r : c.rows)
@@ -491,6 +473,71 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     html += "</ul></li>";
   }
   html += "</ul></div></section>\n";
+  return html;
+}
+
+
+}  // namespace
+
+std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
+                        const std::string& relDir) {
+  const bool holds = holdsResults();  // under mpirun, rank 0 prints and writes
+  const std::string stem = std::filesystem::path(sceneFile).stem().string();
+  if (holds) std::fprintf(stderr, "report: %s: loading\n", stem.c_str());
+  scene::Scene scene = loadScene(sceneFile, spec.lighting);
+  const std::string lighting = applyLighting(scene, spec.lighting);
+  const scene::Camera camera = scene::selectCamera(scene, spec.camera, float(spec.width) / float(spec.height));
+  const scene::RenderPlan plan = scene::analyzeEffects(scene, &camera);
+  const RenderInput input{scene, camera, plan, spec.width, spec.height};
+  const int maxThreads = *std::max_element(spec.threads.begin(), spec.threads.end());
+  SceneRuns runs{sceneFile, stem, scene, lighting, plan, maxThreads, {}, {}, {}};
+
+  // The renders, every rank taking part in each.
+  ComparisonSpec cs;
+  cs.methods = spec.methods;
+  cs.schedules = spec.schedules;
+  cs.integrators = {"path"};
+  cs.compositors = {raster::compositors().begin()->name};
+  cs.threads = spec.threads;
+  cs.repeat = spec.repeat;
+  cs.settings = spec.settings;
+  cs.referenceSettings = ReferenceSettings{sceneFile, spec.camera, "", spec.lighting, spec.referenceSpp, 16,
+                                           spec.settings.ray.seed, spec.referenceDir, false, "image-space",
+                                           everyRank(maxThreads), {}};
+  if (holds) std::fprintf(stderr, "report: %s: comparison run\n", stem.c_str());
+  runs.c = runComparison(cs, input);
+  // Data management: the cached tracer's hit ratio against its cache size.
+  if (std::find(spec.methods.begin(), spec.methods.end(), "image-space-cached") != spec.methods.end())
+    runs.cacheRuns = runCacheSweep(spec, input, maxThreads);
+  // Accuracy against time: the photon map against the path tracer.
+  if (holds) std::fprintf(stderr, "report: %s: accuracy sweep\n", stem.c_str());
+  SweepSpec sweep;
+  sweep.scene = sceneFile;
+  sweep.width = spec.width;
+  sweep.height = spec.height;
+  sweep.camera = spec.camera;
+  sweep.threads = maxThreads;
+  sweep.vary = "spp";
+  sweep.values.assign(spec.photonSpp.begin(), spec.photonSpp.end());
+  sweep.integrators = {"photonmap", "path"};
+  sweep.pathSpp = spec.pathSpp;
+  sweep.pathSppGiven = true;
+  sweep.spp = spec.settings.ray.spp;
+  sweep.maxDepth = spec.settings.ray.maxDepth;
+  sweep.seed = spec.settings.ray.seed;
+  sweep.referenceSpp = spec.referenceSpp;
+  sweep.referenceDepth = 16;
+  sweep.referenceDir = spec.referenceDir.string();
+  sweep.lighting = spec.lighting;
+  sweep.photonmap = spec.settings.ray.photonmap;
+  runs.sw = runSweep(sweep);
+
+  // The section, written by rank 0 alone while the other ranks wait.
+  std::string html;
+  par::ProcessGroup::get().onRank0Alone("rank 0 writing the report's section on " + stem, [&] {
+    html = sceneSection(runs, spec, dir, relDir);
+    return par::Bytes();
+  });
   return html;
 }
 

@@ -7,6 +7,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/parallel/process_group.h"
 #include "tools/sweep/reference_cache.h"
 
 namespace pr::cli {
@@ -30,22 +31,31 @@ Reference pathReference(const ReferenceSettings& s, const RenderInput& input) {
                               {"variant", s.lighting.variant}};
   const ReferenceCache cache(s.dir.empty() ? ReferenceCache::defaultDir() : s.dir);
   Reference out;
-  if (!s.noCache)
-    if (std::optional<image::Image> cached = cache.find(key)) {
-      out.image = std::move(*cached);
-      out.cached = true;
-      std::fprintf(stderr, "reference: cached (path, spp %d) in %s\n", s.spp, cache.dir().string().c_str());
-      return out;
-    }
-  std::fprintf(stderr, "reference: rendering (path, spp %d, depth %d) ...\n", s.spp, s.maxDepth);
+  // Whether the cache holds it is rank 0's to know (it alone reads files): one byte to the others.
+  const par::Bytes cached = par::ProcessGroup::get().onRank0Alone("rank 0's look in the reference cache", [&] {
+    if (!s.noCache)
+      if (std::optional<image::Image> image = cache.find(key)) {
+        out.image = std::move(*image);
+        out.cached = true;
+        std::fprintf(stderr, "reference: cached (path, spp %d) in %s\n", s.spp, cache.dir().string().c_str());
+      }
+    return par::Bytes{std::byte(out.cached)};
+  });
+  if (cached.at(0) != std::byte(0)) {
+    out.cached = true;
+    return out;
+  }
+  const bool holds = holdsResults();
+  if (holds) std::fprintf(stderr, "reference: rendering (path, spp %d, depth %d) ...\n", s.spp, s.maxDepth);
   RenderSettings settings;
   settings.ray.integrator = "path";
   settings.ray.spp = s.spp;
   settings.ray.maxDepth = s.maxDepth;
   settings.ray.seed = s.seed ^ kReferenceSeedOffset;
-  TimedRender t = timedRender(findRenderMethod(s.method), input, settings, s.pes, s.schedule);
+  TimedRender t = timedRender(findRenderMethod(s.method), input, settings, s.where, s.schedule);
   out.cpuSeconds = t.cpuSeconds;
   out.image = std::move(t.outcome.image);
+  if (!holds) return out;  // rank 0 holds the image
   if (!s.noCache) out.file = cache.store(key, out.image);
   std::fprintf(stderr, "reference: %.1f CPU s%s%s\n", out.cpuSeconds, out.file.empty() ? "" : ", stored as ",
                out.file.string().c_str());

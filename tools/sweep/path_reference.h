@@ -1,7 +1,9 @@
 // The reference every error figure of sweep, compare and report is measured against: a long
 // path-traced render of the scene with its own random stream, taken from the reference cache
 // (reference_cache.h) when one with exactly these settings is on disk, else rendered (with
-// progress on stderr) and stored.
+// progress on stderr) and stored. Under mpirun, rank 0 looks in the cache and tells the
+// others; a reference to render is rendered across every rank (`where`), and stored by rank 0,
+// which alone holds its image.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +25,7 @@ struct ReferenceSettings {
   std::filesystem::path dir;  // empty: ReferenceCache::defaultDir()
   bool noCache = false;       // render afresh and do not store
   std::string method = "image-space";  // how it is rendered (the image does not depend on it)
-  int pes = 1;
+  Placement where;
   par::ScheduleOptions schedule;
 };
 

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "common/image/image_io.h"
+#include "common/parallel/process_group.h"
 #include "common/scene/camera_select.h"
 #include "common/scene/effect_analysis.h"
 #include "common/scene/gltf_loader.h"
@@ -32,7 +33,7 @@ struct Context {
 
 // One timed render of the series: a fresh runtime, CPU time of the whole process (every PE).
 SweepTimed render(const Context& c, const RenderSettings& settings) {
-  TimedRender t = timedRender(findRenderMethod(c.args.method), c.input, settings, c.args.threads, c.args.schedule);
+  TimedRender t = timedRender(findRenderMethod(c.args.method), c.input, settings, everyRank(c.args.threads), c.args.schedule);
   return SweepTimed{std::move(t.outcome.image), t.cpuSeconds, t.wallSeconds};
 }
 
@@ -121,13 +122,16 @@ SweepResult runSweep(SweepSpec& a) {
   if (method.properties.family != MethodFamily::Ray)
     throw InputError("sweep compares ray-tracing integrators; method " + a.method + " is " +
                      std::string(toString(method.properties.family)));
+  const bool holds = holdsResults();  // under mpirun, rank 0's: the others render and no more
+  if (par::ProcessGroup::get().ranks() > 1 && !runsAcrossRanks(method))
+    throw InputError("method " + a.method + " does not run across processes (methods that do: " + methodsAcrossRanks() + ")");
   const bool photonmap = std::find(a.integrators.begin(), a.integrators.end(), "photonmap") != a.integrators.end();
   if (a.vary != "spp" && !photonmap)
     throw InputError("--vary " + a.vary + " varies a photon-map setting; add photonmap to --integrator or vary spp");
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
   scene::Scene scene = loadScene(a.scene, a.lighting);
   const std::string lighting = applyLighting(scene, a.lighting);
-  std::fprintf(stderr, "%s\n", lighting.c_str());
+  if (holds) std::fprintf(stderr, "%s\n", lighting.c_str());
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
   if (a.values.empty()) a.values = defaultValues(a.vary, scene);
@@ -140,11 +144,11 @@ SweepResult runSweep(SweepSpec& a) {
                        (range.integral ? "an integer " : "a number ") + "in " + (range.leastAllowed ? "[" : "(") +
                        formatValue(range.least) + ", " + formatValue(range.most) + "])");
   const Context ctx{a, RenderInput{scene, camera, plan, a.width, a.height}};
-  if (!a.images.empty()) std::filesystem::create_directories(a.images);
+  if (!a.images.empty() && holds) std::filesystem::create_directories(a.images);
 
   // The reference: reused when a render with exactly these settings is on disk.
   ReferenceSettings referenceSettings{a.scene, a.camera, a.effects, a.lighting, a.referenceSpp, a.referenceDepth, a.seed,
-                                      a.referenceDir, a.noCache, a.method, a.threads, a.schedule};
+                                      a.referenceDir, a.noCache, a.method, everyRank(a.threads), a.schedule};
   Reference ref = pathReference(referenceSettings, ctx.input);
   const image::Image& reference = ref.image;
 
@@ -154,8 +158,8 @@ SweepResult runSweep(SweepSpec& a) {
     RenderSettings view = baseSettings(a, "photonmap", 1, a.seed, a.maxDepth);
     view.ray.view = "caustic-map";
     const image::Image caustic = render(ctx, view).image;
-    causticMask.resize(caustic.pixels.size());
-    for (std::size_t i = 0; i < caustic.pixels.size(); ++i) {
+    if (holds) causticMask.resize(caustic.pixels.size());
+    for (std::size_t i = 0; i < caustic.pixels.size() && holds; ++i) {
       const double c = rt::luminance(caustic.pixels[i]), r = rt::luminance(reference.pixels[i]);
       causticMask[i] = c > 0.0 && c >= kCausticShare * r;
     }
@@ -178,6 +182,7 @@ SweepResult runSweep(SweepSpec& a) {
       if (integrator == "photonmap") applyVaried(a.vary, v, s);
       else s.ray.spp = int(v);
       SweepRow row{integrator, setting, v, render(ctx, s), {}};
+      if (!holds) continue;
       row.error = imageError(row.timed.image, reference, causticMask);
       std::fprintf(stderr, "[%zu/%zu] %s %s %s: %.2f CPU s, RMSE %.5f\n", rows.size() + 1, total, integrator.c_str(),
                    setting.c_str(), formatValue(v).c_str(), row.timed.cpuSeconds, row.error.rmse);
@@ -190,6 +195,7 @@ SweepResult runSweep(SweepSpec& a) {
       rows.push_back(std::move(row));
     }
   }
+  if (!holds) return {};
   if (!a.images.empty()) image::writeImage((std::filesystem::path(a.images) / "reference.png").string(), reference);
 
   // The target RMSE: given, or the lowest RMSE every integrator reaches.

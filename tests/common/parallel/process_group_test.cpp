@@ -92,3 +92,18 @@ TEST_CASE("ProcessGroup: a task that fails on one rank's PE ends the stage on ev
   CHECK(occurrences(r.output, "parrender: failed (rank 1 of 2): an injected task failure") == 1);
   CHECK(occurrences(r.output, "parrender: failed") == 1);
 }
+
+// Work on rank 0 alone (a one-PE baseline of compare, a look in the reference cache) may take
+// longer than any one wait may last: rank 0 tells the others it is working, and its result
+// reaches every rank; its failure ends every rank with one message.
+TEST_CASE("ProcessGroup: work on rank 0 alone outlasts the bounded wait while the others wait, and its result reaches every rank") {
+  const CommandResult r = mpirun(3, check(), "alone 3", 60, "PARRENDER_RANK_TIMEOUT=1");
+  INFO(r.output);
+  CHECK(r.exitStatus == 0);
+  CHECK(occurrences(r.output, "got rank 0's result") == 3);
+  const CommandResult fail = mpirun(2, check(), "alonefail 0", 60, "PARRENDER_RANK_TIMEOUT=5");
+  INFO(fail.output);
+  CHECK(fail.exitStatus == 1);
+  CHECK(occurrences(fail.output, "parrender: failed (rank 0 of 2): an injected failure alone") == 1);
+  CHECK(occurrences(fail.output, "parrender: failed") == 1);
+}

@@ -7,7 +7,11 @@
 //   stages T     the runtime on T PEs per rank: under several strategies, every task runs once
 //                and chains of messages that cross ranks end before their stage does
 //   stagefail PE a task on PE PE throws; the stage ends on every rank, rank 0 reports it
+//   alone S      rank 0 works alone for S seconds (past PARRENDER_RANK_TIMEOUT) while the others
+//                wait; every rank gets its result
+//   alonefail    rank 0's work alone throws; every rank ends, rank 0 reports it
 // Exit status: the run's (finish), the same on every rank.
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -108,6 +112,19 @@ void stageFail(ProcessGroup& group, int failingPe) {
   });
 }
 
+// Rank 0 works alone for `seconds`, then gives every rank a result naming its size.
+void alone(ProcessGroup& group, int seconds, bool fail) {
+  const std::string made = "made on rank 0 alone";
+  const Bytes result = group.onRank0Alone("the test's work on rank 0", [&] {
+    std::this_thread::sleep_for(std::chrono::seconds(seconds));
+    if (fail) throw std::runtime_error("an injected failure alone");
+    return Bytes(reinterpret_cast<const std::byte*>(made.data()), reinterpret_cast<const std::byte*>(made.data()) + made.size());
+  });
+  if (std::string(reinterpret_cast<const char*>(result.data()), result.size()) != made)
+    throw std::runtime_error("rank " + std::to_string(group.rank()) + " got another result");
+  std::printf("alone: rank %d got rank 0's result\n", group.rank());
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -120,6 +137,7 @@ int main(int argc, char** argv) {
     if (mode == "exchange") exchange(group);
     if (mode == "stages") stages(group, target);
     if (mode == "stagefail") stageFail(group, target);
+    if (mode == "alone" || mode == "alonefail") alone(group, std::max(0, target), mode == "alonefail");
     if (mode == "fail" && group.rank() == target) throw std::runtime_error("an injected failure");
     if (mode == "hang" && group.rank() == target) std::this_thread::sleep_for(std::chrono::seconds(60));
   } catch (const pr::par::FailedElsewhere&) {
