@@ -160,6 +160,17 @@ void run(RenderArgs& a) {
     if (summary.total.computeToComm >= 0.0)
       std::printf("; computation/communication %.1f", summary.total.computeToComm);
     std::printf("\n");
+    // Across ranks: what of it crossed between the processes, the rest staying within one.
+    if (group.ranks() > 1) {
+      std::printf("between ranks:");
+      separator = " ";
+      for (const par::KindTraffic& k : summary.total.byKind) {
+        std::printf("%s%s %llu (%llu bytes)", separator, k.kind.c_str(), (unsigned long long)k.betweenRankMessages,
+                    (unsigned long long)k.betweenRankBytes);
+        separator = ", ";
+      }
+      std::printf("; within ranks: the rest\n");
+    }
   }
 }
 

@@ -58,8 +58,9 @@ class Channel : public ChannelBase {
     PR_CHECK(to >= 0 && to < runtime_.pes(), "Channel '" + name() + "': destination PE out of range");
     const SendReceiveTimer timer(from);
     runtime_.countMessage(from.id(), to, bytes);
-    if (from.id() != to) countSent(bytes);
-    if (!runtime_.isLocal(to)) return sendToRank(from.id(), to, message, bytes);
+    const bool local = runtime_.isLocal(to);
+    if (from.id() != to) countSent(bytes, !local);
+    if (!local) return sendToRank(from.id(), to, message, bytes);
     if (handler_) runtime_.outstanding().add();  // before the receiver can see it
     enqueue(to, std::move(message));
   }

@@ -79,6 +79,8 @@ void mergeRankPart(RunRecord& into, const RunRecord& part, int first, int count,
       } else {
         it->messages += c.messages;
         it->bytes += c.bytes;
+        it->betweenRankMessages += c.betweenRankMessages;
+        it->betweenRankBytes += c.betweenRankBytes;
       }
     }
   }

@@ -131,41 +131,53 @@ std::vector<PeStageRecord> peTotals(const RunRecord& record) {
 
 namespace {
 
-void addTraffic(std::vector<KindTraffic>& into, const std::string& kind, std::uint64_t messages, std::uint64_t bytes) {
-  if (messages == 0 && bytes == 0) return;
-  auto it = std::find_if(into.begin(), into.end(), [&](const KindTraffic& k) { return k.kind == kind; });
-  if (it == into.end()) it = into.insert(into.end(), KindTraffic{kind, 0, 0});
-  it->messages += messages;
-  it->bytes += bytes;
+void addTraffic(std::vector<KindTraffic>& into, const KindTraffic& add) {
+  if (add.messages == 0 && add.bytes == 0) return;
+  auto it = std::find_if(into.begin(), into.end(), [&](const KindTraffic& k) { return k.kind == add.kind; });
+  if (it == into.end()) it = into.insert(into.end(), KindTraffic{add.kind});
+  it->messages += add.messages;
+  it->bytes += add.bytes;
+  it->betweenRankMessages += add.betweenRankMessages;
+  it->betweenRankBytes += add.betweenRankBytes;
 }
 
 }  // namespace
 
-std::vector<KindTraffic> trafficByKind(const StageRecord& stage) {
+std::vector<KindTraffic> trafficByKind(const StageRecord& stage, int ranks) {
   std::vector<KindTraffic> kinds;
-  for (const ChannelTraffic& c : stage.channels) addTraffic(kinds, c.kind, c.messages, c.bytes);
-  std::uint64_t schedulingMessages = 0, schedulingBytes = 0, broadcasts = 0, broadcastBytes = 0;
-  for (const PeStageRecord& r : stage.pes) {
-    schedulingMessages += r.schedulingMessages;
-    schedulingBytes += r.schedulingBytes;
-    broadcasts += r.broadcastsReceived;
-    broadcastBytes += r.broadcastBytesReceived;
+  for (const ChannelTraffic& c : stage.channels)
+    addTraffic(kinds, {c.kind, c.messages, c.bytes, c.betweenRankMessages, c.betweenRankBytes});
+  KindTraffic tasks{"tasks"}, broadcasts{"broadcasts"};
+  const std::size_t perRank = std::max<std::size_t>(1, stage.pes.size() / std::size_t(std::max(1, ranks)));
+  for (std::size_t p = 0; p < stage.pes.size(); ++p) {
+    const PeStageRecord& r = stage.pes[p];
+    tasks.messages += r.schedulingMessages;
+    tasks.bytes += r.schedulingBytes;
+    tasks.betweenRankMessages += r.schedulingMessagesBetweenRanks;
+    tasks.betweenRankBytes += r.schedulingBytesBetweenRanks;
+    broadcasts.messages += r.broadcastsReceived;
+    broadcasts.bytes += r.broadcastBytesReceived;
+    if (p % perRank == 0 && p >= perRank) {  // another rank's first PE: its copy came from rank 0
+      broadcasts.betweenRankMessages += r.broadcastsReceived;
+      broadcasts.betweenRankBytes += r.broadcastBytesReceived;
+    }
   }
-  addTraffic(kinds, "tasks", schedulingMessages, schedulingBytes);
-  addTraffic(kinds, "broadcasts", broadcasts, broadcastBytes);
+  addTraffic(kinds, tasks);
+  addTraffic(kinds, broadcasts);
   return kinds;
 }
 
 RunSummary summarize(const RunRecord& record) {
   RunSummary summary;
   summary.pes = record.pes;
+  summary.ranks = record.ranks;
   summary.wallSeconds = record.wallSeconds;
   double stageWall = 0.0;
   std::vector<KindTraffic> byKind;
   for (const StageRecord& stage : record.stages) {
     summary.stages.push_back(summarizePes(stage.name, stage.schedule, stage.wallSeconds, stage.pes));
-    summary.stages.back().byKind = trafficByKind(stage);
-    for (const KindTraffic& k : summary.stages.back().byKind) addTraffic(byKind, k.kind, k.messages, k.bytes);
+    summary.stages.back().byKind = trafficByKind(stage, record.ranks);
+    for (const KindTraffic& k : summary.stages.back().byKind) addTraffic(byKind, k);
     stageWall += stage.wallSeconds;
   }
   // Efficiency of the whole run over the time spent in stages; the controller's serial code
@@ -231,9 +243,15 @@ std::string formatSummary(const RunSummary& summary) {
   if (!summary.total.byKind.empty()) {
     out += "traffic between PEs by kind:\n";
     for (const KindTraffic& k : summary.total.byKind) {
-      std::snprintf(line, sizeof line, "  %-12s %12llu messages %16llu bytes\n", k.kind.c_str(),
+      std::snprintf(line, sizeof line, "  %-12s %12llu messages %16llu bytes", k.kind.c_str(),
                     (unsigned long long)k.messages, (unsigned long long)k.bytes);
       out += line;
+      if (summary.ranks > 1) {
+        std::snprintf(line, sizeof line, "  (between ranks %llu messages, %llu bytes)", (unsigned long long)k.betweenRankMessages,
+                      (unsigned long long)k.betweenRankBytes);
+        out += line;
+      }
+      out += "\n";
     }
   }
   if (summary.total.computeToComm >= 0.0) {

@@ -30,10 +30,15 @@ const std::vector<PeFigure>& peFigures();
 
 // Messages and bytes between PEs of one kind: a MessageKind of the channels ("primitives",
 // "pixels", "rays", "results", "requests", "data"), "tasks" (scheduling traffic, modelled
-// sizes) or "broadcasts" (replicated data, once per receiving PE).
+// sizes) or "broadcasts" (replicated data, once per receiving PE). Of those, the messages and
+// bytes that crossed between ranks (processes): a channel's messages to a PE on another rank,
+// the task requests and answers of PEs on another rank than the controller's (rank 0), and the
+// copy of each broadcast that reaches every other rank's first PE (a broadcast's root is on
+// rank 0); the rest stayed within a rank. All within a rank on one process.
 struct KindTraffic {
   std::string kind;
   std::uint64_t messages = 0, bytes = 0;
+  std::uint64_t betweenRankMessages = 0, betweenRankBytes = 0;
 };
 
 struct StageSummary {
@@ -62,6 +67,7 @@ struct CounterSummary {
 
 struct RunSummary {
   int pes = 1;
+  int ranks = 1;
   double wallSeconds = 0.0;
   std::vector<StageSummary> stages;
   std::vector<CounterSummary> counters;
@@ -71,8 +77,8 @@ struct RunSummary {
 // Per-PE totals over all stages.
 std::vector<PeStageRecord> peTotals(const RunRecord& record);
 RunSummary summarize(const RunRecord& record);
-// Traffic of one stage by kind (see KindTraffic).
-std::vector<KindTraffic> trafficByKind(const StageRecord& stage);
+// Traffic of one stage by kind (see KindTraffic), its PEs spread over `ranks` ranks.
+std::vector<KindTraffic> trafficByKind(const StageRecord& stage, int ranks = 1);
 // A readable table: one row per stage and a total row; figures as min/mean/max.
 std::string formatSummary(const RunSummary& summary);
 

@@ -19,6 +19,7 @@ struct alignas(64) PeCounters {
   std::atomic<std::uint64_t> tasks{0}, messagesHandled{0};
   std::atomic<std::uint64_t> messagesSent{0}, bytesSent{0}, messagesReceived{0}, bytesReceived{0};
   std::atomic<std::uint64_t> schedulingMessages{0}, schedulingBytes{0};
+  std::atomic<std::uint64_t> schedulingMessagesBetweenRanks{0}, schedulingBytesBetweenRanks{0};
   std::atomic<std::uint64_t> cacheHits{0}, cacheMisses{0}, prefetches{0};
   double busySeconds = 0.0;
   double sendReceiveSeconds = 0.0;  // inside Channel send, receive and broadcast calls

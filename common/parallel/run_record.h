@@ -30,8 +30,10 @@ struct PeStageRecord {
   std::uint64_t messagesHandled = 0;
   std::uint64_t messagesSent = 0, bytesSent = 0;
   std::uint64_t messagesReceived = 0, bytesReceived = 0;
-  // Task requests and task packets between this PE and the controller or a neighbour.
+  // Task requests and task packets between this PE and the controller or a neighbour; the
+  // part of them that crossed between ranks (a PE on another rank than the controller's).
   std::uint64_t schedulingMessages = 0, schedulingBytes = 0;
+  std::uint64_t schedulingMessagesBetweenRanks = 0, schedulingBytesBetweenRanks = 0;
   // Replicated read-only data received (scene, photon map), counted once per receiving PE.
   std::uint64_t broadcastsReceived = 0, broadcastBytesReceived = 0;
   std::uint64_t cacheHits = 0, cacheMisses = 0, prefetches = 0;
@@ -48,6 +50,7 @@ struct Traffic {
 struct ChannelTraffic {
   std::string name, kind;
   std::uint64_t messages = 0, bytes = 0;
+  std::uint64_t betweenRankMessages = 0, betweenRankBytes = 0;  // the part sent to another rank
 };
 
 struct StageRecord {
@@ -90,6 +93,8 @@ struct CounterRecord {
 
 struct RunRecord {
   int pes = 1;
+  // The processes the PEs ran in: PEs [r * pes / ranks, (r + 1) * pes / ranks) on rank r.
+  int ranks = 1;
   std::string schedule;
   int grain = 1;
   double wallSeconds = 0.0;  // first stage start to last stage end

@@ -41,7 +41,9 @@ json summaryJson(const StageSummary& s) {
             {"schedulingBytes", s.schedulingBytes}};
   j["computeToComm"] = s.computeToComm >= 0.0 ? json(s.computeToComm) : json(nullptr);
   json kinds = json::object();
-  for (const KindTraffic& k : s.byKind) kinds[k.kind] = {{"messages", k.messages}, {"bytes", k.bytes}};
+  for (const KindTraffic& k : s.byKind)
+    kinds[k.kind] = {{"messages", k.messages}, {"bytes", k.bytes}, {"betweenRankMessages", k.betweenRankMessages},
+                     {"betweenRankBytes", k.betweenRankBytes}};
   j["trafficByKind"] = kinds;
   json perPe = json::object();
   const auto& figures = peFigures();
@@ -65,6 +67,8 @@ json peJson(const PeStageRecord& r) {
           {"bytesReceived", r.bytesReceived},
           {"schedulingMessages", r.schedulingMessages},
           {"schedulingBytes", r.schedulingBytes},
+          {"schedulingMessagesBetweenRanks", r.schedulingMessagesBetweenRanks},
+          {"schedulingBytesBetweenRanks", r.schedulingBytesBetweenRanks},
           {"broadcastsReceived", r.broadcastsReceived},
           {"broadcastBytesReceived", r.broadcastBytesReceived},
           {"cacheHits", r.cacheHits},
@@ -75,6 +79,7 @@ json peJson(const PeStageRecord& r) {
 json toJson(const RunRecord& record) {
   json j;
   j["pes"] = record.pes;
+  j["ranks"] = record.ranks;
   j["schedule"] = record.schedule;
   j["grain"] = record.grain;
   j["wallSeconds"] = record.wallSeconds;
@@ -105,7 +110,8 @@ json toJson(const RunRecord& record) {
     js["traffic"] = traffic;
     json channels = json::array();
     for (const ChannelTraffic& c : s.channels)
-      channels.push_back({{"name", c.name}, {"kind", c.kind}, {"messages", c.messages}, {"bytes", c.bytes}});
+      channels.push_back({{"name", c.name}, {"kind", c.kind}, {"messages", c.messages}, {"bytes", c.bytes},
+                          {"betweenRankMessages", c.betweenRankMessages}, {"betweenRankBytes", c.betweenRankBytes}});
     js["channels"] = channels;
     json tasks = json::array();
     for (const TaskInfo& t : s.tasks) tasks.push_back({t.costEstimate, t.x, t.y});
@@ -222,6 +228,9 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
   RunRecord record;
   record.pes = field<int>(j, "pes", origin, top);
   if (record.pes < 1) throw InputError(origin + ": \"pes\" must be at least 1");
+  record.ranks = optionalField(j, "ranks", 1, origin, top);
+  if (record.ranks < 1 || record.pes % record.ranks != 0)
+    throw InputError(origin + ": \"ranks\" must divide \"pes\" (" + std::to_string(record.pes) + ")");
   record.schedule = j.value("schedule", std::string());
   record.grain = optionalField(j, "grain", 1, origin, top);
   record.wallSeconds = optionalField(j, "wallSeconds", 0.0, origin, top);
@@ -257,6 +266,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       r.bytesReceived = count("bytesReceived");
       r.schedulingMessages = count("schedulingMessages");
       r.schedulingBytes = count("schedulingBytes");
+      r.schedulingMessagesBetweenRanks = count("schedulingMessagesBetweenRanks");
+      r.schedulingBytesBetweenRanks = count("schedulingBytesBetweenRanks");
       r.broadcastsReceived = count("broadcastsReceived");
       r.broadcastBytesReceived = count("broadcastBytesReceived");
       r.cacheHits = count("cacheHits");
@@ -274,7 +285,9 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       const std::string channel = where + " channel";
       s.channels.push_back({jc.value("name", std::string()), jc.value("kind", std::string()),
                             optionalField(jc, "messages", std::uint64_t{0}, origin, channel),
-                            optionalField(jc, "bytes", std::uint64_t{0}, origin, channel)});
+                            optionalField(jc, "bytes", std::uint64_t{0}, origin, channel),
+                            optionalField(jc, "betweenRankMessages", std::uint64_t{0}, origin, channel),
+                            optionalField(jc, "betweenRankBytes", std::uint64_t{0}, origin, channel)});
     }
     const json tasks = field<json>(js, "tasks", origin, where);
     for (const json& jt : tasks) {

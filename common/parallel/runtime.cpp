@@ -42,6 +42,7 @@ Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(
   for (int i = 0; i < p; ++i) bells_.push_back(std::make_unique<Doorbell>());
   spans_.resize(p);
   record_.pes = p;
+  record_.ranks = ranks_;
   record_.schedule = options_.schedule;
   record_.grain = options_.params.grain;
 }
@@ -324,9 +325,13 @@ void Runtime::peLoop(int p, const StageJob& job) {
         }
         if (grab.from != p && grab.packets + grab.requests > 0) {
           c.schedulingMessages.fetch_add(grab.requests + grab.packets, std::memory_order_relaxed);
-          c.schedulingBytes.fetch_add(grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes +
-                                          grab.moved * kTaskEntryBytes,
-                                      std::memory_order_relaxed);
+          const std::uint64_t bytes =
+              grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes;
+          c.schedulingBytes.fetch_add(bytes, std::memory_order_relaxed);
+          if (askController) {  // asked rank 0's controller, and answered, by messages between ranks
+            c.schedulingMessagesBetweenRanks.fetch_add(grab.requests + grab.packets, std::memory_order_relaxed);
+            c.schedulingBytesBetweenRanks.fetch_add(bytes, std::memory_order_relaxed);
+          }
         }
         for (TaskId id : grab.tasks) {
           if (abort_.load(std::memory_order_relaxed)) break;
@@ -371,8 +376,8 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   // Reset the live state; no PE thread exists at this point.
   for (PeCounters& c : counters_) {
     for (auto* a : {&c.tasks, &c.messagesHandled, &c.messagesSent, &c.bytesSent, &c.messagesReceived,
-                    &c.bytesReceived, &c.schedulingMessages, &c.schedulingBytes, &c.cacheHits, &c.cacheMisses,
-                    &c.prefetches})
+                    &c.bytesReceived, &c.schedulingMessages, &c.schedulingBytes, &c.schedulingMessagesBetweenRanks,
+                    &c.schedulingBytesBetweenRanks, &c.cacheHits, &c.cacheMisses, &c.prefetches})
       a->store(0, std::memory_order_relaxed);
     c.busySeconds = c.sendReceiveSeconds = c.messageWaitSeconds = c.inTaskWaitSeconds = c.pendingWaitSeconds = 0.0;
   }
@@ -450,6 +455,8 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.bytesReceived = c.bytesReceived.load();
     r.schedulingMessages = c.schedulingMessages.load();
     r.schedulingBytes = c.schedulingBytes.load();
+    r.schedulingMessagesBetweenRanks = c.schedulingMessagesBetweenRanks.load();
+    r.schedulingBytesBetweenRanks = c.schedulingBytesBetweenRanks.load();
     for (const PendingBroadcast& b : pendingBroadcasts_)
       if (b.root != p) {
         r.broadcastsReceived += 1;
@@ -466,8 +473,9 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   {
     std::lock_guard lock(channelMutex_);
     for (ChannelBase* channel : registered_) {
-      const auto [messages, bytes] = channel->takeCounts();
-      if (messages > 0) sr.channels.push_back({channel->name(), std::string(toString(channel->kind())), messages, bytes});
+      const auto [messages, bytes, remoteMessages, remoteBytes] = channel->takeCounts();
+      if (messages > 0)
+        sr.channels.push_back({channel->name(), std::string(toString(channel->kind())), messages, bytes, remoteMessages, remoteBytes});
     }
   }
   for (const PendingBroadcast& b : pendingBroadcasts_) {

@@ -30,6 +30,7 @@
 // wake-up and a barrier, not P thread creations (bench_runtime section 6).
 #pragma once
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -89,14 +90,19 @@ class ChannelBase {
   // rank, since every rank makes the same channels (set by Runtime::attach).
   std::uint32_t id() const { return id_; }
   void setId(std::uint32_t id) { id_ = id; }
-  // Called by Channel::send for a message between two PEs.
-  void countSent(std::size_t bytes) {
+  // Called by Channel::send for a message between two PEs, on two ranks or one.
+  void countSent(std::size_t bytes, bool betweenRanks) {
     messages_.fetch_add(1, std::memory_order_relaxed);
     bytes_.fetch_add(bytes, std::memory_order_relaxed);
+    if (!betweenRanks) return;
+    remoteMessages_.fetch_add(1, std::memory_order_relaxed);
+    remoteBytes_.fetch_add(bytes, std::memory_order_relaxed);
   }
-  // The counts since the last call (by the runtime, between stages).
-  std::pair<std::uint64_t, std::uint64_t> takeCounts() {
-    return {messages_.exchange(0, std::memory_order_relaxed), bytes_.exchange(0, std::memory_order_relaxed)};
+  // The counts since the last call (by the runtime, between stages): messages, bytes, and the
+  // messages and bytes of them sent to another rank.
+  std::array<std::uint64_t, 4> takeCounts() {
+    return {messages_.exchange(0, std::memory_order_relaxed), bytes_.exchange(0, std::memory_order_relaxed),
+            remoteMessages_.exchange(0, std::memory_order_relaxed), remoteBytes_.exchange(0, std::memory_order_relaxed)};
   }
   virtual bool pending(int pe) const = 0;
   // Pops one message for pe and runs the handler on it; false when there was none.
@@ -109,7 +115,7 @@ class ChannelBase {
   std::string name_;
   MessageKind kind_;
   std::uint32_t id_ = 0;
-  std::atomic<std::uint64_t> messages_{0}, bytes_{0};
+  std::atomic<std::uint64_t> messages_{0}, bytes_{0}, remoteMessages_{0}, remoteBytes_{0};
 };
 
 // What runStage throws on a rank whose PEs did not fail when a PE on another rank did: the

@@ -41,7 +41,10 @@ const par::KindTraffic* kindTraffic(const ComparisonRow& row, const std::string&
 
 par::KindTraffic allTraffic(const ComparisonRow& row) {
   par::KindTraffic all{"all"};
-  for (const par::KindTraffic& k : row.summary.total.byKind) all.messages += k.messages, all.bytes += k.bytes;
+  for (const par::KindTraffic& k : row.summary.total.byKind) {
+    all.messages += k.messages, all.bytes += k.bytes;
+    all.betweenRankMessages += k.betweenRankMessages, all.betweenRankBytes += k.betweenRankBytes;
+  }
   return all;
 }
 

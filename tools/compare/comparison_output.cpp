@@ -74,6 +74,9 @@ std::string comparisonTable(const Comparison& c) {
   std::vector<std::string> header = {"method", "family", "schedule", "integrator", "compositor", "P", "wall_s", "spread",
                                      "cpu_s", "T1/Tn", "Ts/Tn", "eff", "imbal", "messages", "bytes"};
   for (const std::string& k : kinds) header.push_back(k + " msg/B");
+  // Under mpirun: what of every row's traffic crossed between ranks.
+  const bool acrossRanks = std::any_of(c.rows.begin(), c.rows.end(), [](const ComparisonRow& r) { return r.what.ranks > 1; });
+  if (acrossRanks) header.push_back("x-rank msg/B");
   for (const char* h : {"comp/comm", "hit", "rmse", "image"}) header.push_back(h);
   cells.push_back(header);
   for (const ComparisonRow& r : c.rows) {
@@ -100,6 +103,8 @@ std::string comparisonTable(const Comparison& c) {
       const par::KindTraffic* kt = kindTraffic(r, k);
       line.push_back(kt ? compact(kt->messages) + "/" + compact(kt->bytes) : "-");
     }
+    if (acrossRanks)
+      line.push_back(r.what.ranks > 1 ? compact(all.betweenRankMessages) + "/" + compact(all.betweenRankBytes) : "-");
     line.push_back(orDash(t.computeToComm, t.computeToComm >= 0.0, "%.1f"));
     line.push_back(orDash(r.cacheHitRatio, r.cacheHitRatio >= 0.0, "%.3f"));
     line.push_back(orDash(r.rmse, r.rmse >= 0.0, "%.5f"));
@@ -124,7 +129,7 @@ std::string comparisonCsv(const Comparison& c) {
   out << "method,family,schedule,integrator,compositor,pes,repeats,wall_seconds,wall_min,wall_max,cpu_seconds,speedup,"
          "speedup_serial,efficiency,load_imbalance,messages,bytes";
   for (const std::string& k : comparisonKinds()) out << "," << k << "_messages," << k << "_bytes";
-  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks\n";
+  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks,between_ranks_messages,between_ranks_bytes\n";
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     out << r.what.method << "," << toString(r.what.family) << "," << r.what.schedule << "," << r.what.integrator << ","
@@ -137,7 +142,8 @@ std::string comparisonCsv(const Comparison& c) {
       out << "," << (kt ? kt->messages : 0) << "," << (kt ? kt->bytes : 0);
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
-        << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "," << r.what.ranks << "\n";
+        << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "," << r.what.ranks << ","
+        << allTraffic(r).betweenRankMessages << "," << allTraffic(r).betweenRankBytes << "\n";
   }
   return out.str();
 }
@@ -147,7 +153,9 @@ nlohmann::json comparisonJson(const Comparison& c) {
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     nlohmann::json byKind = nlohmann::json::object();
-    for (const par::KindTraffic& k : t.byKind) byKind[k.kind] = {{"messages", k.messages}, {"bytes", k.bytes}};
+    for (const par::KindTraffic& k : t.byKind)
+      byKind[k.kind] = {{"messages", k.messages}, {"bytes", k.bytes}, {"betweenRankMessages", k.betweenRankMessages},
+                        {"betweenRankBytes", k.betweenRankBytes}};
     auto optional = [](double v, bool known) { return known ? nlohmann::json(v) : nlohmann::json(nullptr); };
     rows.push_back({{"method", r.what.method},
                     {"family", toString(r.what.family)},
@@ -168,6 +176,8 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"loadImbalance", t.imbalance},
                     {"messages", allTraffic(r).messages},
                     {"bytes", allTraffic(r).bytes},
+                    {"betweenRankMessages", allTraffic(r).betweenRankMessages},
+                    {"betweenRankBytes", allTraffic(r).betweenRankBytes},
                     {"byKind", byKind},
                     {"computeToComm", optional(t.computeToComm, t.computeToComm >= 0.0)},
                     {"cacheHitRatio", optional(r.cacheHitRatio, r.cacheHitRatio >= 0.0)},
