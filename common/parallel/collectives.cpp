@@ -158,6 +158,13 @@ void Runtime::shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds) {
   pe.recordWait(now() - t0);
 }
 
+void Runtime::broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds) {
+  const std::size_t bytes = data.size();  // rank 0's, before it leaves
+  shareFromRank0(pe, data, timeoutSeconds);
+  // Read by the controlling thread only once the stage has ended.
+  pendingBroadcasts_.push_back({rank_ == 0 ? bytes : data.size(), 0, true});
+}
+
 const RunRecord& Runtime::gatherRecord(double timeoutSeconds) {
   PR_CHECK(!inStage_, "gatherRecord is called between stages");
   if (ranks_ == 1) return record_;

@@ -72,8 +72,9 @@ std::vector<std::vector<T>> gatherToRoot(Runtime& rt, std::string_view stage, st
 
 // gatherToRoot to PE 0, then, across ranks, the lists rank 0 holds are sent to every other rank
 // in a stage of their own (`stage` + " share": a real broadcast of their bytes, from rank 0 to
-// each rank's first PE), so every rank returns the lists indexed by source PE: what a pre-pass
-// needs where every rank then builds the same thing from them. On one rank it is gatherToRoot.
+// each rank's first PE, booked as one), so every rank returns the lists indexed by source PE:
+// what a pre-pass needs where every rank's controlling thread then builds the same thing from
+// them. On one rank it is gatherToRoot: the one controlling thread already holds them.
 template <class T>
   requires std::is_trivially_copyable_v<T>
 std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std::string channel, MessageKind kind,
@@ -86,7 +87,7 @@ std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std
       WireWriter w(bytes);
       for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
     }
-    rt.shareFromRank0(pe, bytes);
+    rt.broadcastToRanks(pe, bytes);
     if (rt.rank() == 0) return;
     WireReader r(bytes);
     for (std::vector<T>& list : out) list = r.sequence<T>();

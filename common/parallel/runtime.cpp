@@ -457,8 +457,9 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.schedulingBytes = c.schedulingBytes.load();
     r.schedulingMessagesBetweenRanks = c.schedulingMessagesBetweenRanks.load();
     r.schedulingBytesBetweenRanks = c.schedulingBytesBetweenRanks.load();
+    const bool firstOfOtherRank = p % localPes_ == 0 && p / localPes_ != 0;
     for (const PendingBroadcast& b : pendingBroadcasts_)
-      if (b.root != p) {
+      if (b.ranksOnly ? firstOfOtherRank : b.root != p) {
         r.broadcastsReceived += 1;
         r.broadcastBytesReceived += b.bytes;
       }

@@ -196,6 +196,10 @@ class Runtime {
   // other rank's (rank 0 sends it to each, and no longer holds it; the wait for it is booked as
   // waiting). A real broadcast of replicated data, which the caller books with recordBroadcast.
   void shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds = 300.0);
+  // shareFromRank0, booked in this stage as the broadcast it is: one copy of the data to each
+  // other rank's first PE, between ranks (what the rest of a rank's PEs read of it, the rank
+  // makes of it first and books where it shares that). For data no other broadcast books.
+  void broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds = 300.0);
   void sumAcrossRanks(std::span<double> values, double timeoutSeconds = 300.0);
   // Seconds since the runtime was created (steady clock).
   double now() const {
@@ -286,6 +290,7 @@ class Runtime {
   struct PendingBroadcast {
     std::size_t bytes;
     int root;
+    bool ranksOnly = false;  // received by each other rank's first PE only (broadcastToRanks)
   };
   std::vector<PendingBroadcast> pendingBroadcasts_;
 

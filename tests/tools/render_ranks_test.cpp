@@ -14,6 +14,7 @@
 #include <string>
 
 #include "common/image/image_io.h"
+#include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
 #include "mpirun_support.h"
 
@@ -261,6 +262,93 @@ TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and th
   REQUIRE(split != r.stages.end());
   CHECK(split->pes[0].tasks == 1);
   CHECK(split->pes[1].tasks == 1);
+}
+
+// The record says which traffic crossed between the ranks: every channel message between two
+// PEs on different ranks (the per-pair figures say which pairs those are), the task traffic of
+// PEs that asked rank 0's controller, and each broadcast's copy to every other rank's first
+// PE; in one process nothing crosses.
+TEST_CASE("RenderRanks: the record splits every kind of traffic into what crossed between ranks and what stayed within one") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_split");
+  const std::string common = join({"render ", cornell(), " -m object-space --integrator path --width 48 --height 48 --spp 1 "
+                                   "--tile-size 8 --quiet"});
+  const CommandResult ranks = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "r.png"), " --metrics ",
+                                                    quoted(dir / "ranks.json")}));
+  INFO(ranks.output);
+  REQUIRE(ranks.exitStatus == 0);
+  CHECK(ranks.output.find("between ranks: ") != std::string::npos);
+  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  REQUIRE(r.ranks == 2);
+  REQUIRE(r.pes == 4);
+  const auto rankOf = [](int pe) { return pe / 2; };
+  std::uint64_t crossingPairs = 0, crossingChannels = 0, channels = 0, crossingBroadcasts = 0, taskCrossings = 0;
+  for (const pr::par::StageRecord& s : r.stages) {
+    for (const pr::par::Traffic& t : s.traffic)
+      if (rankOf(t.from) != rankOf(t.to)) crossingPairs += t.messages;
+    for (const pr::par::ChannelTraffic& c : s.channels) {
+      CHECK(c.betweenRankMessages <= c.messages);
+      crossingChannels += c.betweenRankMessages;
+      channels += c.messages;
+    }
+    for (int p = 0; p < 4; ++p) {
+      const pr::par::PeStageRecord& pe = s.pes[std::size_t(p)];
+      if (p == 2) crossingBroadcasts += pe.broadcastsReceived;
+      if (p < 2) CHECK(pe.schedulingMessagesBetweenRanks == 0);  // rank 0 asks its own controller
+      taskCrossings += pe.schedulingMessagesBetweenRanks;
+    }
+  }
+  CHECK(crossingChannels > 0);
+  CHECK(crossingChannels < channels);
+  CHECK(crossingChannels == crossingPairs);
+  CHECK(taskCrossings > 0);
+  CHECK(crossingBroadcasts > 0);
+  const pr::par::RunSummary summary = pr::par::summarize(r);
+  for (const pr::par::KindTraffic& k : summary.total.byKind) {
+    CAPTURE(k.kind);
+    if (k.kind == "broadcasts") CHECK(k.betweenRankMessages == crossingBroadcasts);
+    if (k.kind == "tasks") CHECK(k.betweenRankMessages == taskCrossings);
+  }
+  // One process: ranks 1, nothing between ranks.
+  const CommandResult one = pr::test::runParrender(join({common, " --threads 4 -o ", quoted(dir / "t.png"), " --metrics ",
+                                                          quoted(dir / "threads.json")}));
+  INFO(one.output);
+  REQUIRE(one.exitStatus == 0);
+  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  CHECK(t.ranks == 1);
+  for (const pr::par::KindTraffic& k : pr::par::summarize(t).total.byKind) {
+    CAPTURE(k.kind);
+    CHECK(k.messages > 0);
+    CHECK(k.betweenRankMessages == 0);
+  }
+}
+
+// The photons gathered to rank 0 reach every other rank as a broadcast of their bytes, booked
+// in the share stage on each other rank's first PE (and not on the PEs that read the rank's
+// copy); in one process the controlling thread already holds them and nothing is shared.
+TEST_CASE("RenderRanks: the photon map's share of the gathered photons between ranks is a booked broadcast") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_ranks_photon_share");
+  const std::string common = join({"render ", cornellGlass(), " -m image-space --integrator photonmap --width 24 --height 20 "
+                                   "--spp 1 --photons 4000 --caustic-photons 4000 --gather 8 --quiet"});
+  const CommandResult ranks = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "r.png"), " --metrics ",
+                                                    quoted(dir / "ranks.json")}));
+  INFO(ranks.output);
+  REQUIRE(ranks.exitStatus == 0);
+  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const auto share = std::find_if(r.stages.begin(), r.stages.end(),
+                                  [](const pr::par::StageRecord& s) { return s.name.find("photon merge share") != std::string::npos; });
+  REQUIRE(share != r.stages.end());
+  CHECK(share->broadcasts == 1);
+  CHECK(share->broadcastBytes > 4000u * 16u);  // the photons stored (each more than 16 bytes)
+  CHECK(share->pes[2].broadcastsReceived == 1);
+  CHECK(share->pes[2].broadcastBytesReceived == share->broadcastBytes);
+  for (int p : {0, 1, 3}) CHECK(share->pes[std::size_t(p)].broadcastsReceived == 0);
+  const CommandResult one = pr::test::runParrender(join({common, " --threads 4 -o ", quoted(dir / "t.png"), " --metrics ",
+                                                          quoted(dir / "threads.json")}));
+  INFO(one.output);
+  REQUIRE(one.exitStatus == 0);
+  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  CHECK(std::none_of(t.stages.begin(), t.stages.end(),
+                     [](const pr::par::StageRecord& s) { return s.name.find("share") != std::string::npos; }));
 }
 
 TEST_CASE("RenderRanks: what does not run across ranks exits 2 with one message from rank 0, and so do --help and bad options") {
