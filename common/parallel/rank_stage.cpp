@@ -15,8 +15,10 @@
 // becomes active again only by receiving a message, which the second wave would have counted.
 //
 // Scheduling: a strategy that decides each PE's tasks from reset()'s inputs alone (a static
-// portion) runs on every rank for that rank's PEs; any other is held by the system controller
-// on rank 0, and a PE on another rank asks it for work with a request message (carrying the
+// portion) runs on every rank for that rank's PEs; so does a stealing one (distributed task
+// management), whose PE asks a PE on another rank for half its pool with a steal request,
+// answered by that rank's controlling thread; any other is held by the system controller on
+// rank 0, and a PE on another rank asks it for work with a request message (carrying the
 // tasks it finished since it last asked) and waits for the answer, handling its messages.
 //
 // A failure: the rank whose PE failed tells every other rank, each stops its PEs and rethrows
@@ -38,7 +40,7 @@ namespace {
 // Every message of the runtime between ranks goes under one tag with this header in front.
 constexpr int kRuntimeTag = ProcessGroup::kFirstUserTag;
 
-enum FrameType : std::uint32_t { kData = 1, kProbe, kReply, kEnd, kAbort, kTaskRequest, kTaskAnswer };
+enum FrameType : std::uint32_t { kData = 1, kProbe, kReply, kEnd, kAbort, kTaskRequest, kTaskAnswer, kStealRequest };
 
 struct Frame {
   std::uint32_t type = 0;
@@ -97,20 +99,9 @@ void Runtime::sendControl(int to, std::uint32_t type, int stage, int a, Bytes pa
 // brings tasks it sends its next request, so the answer travels while those tasks run (a
 // local pool of one packet, the seed's latency hiding, 3.3); only its first request, and one
 // after an empty pool, is waited for. `asked`: a request of this PE is in flight.
-void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
-                        std::vector<TaskReport>& reports, bool& asked) {
-  if (!askController) {
-    scheduler.next(pe.id(), now(), grab);
-    return;
-  }
-  const auto request = [&] {
-    Bytes payload(reports.size() * sizeof(TaskReport));
-    if (!reports.empty()) std::memcpy(payload.data(), reports.data(), payload.size());
-    sendControl(0, kTaskRequest, pe.stage(), pe.id(), std::move(payload));
-    reports.clear();
-    asked = true;
-  };
-  if (!asked) request();
+// Waits for the answer to this PE's request (to the controller, or a steal), pumping this
+// rank's messages meanwhile; false if the stage is aborting.
+bool Runtime::awaitAnswer(Pe& pe, Grab& grab, std::vector<TaskSpan>& spans) {
   std::optional<Grab>& answer = rankStage_.answers[static_cast<std::size_t>(pe.id() - firstLocalPe())];
   int spins = 0;
   for (;;) {
@@ -119,12 +110,12 @@ void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& 
       if (answer) {
         grab = std::move(*answer);
         answer.reset();
-        break;
+        return true;
       }
     }
     if (abort_.load(std::memory_order_acquire)) {
       grab.clear();
-      return;
+      return false;
     }
     // Pump while waiting (the answer may be in this rank's queue already), then block.
     if (handleMessages(pe, spans) || pumpRankStage()) {
@@ -135,6 +126,50 @@ void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& 
       waitForWork(pe.id());
     }
   }
+}
+
+void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
+                        std::vector<TaskReport>& reports, bool& asked) {
+  if (!askController) {
+    // A stealing strategy may stop at a victim on another rank: ask it, and search on. Each
+    // ask, and what the search moved before it, is booked here: the answer that ends the
+    // search may bring no task, and then the caller books nothing.
+    PeCounters& c = counters_[static_cast<std::size_t>(pe.id())];
+    const auto book = [&c](std::uint64_t messages, std::uint64_t bytes, bool betweenRanks) {
+      c.schedulingMessages.fetch_add(messages, std::memory_order_relaxed);
+      c.schedulingBytes.fetch_add(bytes, std::memory_order_relaxed);
+      if (!betweenRanks) return;
+      c.schedulingMessagesBetweenRanks.fetch_add(messages, std::memory_order_relaxed);
+      c.schedulingBytesBetweenRanks.fetch_add(bytes, std::memory_order_relaxed);
+    };
+    for (;;) {
+      scheduler.next(pe.id(), now(), grab);
+      if (grab.askPe < 0) return;
+      const int victim = grab.askPe;
+      book(std::uint64_t(grab.requests + grab.packets),
+           grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes, false);
+      Bytes payload(sizeof(std::int32_t));
+      const std::int32_t v = victim;
+      std::memcpy(payload.data(), &v, sizeof v);
+      sendControl(rankOf(victim), kStealRequest, pe.stage(), pe.id(), std::move(payload));
+      Grab answer;
+      if (!awaitAnswer(pe, answer, spans)) {
+        grab.clear();
+        return;
+      }
+      book(2, kTaskRequestBytes + kTaskPacketHeaderBytes + answer.tasks.size() * kTaskEntryBytes, true);  // request, answer
+      scheduler.stolen(pe.id(), victim, std::move(answer.tasks));
+    }
+  }
+  const auto request = [&] {
+    Bytes payload(reports.size() * sizeof(TaskReport));
+    if (!reports.empty()) std::memcpy(payload.data(), reports.data(), payload.size());
+    sendControl(0, kTaskRequest, pe.stage(), pe.id(), std::move(payload));
+    reports.clear();
+    asked = true;
+  };
+  if (!asked) request();
+  if (!awaitAnswer(pe, grab, spans)) return;
   asked = false;
   if (!grab.tasks.empty()) request();
 }
@@ -197,6 +232,18 @@ void Runtime::handleRankMessage(Envelope& e) {
       Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
       std::memcpy(answer.data(), &head, sizeof head);
       if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
+      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+      break;
+    }
+    case kStealRequest: {  // PE f.from asks for half of local PE victim's pool
+      std::int32_t victim = -1;
+      if (payload.size() >= sizeof victim) std::memcpy(&victim, payload.data(), sizeof victim);
+      PR_CHECK(isLocal(victim), "a steal request for a PE this rank does not have");
+      const std::vector<TaskId> tasks = job_.scheduler->stealFrom(victim);
+      const AnswerHead head{victim, 0, 0, 1, tasks.size()};
+      Bytes answer(sizeof head + tasks.size() * sizeof(TaskId));
+      std::memcpy(answer.data(), &head, sizeof head);
+      if (!tasks.empty()) std::memcpy(answer.data() + sizeof head, tasks.data(), tasks.size() * sizeof(TaskId));
       sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
       break;
     }

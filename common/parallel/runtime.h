@@ -264,6 +264,7 @@ class Runtime {
     TaskId task;
     double seconds;
   };
+  bool awaitAnswer(Pe& pe, Grab& grab, std::vector<TaskSpan>& spans);
   void nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
                  std::vector<TaskReport>& reports, bool& asked);
   void driveRankStage(int stage);

@@ -1,7 +1,10 @@
 // Distributed task management (seed 3.4.4): the tasks start spread over the PEs' task pools
 // (balanced contiguous portions); a PE whose pool is empty asks its neighbours, nearest first
 // around a ring (p+1, p-1, p+2, ...), and takes half of the first non-empty pool it finds
-// instead of going to the controller. Work stealing in today's words.
+// instead of going to the controller. Work stealing in today's words. Across ranks each rank
+// keeps its own PEs' pools; a search that reaches a PE on another rank asks it by message
+// (Scheduler::stealsAcrossRanks), in the same ring order, and does not ask a pool that
+// answered empty again in the stage.
 #include <algorithm>
 #include <deque>
 #include <mutex>
@@ -15,8 +18,15 @@ class DistributedScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "distributed"; }
 
+  bool stealsAcrossRanks() const override { return true; }
+  void setLocalPes(int first, int count) override {
+    firstLocal_ = first;
+    localCount_ = count;
+  }
+
   void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
     pes_ = pes;
+    answeredEmpty_.assign(std::size_t(pes), {});
     grain_ = std::max(1, params.grain);
     pools_.clear();
     for (int p = 0; p < pes_; ++p) pools_.push_back(std::make_unique<Pool>());
@@ -43,6 +53,12 @@ class DistributedScheduler : public Scheduler {
       int victim = -1;
       for (int d = 1; d < pes_ && victim < 0; ++d) {
         for (int q : {(pe + d) % pes_, ((pe - d) % pes_ + pes_) % pes_}) {
+          if (!local(q)) {  // its pool is on another rank: ask it, unless it answered empty
+            std::vector<char>& empty = answeredEmpty_[std::size_t(pe)];
+            if (!empty.empty() && empty[std::size_t(q)]) continue;
+            out.askPe = q;
+            return;
+          }
           Pool& pool = *pools_[q];
           std::lock_guard lock(pool.mutex);
           if (pool.tasks.empty()) continue;
@@ -66,11 +82,33 @@ class DistributedScheduler : public Scheduler {
     }
   }
 
+  std::vector<TaskId> stealFrom(int victim) override {
+    Pool& pool = *pools_[victim];
+    std::lock_guard lock(pool.mutex);
+    const std::size_t half = (pool.tasks.size() + 1) / 2;
+    std::vector<TaskId> stolen(pool.tasks.end() - half, pool.tasks.end());
+    pool.tasks.erase(pool.tasks.end() - half, pool.tasks.end());
+    return stolen;
+  }
+
+  void stolen(int pe, int victim, std::vector<TaskId> tasks) override {
+    if (tasks.empty()) {
+      std::vector<char>& empty = answeredEmpty_[std::size_t(pe)];
+      if (empty.empty()) empty.assign(std::size_t(pes_), 0);
+      empty[std::size_t(victim)] = 1;
+      return;
+    }
+    std::lock_guard lock(pools_[pe]->mutex);
+    pools_[pe]->tasks.insert(pools_[pe]->tasks.end(), tasks.begin(), tasks.end());
+  }
+
  private:
   struct Pool {
     std::mutex mutex;
     std::deque<TaskId> tasks;
   };
+
+  bool local(int q) const { return localCount_ < 0 || (q >= firstLocal_ && q < firstLocal_ + localCount_); }
 
   bool takeOwn(int pe, Grab& out) {
     Pool& pool = *pools_[pe];
@@ -86,6 +124,9 @@ class DistributedScheduler : public Scheduler {
   std::size_t grain_ = 1;
   std::vector<std::unique_ptr<Pool>> pools_;
   std::vector<char> initial_;
+  int firstLocal_ = 0, localCount_ = -1;  // -1: every PE is local
+  // Per PE (by its own thread only): the PEs on other ranks whose pools answered it empty.
+  std::vector<std::vector<char>> answeredEmpty_;
 };
 
 }  // namespace

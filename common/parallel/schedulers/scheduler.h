@@ -47,6 +47,10 @@ struct Grab {
   int packets = 0;
   std::size_t moved = 0;
   bool blocking = true;
+  // Across ranks, a stealing strategy's search reached PE askPe, on another rank: no tasks yet;
+  // the runtime asks that PE's rank (Scheduler::stealFrom there), hands the answer to stolen()
+  // and asks next() again. -1: nothing to ask.
+  int askPe = -1;
 
   void clear() {
     tasks.clear();
@@ -55,6 +59,7 @@ struct Grab {
     packets = 0;
     moved = 0;
     blocking = true;
+    askPe = -1;
   }
 };
 
@@ -78,6 +83,21 @@ class Scheduler {
   // ranks, each rank then answers its own PEs; otherwise the system controller on rank 0 holds
   // the strategy and a PE on another rank asks it with a message (rank_stage.cpp).
   virtual bool decidedPerPe() const { return false; }
+
+  // Distributed task management across ranks (seed 3.4.4): a strategy whose PEs keep their own
+  // pools and steal from each other's says so, and each rank runs it for its own PEs
+  // [first, first + count) (setLocalPes, before reset). Its search for a victim stops at a PE
+  // on another rank with Grab::askPe; that rank's runtime answers with stealFrom(victim) (the
+  // victim's pool is there), and the asking PE's runtime hands the tasks (none: the pool was
+  // empty) to stolen(). Without setLocalPes every PE is local - one process, the simulator -
+  // and the search never stops to ask.
+  virtual bool stealsAcrossRanks() const { return false; }
+  virtual void setLocalPes(int first, int count) { (void)first, (void)count; }
+  virtual std::vector<TaskId> stealFrom(int victim) {
+    (void)victim;
+    return {};
+  }
+  virtual void stolen(int pe, int victim, std::vector<TaskId> tasks) { (void)pe, (void)victim, (void)tasks; }
 };
 
 // Registry: name -> factory -> one-line description, and what the strategy declares about

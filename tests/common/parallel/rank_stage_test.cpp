@@ -232,3 +232,31 @@ TEST_CASE("RankStage: sums across ranks and a computation replicated on each ran
   CHECK(replicatedOn[1] == std::vector<int>{2});
   CHECK(replicatedOn[2] == std::vector<int>{4});
 }
+
+// Distributed task management across ranks: each rank keeps its own PEs' pools, and a PE that
+// runs dry asks the next PE around the ring, on another rank by a steal request that rank
+// answers from its pool; nothing goes through rank 0's controller. Rank 0's portions are slow,
+// so the other ranks' PEs steal from them.
+TEST_CASE("RankStage: distributed task management steals between ranks by messages, every task once") {
+  constexpr int kTasks = 60;  // portions of 10 per PE: PEs 0 and 1 (rank 0) hold tasks 0-19
+  std::vector<std::atomic<int>> runs(kTasks);
+  std::vector<std::atomic<int>> ranOn(kTasks);
+  std::uint64_t betweenRanks = 0;
+  const auto errors = runOnRanks(3, 2, "distributed", [&](Runtime& rt) {
+    rt.runStage("tasks", TaskSet::uniform(kTasks), [&](Pe& pe, TaskId t) {
+      runs[static_cast<std::size_t>(t)].fetch_add(1);
+      ranOn[static_cast<std::size_t>(t)].store(pe.id());
+      if (t < 20) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+    });
+    const RunRecord& record = rt.gatherRecord();
+    if (rt.rank() != 0) return;
+    for (const PeStageRecord& pe : record.stages[0].pes) betweenRanks += pe.schedulingMessagesBetweenRanks;
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  for (int t = 0; t < kTasks; ++t) CHECK(runs[static_cast<std::size_t>(t)].load() == 1);
+  int stolenAcross = 0;  // rank 0's tasks that ran on another rank's PE
+  for (int t = 0; t < 20; ++t) stolenAcross += ranOn[static_cast<std::size_t>(t)].load() >= 2;
+  CHECK(stolenAcross > 0);
+  CHECK(betweenRanks > 0);  // steal requests and their answers, two messages each
+  CHECK(betweenRanks % 2 == 0);
+}
