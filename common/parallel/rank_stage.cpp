@@ -15,9 +15,10 @@
 // becomes active again only by receiving a message, which the second wave would have counted.
 //
 // Scheduling: a strategy that decides each PE's tasks from reset()'s inputs alone (a static
-// portion) runs on every rank for that rank's PEs; so does a stealing one (distributed task
-// management), whose PE asks a PE on another rank for half its pool with a steal request,
-// answered by that rank's controlling thread; any other is held by the system controller on
+// portion) runs on every rank for that rank's PEs; so does one with local pools: distributed
+// task management, whose PE asks a PE on another rank for half its pool with a steal request,
+// answered by that rank's controlling thread, and a task manager, whose PE on another rank than
+// 0 asks rank 0 for refills of its local pool ahead of need; any other is held by the system controller on
 // rank 0, and a PE on another rank asks it for work with a request message (carrying the
 // tasks it finished since it last asked) and waits for the answer, handling its messages.
 //
@@ -40,7 +41,8 @@ namespace {
 // Every message of the runtime between ranks goes under one tag with this header in front.
 constexpr int kRuntimeTag = ProcessGroup::kFirstUserTag;
 
-enum FrameType : std::uint32_t { kData = 1, kProbe, kReply, kEnd, kAbort, kTaskRequest, kTaskAnswer, kStealRequest };
+enum FrameType : std::uint32_t { kData = 1, kProbe, kReply, kEnd, kAbort, kTaskRequest, kTaskAnswer, kStealRequest,
+                               kRefillRequest, kRefillAnswer };
 
 struct Frame {
   std::uint32_t type = 0;
@@ -131,33 +133,39 @@ bool Runtime::awaitAnswer(Pe& pe, Grab& grab, std::vector<TaskSpan>& spans) {
 void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
                         std::vector<TaskReport>& reports, bool& asked) {
   if (!askController) {
-    // A stealing strategy may stop at a victim on another rank: ask it, and search on. Each
-    // ask, and what the search moved before it, is booked here: the answer that ends the
-    // search may bring no task, and then the caller books nothing.
-    PeCounters& c = counters_[static_cast<std::size_t>(pe.id())];
-    const auto book = [&c](std::uint64_t messages, std::uint64_t bytes, bool betweenRanks) {
-      c.schedulingMessages.fetch_add(messages, std::memory_order_relaxed);
-      c.schedulingBytes.fetch_add(bytes, std::memory_order_relaxed);
-      if (!betweenRanks) return;
-      c.schedulingMessagesBetweenRanks.fetch_add(messages, std::memory_order_relaxed);
-      c.schedulingBytesBetweenRanks.fetch_add(bytes, std::memory_order_relaxed);
-    };
+    // A strategy with local pools may stop to ask another rank: a steal from a PE there (asked
+    // and waited for), or refills from rank 0 (asked, and waited for only when the pool is
+    // empty); then it is asked again. Each ask, and what the search moved before it, is booked
+    // here: the answer that ends the search may bring no task, and then the caller books none.
     for (;;) {
       scheduler.next(pe.id(), now(), grab);
-      if (grab.askPe < 0) return;
+      const bool ask = grab.askPe != -1 || grab.refillRequests > 0;
+      if (!ask) return;
+      bookScheduling(pe.id(), std::uint64_t(grab.requests + grab.packets),
+                     grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes,
+                     false);
+      grab.requests = grab.packets = 0;
+      grab.moved = 0;
+      for (int i = 0; i < grab.refillRequests; ++i) {
+        sendControl(0, kRefillRequest, pe.stage(), pe.id());
+        bookScheduling(pe.id(), 1, kTaskRequestBytes, true);  // its answer is booked on arrival
+      }
+      if (grab.askPe == -1) return;  // tasks to run while the refills travel
       const int victim = grab.askPe;
-      book(std::uint64_t(grab.requests + grab.packets),
-           grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes, false);
-      Bytes payload(sizeof(std::int32_t));
-      const std::int32_t v = victim;
-      std::memcpy(payload.data(), &v, sizeof v);
-      sendControl(rankOf(victim), kStealRequest, pe.stage(), pe.id(), std::move(payload));
+      if (victim >= 0) {
+        Bytes payload(sizeof(std::int32_t));
+        const std::int32_t v = victim;
+        std::memcpy(payload.data(), &v, sizeof v);
+        sendControl(rankOf(victim), kStealRequest, pe.stage(), pe.id(), std::move(payload));
+      }
       Grab answer;
       if (!awaitAnswer(pe, answer, spans)) {
         grab.clear();
         return;
       }
-      book(2, kTaskRequestBytes + kTaskPacketHeaderBytes + answer.tasks.size() * kTaskEntryBytes, true);  // request, answer
+      if (victim < 0) continue;  // a refill arrived (refill() has put it in the pool)
+      bookScheduling(pe.id(), 2, kTaskRequestBytes + kTaskPacketHeaderBytes + answer.tasks.size() * kTaskEntryBytes,
+                     true);  // the steal request and its answer
       scheduler.stolen(pe.id(), victim, std::move(answer.tasks));
     }
   }
@@ -172,6 +180,16 @@ void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& 
   if (!awaitAnswer(pe, grab, spans)) return;
   asked = false;
   if (!grab.tasks.empty()) request();
+}
+
+void Runtime::bookScheduling(int pe, std::uint64_t messages, std::uint64_t bytes, bool betweenRanks) {
+  if (messages == 0) return;
+  PeCounters& c = counters_[static_cast<std::size_t>(pe)];
+  c.schedulingMessages.fetch_add(messages, std::memory_order_relaxed);
+  c.schedulingBytes.fetch_add(bytes, std::memory_order_relaxed);
+  if (!betweenRanks) return;
+  c.schedulingMessagesBetweenRanks.fetch_add(messages, std::memory_order_relaxed);
+  c.schedulingBytesBetweenRanks.fetch_add(bytes, std::memory_order_relaxed);
 }
 
 // One message from another rank, under pumpMutex.
@@ -245,6 +263,26 @@ void Runtime::handleRankMessage(Envelope& e) {
       std::memcpy(answer.data(), &head, sizeof head);
       if (!tasks.empty()) std::memcpy(answer.data() + sizeof head, tasks.data(), tasks.size() * sizeof(TaskId));
       sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+      break;
+    }
+    case kRefillRequest: {  // rank 0: a packet of the controller's pool for PE f.from
+      const std::vector<TaskId> packet = job_.scheduler->supplyPacket(f.from);
+      Bytes answer(packet.size() * sizeof(TaskId));
+      if (!packet.empty()) std::memcpy(answer.data(), packet.data(), answer.size());
+      sendControl(rankOf(f.from), kRefillAnswer, stage, f.from, std::move(answer));
+      break;
+    }
+    case kRefillAnswer: {  // a packet for local PE f.to's pool; it may be waiting for one
+      PR_CHECK(isLocal(f.to), "a refill for a PE this rank does not have");
+      std::vector<TaskId> packet(payload.size() / sizeof(TaskId));
+      if (!packet.empty()) std::memcpy(packet.data(), payload.data(), packet.size() * sizeof(TaskId));
+      bookScheduling(f.to, 1, kTaskPacketHeaderBytes + packet.size() * kTaskEntryBytes, true);
+      job_.scheduler->refill(f.to, std::move(packet));
+      {
+        std::lock_guard lock(rs.answerMutex);
+        rs.answers[static_cast<std::size_t>(f.to - firstLocalPe())] = Grab{};
+      }
+      ring(f.to);
       break;
     }
     case kTaskAnswer: {

@@ -302,7 +302,7 @@ void Runtime::peLoop(int p, const StageJob& job) {
   // not known to its rank in advance); on one rank every task is counted from the start.
   const bool acrossRanks = ranks_ > 1;
   const bool askController =
-      acrossRanks && rank_ != 0 && !scheduler.decidedPerPe() && !scheduler.stealsAcrossRanks();
+      acrossRanks && rank_ != 0 && !scheduler.decidedPerPe() && !scheduler.localPoolsAcrossRanks();
   std::vector<TaskReport> reports;  // finished tasks, for the controller's next answer
   bool asked = false;               // a request to the controller is in flight
   try {
@@ -400,7 +400,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   rankStage_.received.store(0);
   rankStage_.failedHere = rankStage_.announced = false;
   for (std::optional<Grab>& answer : rankStage_.answers) answer.reset();
-  if (ranks_ > 1) scheduler.setLocalPes(firstLocalPe(), localPes_);  // a stealing strategy's own pools
+  if (ranks_ > 1) scheduler.setLocalPes(firstLocalPe(), localPes_);  // local pools where their PEs are
   scheduler.reset(tasks, pes, options_.params);
 
   if (workers_.empty()) startWorkers();

@@ -265,6 +265,8 @@ class Runtime {
     double seconds;
   };
   bool awaitAnswer(Pe& pe, Grab& grab, std::vector<TaskSpan>& spans);
+  // Scheduling traffic of PE pe's asks across ranks (steals, refills), counted as it happens.
+  void bookScheduling(int pe, std::uint64_t messages, std::uint64_t bytes, bool betweenRanks);
   void nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
                  std::vector<TaskReport>& reports, bool& asked);
   void driveRankStage(int stage);

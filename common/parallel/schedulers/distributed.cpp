@@ -3,7 +3,7 @@
 // around a ring (p+1, p-1, p+2, ...), and takes half of the first non-empty pool it finds
 // instead of going to the controller. Work stealing in today's words. Across ranks each rank
 // keeps its own PEs' pools; a search that reaches a PE on another rank asks it by message
-// (Scheduler::stealsAcrossRanks), in the same ring order, and does not ask a pool that
+// (Scheduler::localPoolsAcrossRanks), in the same ring order, and does not ask a pool that
 // answered empty again in the stage.
 #include <algorithm>
 #include <deque>
@@ -18,7 +18,7 @@ class DistributedScheduler : public Scheduler {
  public:
   std::string_view name() const override { return "distributed"; }
 
-  bool stealsAcrossRanks() const override { return true; }
+  bool localPoolsAcrossRanks() const override { return true; }
   void setLocalPes(int first, int count) override {
     firstLocal_ = first;
     localCount_ = count;

@@ -47,10 +47,16 @@ struct Grab {
   int packets = 0;
   std::size_t moved = 0;
   bool blocking = true;
-  // Across ranks, a stealing strategy's search reached PE askPe, on another rank: no tasks yet;
-  // the runtime asks that PE's rank (Scheduler::stealFrom there), hands the answer to stolen()
-  // and asks next() again. -1: nothing to ask.
+  // Across ranks, for a strategy with local pools (Scheduler::localPoolsAcrossRanks), no tasks
+  // yet and: askPe >= 0, a stealing search reached PE askPe on another rank (the runtime asks
+  // that PE's rank, stealFrom there, hands the answer to stolen() and asks next() again); or
+  // askPe == kAwaitRefill, the PE's local pool is empty and a refill is on its way (the runtime
+  // waits for it, then asks next() again). -1: nothing to ask.
+  static constexpr int kAwaitRefill = -2;
   int askPe = -1;
+  // Refill requests the runtime sends rank 0 now, without waiting (a task manager's local pool
+  // on another rank; answered by supplyPacket there and handed to refill() here).
+  int refillRequests = 0;
 
   void clear() {
     tasks.clear();
@@ -60,6 +66,7 @@ struct Grab {
     moved = 0;
     blocking = true;
     askPe = -1;
+    refillRequests = 0;
   }
 };
 
@@ -84,20 +91,29 @@ class Scheduler {
   // the strategy and a PE on another rank asks it with a message (rank_stage.cpp).
   virtual bool decidedPerPe() const { return false; }
 
-  // Distributed task management across ranks (seed 3.4.4): a strategy whose PEs keep their own
-  // pools and steal from each other's says so, and each rank runs it for its own PEs
-  // [first, first + count) (setLocalPes, before reset). Its search for a victim stops at a PE
-  // on another rank with Grab::askPe; that rank's runtime answers with stealFrom(victim) (the
-  // victim's pool is there), and the asking PE's runtime hands the tasks (none: the pool was
-  // empty) to stolen(). Without setLocalPes every PE is local - one process, the simulator -
-  // and the search never stops to ask.
-  virtual bool stealsAcrossRanks() const { return false; }
+  // A strategy whose PEs keep local task pools says so, and across ranks each rank runs it for
+  // its own PEs [first, first + count) (setLocalPes, before reset), the pools where their PEs
+  // are. Without setLocalPes every PE is local - one process, the simulator - and nothing is
+  // asked by message; with it, the same decisions, each transfer between ranks a message:
+  // - distributed task management (seed 3.4.4): a search for a victim stops at a PE on another
+  //   rank with Grab::askPe; that rank's runtime answers with stealFrom(victim), and the
+  //   asking PE's runtime hands the tasks (none: the pool was empty) to stolen();
+  // - a task manager's local pool (seed 3.4.3) on a rank other than rank 0, where the central
+  //   pool is: Grab::refillRequests asks rank 0 for packets ahead of need, answered by
+  //   supplyPacket there and handed to refill() here (none: the central pool is exhausted);
+  //   an empty pool waits for one (Grab::kAwaitRefill).
+  virtual bool localPoolsAcrossRanks() const { return false; }
   virtual void setLocalPes(int first, int count) { (void)first, (void)count; }
   virtual std::vector<TaskId> stealFrom(int victim) {
     (void)victim;
     return {};
   }
   virtual void stolen(int pe, int victim, std::vector<TaskId> tasks) { (void)pe, (void)victim, (void)tasks; }
+  virtual std::vector<TaskId> supplyPacket(int pe) {
+    (void)pe;
+    return {};
+  }
+  virtual void refill(int pe, std::vector<TaskId> tasks) { (void)pe, (void)tasks; }
 };
 
 // Registry: name -> factory -> one-line description, and what the strategy declares about

@@ -260,3 +260,39 @@ TEST_CASE("RankStage: distributed task management steals between ranks by messag
   CHECK(betweenRanks > 0);  // steal requests and their answers, two messages each
   CHECK(betweenRanks % 2 == 0);
 }
+
+// A task manager across ranks: the controller's pool is on rank 0, each local pool where its PE
+// is; a PE on another rank asks rank 0 for refills ahead of need, two messages each (request
+// and packet) between ranks, while rank 0's PEs take their packets in place.
+TEST_CASE("RankStage: a task manager's local pools on other ranks are refilled from rank 0 by messages, every task once") {
+  constexpr int kTasks = 80;
+  std::vector<std::atomic<int>> runs(kTasks);
+  std::vector<std::uint64_t> between, scheduling;
+  std::vector<std::uint64_t> tasksRun;
+  const auto errors = runOnRanks(2, 2, "task-manager", [&](Runtime& rt) {
+    rt.runStage("tasks", TaskSet::uniform(kTasks), [&](Pe&, TaskId t) {
+      runs[static_cast<std::size_t>(t)].fetch_add(1);
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    });
+    const RunRecord& record = rt.gatherRecord();
+    if (rt.rank() != 0) return;
+    for (const PeStageRecord& pe : record.stages[0].pes) {
+      between.push_back(pe.schedulingMessagesBetweenRanks);
+      scheduling.push_back(pe.schedulingMessages);
+      tasksRun.push_back(pe.tasks);
+    }
+  }, 2);
+  for (const std::string& e : errors) CHECK(e == "");
+  for (int t = 0; t < kTasks; ++t) CHECK(runs[static_cast<std::size_t>(t)].load() == 1);
+  REQUIRE(between.size() == 4);
+  for (int p : {0, 1}) CHECK(between[std::size_t(p)] == 0);  // the controller's own rank
+  for (int p : {2, 3}) {
+    CAPTURE(p);
+    CHECK(tasksRun[std::size_t(p)] > 0);
+    // Every packet it ran came as a request and an answer (grain 2), and one more pair told it
+    // the pool was spent; all of it crossed between ranks.
+    CHECK(between[std::size_t(p)] >= 2 * (tasksRun[std::size_t(p)] / 2));
+    CHECK(between[std::size_t(p)] % 2 == 0);
+    CHECK(scheduling[std::size_t(p)] == between[std::size_t(p)]);
+  }
+}
