@@ -162,7 +162,7 @@ void Runtime::broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds) {
   const std::size_t bytes = data.size();  // rank 0's, before it leaves
   shareFromRank0(pe, data, timeoutSeconds);
   // Read by the controlling thread only once the stage has ended.
-  pendingBroadcasts_.push_back({rank_ == 0 ? bytes : data.size(), 0, true});
+  pendingBroadcasts_.push_back({rank_ == 0 ? bytes : data.size(), 0, PendingBroadcast::To::OtherRanksFirstPe});
 }
 
 const RunRecord& Runtime::gatherRecord(double timeoutSeconds) {

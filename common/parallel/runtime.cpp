@@ -134,6 +134,11 @@ void Runtime::recordBroadcast(std::size_t bytes, int root) {
   pendingBroadcasts_.push_back({bytes, root});
 }
 
+void Runtime::recordBroadcastWithinRanks(std::size_t bytes) {
+  PR_CHECK(!inStage_, "recordBroadcastWithinRanks is called between stages");
+  pendingBroadcasts_.push_back({bytes, 0, PendingBroadcast::To::WithinRanks});
+}
+
 void Runtime::addCounter(std::string_view name, int pe, double value) {
   PR_CHECK(pe >= 0 && pe < options_.pes, "counter '" + std::string(name) + "' names PE " + std::to_string(pe));
   std::lock_guard<std::mutex> lock(counterMutex_);
@@ -459,9 +464,10 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.schedulingBytes = c.schedulingBytes.load();
     r.schedulingMessagesBetweenRanks = c.schedulingMessagesBetweenRanks.load();
     r.schedulingBytesBetweenRanks = c.schedulingBytesBetweenRanks.load();
-    const bool firstOfOtherRank = p % localPes_ == 0 && p / localPes_ != 0;
+    const bool firstOfRank = p % localPes_ == 0, firstOfOtherRank = firstOfRank && p / localPes_ != 0;
+    using To = PendingBroadcast::To;
     for (const PendingBroadcast& b : pendingBroadcasts_)
-      if (b.ranksOnly ? firstOfOtherRank : b.root != p) {
+      if (b.to == To::OtherRanksFirstPe ? firstOfOtherRank : b.to == To::WithinRanks ? !firstOfRank : b.root != p) {
         r.broadcastsReceived += 1;
         r.broadcastBytesReceived += b.bytes;
       }

@@ -180,6 +180,11 @@ class Runtime {
   // to every other PE: counted as one broadcast message per receiving PE in the next stage run
   // (root receives nothing, so a P = 1 run has no broadcast traffic).
   void recordBroadcast(std::size_t bytes, int root = 0);
+  // Replicated data every rank's first PE holds already - built there from what reached it as a
+  // booked transfer (broadcastToRanks), or replicated work - read by the rank's other PEs: one
+  // broadcast message per receiving PE within each rank, none between ranks. On one rank it is
+  // recordBroadcast: PE 0 holds it, every other PE receives a copy.
+  void recordBroadcastWithinRanks(std::size_t bytes);
 
   // Adds value to the named per-PE counter (created at zero for every PE on first use).
   // Thread-safe: callable from tasks, handlers or the controlling thread.
@@ -293,7 +298,9 @@ class Runtime {
   struct PendingBroadcast {
     std::size_t bytes;
     int root;
-    bool ranksOnly = false;  // received by each other rank's first PE only (broadcastToRanks)
+    enum class To { EveryPe, OtherRanksFirstPe, WithinRanks };
+    To to = To::EveryPe;  // every PE but root; each other rank's first PE (broadcastToRanks);
+                          // every PE but its rank's first (recordBroadcastWithinRanks)
   };
   std::vector<PendingBroadcast> pendingBroadcasts_;
 

@@ -296,3 +296,42 @@ TEST_CASE("RankStage: a task manager's local pools on other ranks are refilled f
     CHECK(scheduling[std::size_t(p)] == between[std::size_t(p)]);
   }
 }
+
+// The three ways a broadcast is booked across ranks: to every PE but the root
+// (recordBroadcast), carried from rank 0 to each other rank's first PE (broadcastToRanks), and
+// from each rank's first PE to the rank's other PEs (recordBroadcastWithinRanks); on one rank
+// the last is the first.
+TEST_CASE("RankStage: a broadcast is booked to every other PE, to each other rank's first PE, or within each rank") {
+  std::vector<std::uint64_t> every, toRanks, within, carried;
+  const auto errors = runOnRanks(3, 2, "demand", [&](Runtime& rt) {
+    rt.recordBroadcast(100);
+    rt.runStage("every", TaskSet::uniform(6), [](Pe&, TaskId) {});
+    Bytes data;
+    rt.runOncePerRank("share", [&](Pe& pe) {
+      if (rt.rank() == 0) data.assign(40, std::byte{7});
+      rt.broadcastToRanks(pe, data);
+    });
+    rt.recordBroadcastWithinRanks(10);
+    rt.runStage("within", TaskSet::uniform(6), [](Pe&, TaskId) {});
+    const RunRecord& record = rt.gatherRecord();
+    if (rt.rank() != 0) return;
+    for (int p = 0; p < 6; ++p) {
+      every.push_back(record.stages[0].pes[std::size_t(p)].broadcastBytesReceived);
+      toRanks.push_back(record.stages[1].pes[std::size_t(p)].broadcastBytesReceived);
+      within.push_back(record.stages[2].pes[std::size_t(p)].broadcastBytesReceived);
+    }
+    carried.push_back(record.stages[1].broadcastBytes);
+  });
+  for (const std::string& e : errors) CHECK(e == "");
+  CHECK(every == std::vector<std::uint64_t>{0, 100, 100, 100, 100, 100});
+  CHECK(toRanks == std::vector<std::uint64_t>{0, 0, 40, 0, 40, 0});
+  CHECK(within == std::vector<std::uint64_t>{0, 10, 0, 10, 0, 10});
+  CHECK(carried == std::vector<std::uint64_t>{40});
+  // One rank: within ranks is every PE but PE 0.
+  RuntimeOptions options;
+  options.pes = 3;
+  Runtime one(options);
+  one.recordBroadcastWithinRanks(10);
+  one.runStage("within", TaskSet::uniform(3), [](Pe&, TaskId) {});
+  for (int p = 0; p < 3; ++p) CHECK(one.record().stages[0].pes[std::size_t(p)].broadcastBytesReceived == (p == 0 ? 0u : 10u));
+}
