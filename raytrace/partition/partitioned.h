@@ -66,12 +66,14 @@ inline uint64_t emitterBytes(const LightSampler& lights) {
 
 // Counts what every PE of a partitioned tracer holds a copy of as one broadcast per PE: the
 // shading data, the emitters and the routing directory (directoryBytes: kd tree and voxel
-// owners, or piece bounds and owners). Called between stages, before the trace stage.
+// owners, or piece bounds and owners). Called between stages, before the trace stage. Across
+// ranks each rank's first PE holds them already (the shading data and emitters from the scene
+// it loaded, the directory from what rank 0 sent it, booked there): booked within the ranks.
 inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const LightSampler& lights,
                                  uint64_t directoryBytes) {
   const uint64_t emitters = emitterBytes(lights);
   for (int p = 0; p < rt.pes(); ++p) rt.addCounter("Partition/emitter_bytes", p, double(emitters));
-  rt.recordBroadcast(shadingDataBytes(s) + emitters + directoryBytes);
+  rt.recordBroadcastWithinRanks(shadingDataBytes(s) + emitters + directoryBytes);
 }
 
 // Counts the rays a camera-ray task starts by kind, as the world-model loop counts the rays it
@@ -105,8 +107,9 @@ class SceneViews {
 };
 
 // Inside a stage, on each rank's first PE, across ranks: what rank 0 made reaches every other
-// rank as its encoding. encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others;
-// nothing moves on one rank.
+// rank as its encoding, booked as that broadcast between ranks (Runtime::broadcastToRanks).
+// encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others; nothing moves on one
+// rank.
 template <class Encode, class Decode>
 void shareEncodedFromRank0(par::Runtime& rt, par::Pe& pe, Encode&& encode, Decode&& decode) {
   if (rt.ranks() == 1) return;
@@ -115,7 +118,7 @@ void shareEncodedFromRank0(par::Runtime& rt, par::Pe& pe, Encode&& encode, Decod
     par::WireWriter w(bytes);
     encode(w);
   }
-  rt.shareFromRank0(pe, bytes);
+  rt.broadcastToRanks(pe, bytes);
   if (rt.rank() == 0) return;
   par::WireReader r(bytes);
   decode(r);
