@@ -264,6 +264,32 @@ TEST_CASE("RenderRanks: object-space on 2 ranks of one PE sends the rays, and th
   CHECK(split->pes[1].tasks == 1);
 }
 
+// The partitioned tracers count what the thread runtime counts, kind by kind, whether the two
+// PEs are threads or ranks: the same data items, requests, results and geometry shares, and the
+// same ray bytes (object's batches leave when a PE runs dry, so their number may differ). Only
+// the broadcasts differ, as they should: across ranks each rank builds its own item directory
+// (image-space-cached) and object's assignment travels from rank 0 as its encoding.
+TEST_CASE("RenderRanks: the partitioned tracers on 2 ranks of one PE count the traffic of the thread runtime at P = 2, kind by kind") {
+  for (const std::string method : {"image-space-cached", "object"}) {
+    CAPTURE(method);
+    const auto records = threadsAndRanksRecords(pr::test::scratchDir("render_ranks_kinds_" + method), method);
+    const pr::par::RunSummary t = pr::par::summarize(records.first), r = pr::par::summarize(records.second);
+    const auto kind = [](const pr::par::RunSummary& s, const std::string& name) {
+      for (const pr::par::KindTraffic& k : s.total.byKind)
+        if (k.kind == name) return k;
+      return pr::par::KindTraffic{name};
+    };
+    for (const std::string name : {"data", "requests", "results", "rays", "primitives"}) {
+      CAPTURE(name);
+      CHECK(kind(r, name).bytes == kind(t, name).bytes);
+      if (name != "rays") CHECK(kind(r, name).messages == kind(t, name).messages);
+      CHECK(kind(r, name).betweenRankMessages == kind(r, name).messages);  // two ranks of one PE
+    }
+    CHECK(kind(t, "data").bytes > 0);
+    CHECK(kind(t, "results").bytes > 0);
+  }
+}
+
 // The record says which traffic crossed between the ranks: every channel message between two
 // PEs on different ranks (the per-pair figures say which pairs those are), the task traffic of
 // PEs that asked rank 0's controller, and each broadcast's copy to every other rank's first
