@@ -3,6 +3,9 @@
 // when several threads receive), on a duplicate of MPI_COMM_WORLD. The only code that includes
 // mpi.h; loaded by process_group.cpp when mpirun launched the program.
 #include <mpi.h>
+#include <sys/mman.h>
+
+#include <cstdint>
 
 #include <chrono>
 #include <climits>
@@ -17,6 +20,16 @@
 
 namespace pr::par {
 namespace {
+
+// Whole 2 MiB pages inside a buffer about to be written once (common/util/allocator.h says
+// why; repeated here, since this module links nothing of parrender's).
+void adviseHugePages(const void* data, std::size_t bytes) {
+  constexpr std::uintptr_t kHugePage = std::uintptr_t(2) << 20;
+  const auto begin = reinterpret_cast<std::uintptr_t>(data);
+  const std::uintptr_t first = (begin + kHugePage - 1) & ~(kHugePage - 1);
+  const std::uintptr_t last = (begin + bytes) & ~(kHugePage - 1);
+  if (data && last > first) (void)madvise(reinterpret_cast<void*>(first), last - first, MADV_HUGEPAGE);
+}
 
 class MpiTransport final : public Transport {
  public:
@@ -50,6 +63,8 @@ class MpiTransport final : public Transport {
     Envelope e;
     e.source = status.MPI_SOURCE;
     e.tag = tag;
+    e.bytes.reserve(std::size_t(count));
+    adviseHugePages(e.bytes.data(), e.bytes.capacity());
     e.bytes.resize(std::size_t(count));
     MPI_Mrecv(e.bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
     return e;
