@@ -68,6 +68,14 @@ struct AnswerHead {
   std::uint64_t moved;
 };
 
+Bytes encodeAnswer(const Grab& grab) {
+  const AnswerHead head{grab.from, grab.requests, grab.packets, grab.blocking ? 1 : 0, grab.moved};
+  Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
+  std::memcpy(answer.data(), &head, sizeof head);
+  if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
+  return answer;
+}
+
 }  // namespace
 
 void Runtime::sendToRank(const ChannelBase& channel, int from, int to, Bytes framed, std::size_t counted) {
@@ -141,9 +149,7 @@ void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& 
       scheduler.next(pe.id(), now(), grab);
       const bool ask = grab.askPe != -1 || grab.refillRequests > 0;
       if (!ask) return;
-      bookScheduling(pe.id(), std::uint64_t(grab.requests + grab.packets),
-                     grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes,
-                     false);
+      bookScheduling(pe.id(), std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), false);
       grab.requests = grab.packets = 0;
       grab.moved = 0;
       for (int i = 0; i < grab.refillRequests; ++i) {
@@ -164,8 +170,7 @@ void Runtime::nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& 
         return;
       }
       if (victim < 0) continue;  // a refill arrived (refill() has put it in the pool)
-      bookScheduling(pe.id(), 2, kTaskRequestBytes + kTaskPacketHeaderBytes + answer.tasks.size() * kTaskEntryBytes,
-                     true);  // the steal request and its answer
+      bookScheduling(pe.id(), std::uint64_t(answer.requests + answer.packets), answer.transferBytes(), true);
       scheduler.stolen(pe.id(), victim, std::move(answer.tasks));
     }
   }
@@ -246,23 +251,19 @@ void Runtime::handleRankMessage(Envelope& e) {
       }
       Grab grab;
       scheduler.next(f.from, now(), grab);
-      const AnswerHead head{grab.from, grab.requests, grab.packets, grab.blocking ? 1 : 0, grab.moved};
-      Bytes answer(sizeof head + grab.tasks.size() * sizeof(TaskId));
-      std::memcpy(answer.data(), &head, sizeof head);
-      if (!grab.tasks.empty()) std::memcpy(answer.data() + sizeof head, grab.tasks.data(), grab.tasks.size() * sizeof(TaskId));
-      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, encodeAnswer(grab));
       break;
     }
     case kStealRequest: {  // PE f.from asks for half of local PE victim's pool
       std::int32_t victim = -1;
       if (payload.size() >= sizeof victim) std::memcpy(&victim, payload.data(), sizeof victim);
       PR_CHECK(isLocal(victim), "a steal request for a PE this rank does not have");
-      const std::vector<TaskId> tasks = job_.scheduler->stealFrom(victim);
-      const AnswerHead head{victim, 0, 0, 1, tasks.size()};
-      Bytes answer(sizeof head + tasks.size() * sizeof(TaskId));
-      std::memcpy(answer.data(), &head, sizeof head);
-      if (!tasks.empty()) std::memcpy(answer.data() + sizeof head, tasks.data(), tasks.size() * sizeof(TaskId));
-      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, std::move(answer));
+      Grab stolen;  // the request and this answer
+      stolen.from = victim;
+      stolen.requests = stolen.packets = 1;
+      stolen.tasks = job_.scheduler->stealFrom(victim);
+      stolen.moved = stolen.tasks.size();
+      sendControl(rankOf(f.from), kTaskAnswer, stage, f.from, encodeAnswer(stolen));
       break;
     }
     case kRefillRequest: {  // rank 0: a packet of the controller's pool for PE f.from

@@ -329,16 +329,8 @@ void Runtime::peLoop(int p, const StageJob& job) {
           if (acrossRanks) outstanding_.done();
           continue;
         }
-        if (grab.from != p && grab.packets + grab.requests > 0) {
-          c.schedulingMessages.fetch_add(grab.requests + grab.packets, std::memory_order_relaxed);
-          const std::uint64_t bytes =
-              grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes;
-          c.schedulingBytes.fetch_add(bytes, std::memory_order_relaxed);
-          if (askController) {  // asked rank 0's controller, and answered, by messages between ranks
-            c.schedulingMessagesBetweenRanks.fetch_add(grab.requests + grab.packets, std::memory_order_relaxed);
-            c.schedulingBytesBetweenRanks.fetch_add(bytes, std::memory_order_relaxed);
-          }
-        }
+        // Asked of rank 0's controller, and answered, by messages between ranks.
+        if (grab.from != p) bookScheduling(p, std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), askController);
         for (TaskId id : grab.tasks) {
           if (abort_.load(std::memory_order_relaxed)) break;
           current = id;

@@ -199,11 +199,9 @@ class Runtime {
   const RunRecord& gatherRecord(double timeoutSeconds = 300.0);
   // Inside a runOncePerRank stage, on each rank's first PE: data, held on rank 0, becomes every
   // other rank's (rank 0 sends it to each, and no longer holds it; the wait for it is booked as
-  // waiting). A real broadcast of replicated data, which the caller books with recordBroadcast.
-  void shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds = 300.0);
-  // shareFromRank0, booked in this stage as the broadcast it is: one copy of the data to each
-  // other rank's first PE, between ranks (what the rest of a rank's PEs read of it, the rank
-  // makes of it first and books where it shares that). For data no other broadcast books.
+  // waiting). A real broadcast, booked in this stage as one copy to each other rank's first
+  // PE, between ranks (what the rest of a rank's PEs read of it, the rank makes of it first
+  // and books where it shares that: recordBroadcastWithinRanks). Nothing moves on one rank.
   void broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds = 300.0);
   void sumAcrossRanks(std::span<double> values, double timeoutSeconds = 300.0);
   // Seconds since the runtime was created (steady clock).
@@ -270,7 +268,7 @@ class Runtime {
     double seconds;
   };
   bool awaitAnswer(Pe& pe, Grab& grab, std::vector<TaskSpan>& spans);
-  // Scheduling traffic of PE pe's asks across ranks (steals, refills), counted as it happens.
+  // Scheduling traffic of PE pe (its part between ranks too), counted as it happens.
   void bookScheduling(int pe, std::uint64_t messages, std::uint64_t bytes, bool betweenRanks);
   void nextTasks(Pe& pe, Scheduler& scheduler, bool askController, Grab& grab, std::vector<TaskSpan>& spans,
                  std::vector<TaskReport>& reports, bool& asked);

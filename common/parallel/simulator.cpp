@@ -294,10 +294,8 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       PeStageRecord& r = sr.pes[p];
       const std::uint64_t messages = grab.requests + grab.packets;
       if (grab.from != p && messages > 0) {
-        const std::uint64_t bytes =
-            grab.requests * kTaskRequestBytes + grab.packets * kTaskPacketHeaderBytes + grab.moved * kTaskEntryBytes;
         r.schedulingMessages += messages;
-        r.schedulingBytes += bytes;
+        r.schedulingBytes += grab.transferBytes();
         if (grab.blocking && grab.packets > 0) {
           // Idle until the first packet arrives; refills in the same answer travel while it computes.
           const std::uint64_t first = (grab.requests > 0 ? kTaskRequestBytes : 0) + kTaskPacketHeaderBytes +

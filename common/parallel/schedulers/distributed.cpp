@@ -59,21 +59,14 @@ class DistributedScheduler : public Scheduler {
             out.askPe = q;
             return;
           }
-          Pool& pool = *pools_[q];
-          std::lock_guard lock(pool.mutex);
-          if (pool.tasks.empty()) continue;
-          const std::size_t half = (pool.tasks.size() + 1) / 2;
-          stolen.assign(pool.tasks.end() - half, pool.tasks.end());
-          pool.tasks.erase(pool.tasks.end() - half, pool.tasks.end());
+          stolen = stealFrom(q);
+          if (stolen.empty()) continue;
           victim = q;
           break;
         }
       }
       if (victim < 0) return;  // every pool is empty: the stage's tasks are all handed out
-      {
-        std::lock_guard lock(pools_[pe]->mutex);
-        pools_[pe]->tasks.insert(pools_[pe]->tasks.end(), stolen.begin(), stolen.end());
-      }
+      addToPool(pe, stolen);
       out.from = victim;
       out.requests += 1;
       out.packets += 1;
@@ -82,6 +75,7 @@ class DistributedScheduler : public Scheduler {
     }
   }
 
+  // Half of victim's pool (rounded up), from its far end; none when it is empty.
   std::vector<TaskId> stealFrom(int victim) override {
     Pool& pool = *pools_[victim];
     std::lock_guard lock(pool.mutex);
@@ -98,8 +92,7 @@ class DistributedScheduler : public Scheduler {
       empty[std::size_t(victim)] = 1;
       return;
     }
-    std::lock_guard lock(pools_[pe]->mutex);
-    pools_[pe]->tasks.insert(pools_[pe]->tasks.end(), tasks.begin(), tasks.end());
+    addToPool(pe, tasks);
   }
 
  private:
@@ -107,6 +100,11 @@ class DistributedScheduler : public Scheduler {
     std::mutex mutex;
     std::deque<TaskId> tasks;
   };
+
+  void addToPool(int pe, const std::vector<TaskId>& tasks) {
+    std::lock_guard lock(pools_[pe]->mutex);
+    pools_[pe]->tasks.insert(pools_[pe]->tasks.end(), tasks.begin(), tasks.end());
+  }
 
   bool local(int q) const { return localCount_ < 0 || (q >= firstLocal_ && q < firstLocal_ + localCount_); }
 

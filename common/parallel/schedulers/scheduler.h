@@ -68,6 +68,10 @@ struct Grab {
     askPe = -1;
     refillRequests = 0;
   }
+  // The bytes of its requests, packets and moved task ids (the modelled sizes above).
+  std::uint64_t transferBytes() const {
+    return requests * kTaskRequestBytes + packets * kTaskPacketHeaderBytes + moved * kTaskEntryBytes;
+  }
 };
 
 class Scheduler {

@@ -11,6 +11,7 @@
 #include <deque>
 #include <memory>
 #include <mutex>
+#include <utility>
 
 #include "common/parallel/schedulers/scheduler.h"
 
@@ -51,8 +52,8 @@ class TaskManagerScheduler : public Scheduler {
 
   std::vector<TaskId> supplyPacket(int) override {
     std::vector<TaskId> packet;
-    const std::size_t start = cursor_.fetch_add(grain_, std::memory_order_relaxed);
-    for (std::size_t id = start; id < std::min(total_, start + grain_); ++id) packet.push_back(static_cast<TaskId>(id));
+    const auto [start, end] = claimPacket();
+    for (std::size_t id = start; id < end; ++id) packet.push_back(static_cast<TaskId>(id));
     return packet;
   }
 
@@ -96,10 +97,15 @@ class TaskManagerScheduler : public Scheduler {
     out.from = kController;
   }
 
+  // The next packet of the controller's pool: task ids [first, second), empty once it is spent.
+  std::pair<std::size_t, std::size_t> claimPacket() {
+    const std::size_t start = std::min(total_, cursor_.fetch_add(grain_, std::memory_order_relaxed));
+    return {start, std::min(total_, start + grain_)};
+  }
+
   bool fetchPacket(std::deque<TaskId>& pool, Grab& out) {
-    const std::size_t start = cursor_.fetch_add(grain_, std::memory_order_relaxed);
-    if (start >= total_) return false;
-    const std::size_t end = std::min(total_, start + grain_);
+    const auto [start, end] = claimPacket();
+    if (start == end) return false;
     for (std::size_t id = start; id < end; ++id) pool.push_back(static_cast<TaskId>(id));
     out.requests += 1;
     out.packets += 1;
