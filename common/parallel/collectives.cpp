@@ -140,11 +140,15 @@ void Runtime::sumAcrossRanks(std::span<double> values, double timeoutSeconds) {
   for (int r = 1; r < ranks_; ++r) transport.send(r, kSumTag, asBytes());
 }
 
-void Runtime::shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds) {
-  PR_CHECK(inStage_ && pe.id() == firstLocalPe(), "shareFromRank0 runs on each rank's first PE, inside a stage");
+void Runtime::broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds) {
+  PR_CHECK(inStage_ && pe.id() == firstLocalPe(), "broadcastToRanks runs on each rank's first PE, inside a stage");
   if (ranks_ == 1) return;
+  // Booked in this stage, as the data's size (read by the controlling thread only once the
+  // stage has ended).
+  const auto book = [&](std::size_t bytes) { pendingBroadcasts_.push_back({bytes, 0, PendingBroadcast::To::OtherRanksFirstPe}); };
   Transport& transport = *options_.transport;
   if (rank_ == 0) {
+    book(data.size());
     for (int r = 1; r < ranks_; ++r) transport.send(r, kShareTag, r + 1 < ranks_ ? data : std::move(data));
     // Until the data has left: without asynchronous progress it moves only while this rank
     // calls the transport.
@@ -156,13 +160,7 @@ void Runtime::shareFromRank0(Pe& pe, Bytes& data, double timeoutSeconds) {
   const double t0 = now();
   data = awaitFrom(transport, kShareTag, timeoutSeconds, "rank 0's broadcast").bytes;
   pe.recordWait(now() - t0);
-}
-
-void Runtime::broadcastToRanks(Pe& pe, Bytes& data, double timeoutSeconds) {
-  const std::size_t bytes = data.size();  // rank 0's, before it leaves
-  shareFromRank0(pe, data, timeoutSeconds);
-  // Read by the controlling thread only once the stage has ended.
-  pendingBroadcasts_.push_back({rank_ == 0 ? bytes : data.size(), 0, PendingBroadcast::To::OtherRanksFirstPe});
+  book(data.size());
 }
 
 const RunRecord& Runtime::gatherRecord(double timeoutSeconds) {

@@ -70,6 +70,24 @@ std::vector<std::vector<T>> gatherToRoot(Runtime& rt, std::string_view stage, st
   return out;
 }
 
+// Inside a stage, on each rank's first PE, across ranks: what rank 0 made reaches every other
+// rank as its encoding, booked as that broadcast between ranks (Runtime::broadcastToRanks).
+// encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others; nothing moves on one
+// rank.
+template <class Encode, class Decode>
+void shareEncodedFromRank0(Runtime& rt, Pe& pe, Encode&& encode, Decode&& decode) {
+  if (rt.ranks() == 1) return;
+  Bytes bytes;
+  if (rt.rank() == 0) {
+    WireWriter w(bytes);
+    encode(w);
+  }
+  rt.broadcastToRanks(pe, bytes);
+  if (rt.rank() == 0) return;
+  WireReader r(bytes);
+  decode(r);
+}
+
 // gatherToRoot to PE 0, then, across ranks, the lists rank 0 holds are sent to every other rank
 // in a stage of their own (`stage` + " share": a real broadcast of their bytes, from rank 0 to
 // each rank's first PE, booked as one), so every rank returns the lists indexed by source PE:
@@ -82,16 +100,15 @@ std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std
   std::vector<std::vector<T>> out = gatherToRoot(rt, stage, std::move(channel), kind, std::move(perPe), bytesPerItem);
   if (rt.ranks() == 1) return out;
   rt.runOncePerRank(std::string(stage) + " share", [&](Pe& pe) {
-    Bytes bytes;
-    if (rt.rank() == 0) {
-      WireWriter w(bytes);
-      for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
-    }
-    rt.broadcastToRanks(pe, bytes);
-    if (rt.rank() == 0) return;
-    WireReader r(bytes);
-    for (std::vector<T>& list : out) list = r.sequence<T>();
-    if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
+    shareEncodedFromRank0(
+        rt, pe,
+        [&](WireWriter& w) {
+          for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
+        },
+        [&](WireReader& r) {
+          for (std::vector<T>& list : out) list = r.sequence<T>();
+          if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
+        });
   });
   return out;
 }

@@ -246,7 +246,7 @@ class ObjectFrame {
   // On each rank's first PE in the split stage, across ranks: rank 0's assignment reaches
   // every rank.
   void shareAssignment(par::Pe& pe) {
-    shareEncodedFromRank0(
+    par::shareEncodedFromRank0(
         rt_, pe, [&](par::WireWriter& w) { assignment_.encode(w); },
         [&](par::WireReader& r) {
           assignment_ = ObjectAssignment::decode(r);

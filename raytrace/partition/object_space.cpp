@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "common/parallel/batched_channel.h"
+#include "common/parallel/gather_to_root.h"
 #include "raytrace/partition/film_assembly.h"
 #include "common/util/error.h"
 #include "raytrace/partition/partition_margin.h"
@@ -175,7 +176,7 @@ class ObjectSpaceFrame {
   // On each rank's first PE in the split stage, across ranks: rank 0's split, voxel owners and
   // the tiles' preferred PEs reach every rank.
   void shareSplit(par::Pe& pe, std::vector<int>& preferred) {
-    shareEncodedFromRank0(
+    par::shareEncodedFromRank0(
         rt_, pe,
         [&](par::WireWriter& w) {
           split_.encode(w);

@@ -106,24 +106,6 @@ class SceneViews {
   std::vector<std::unique_ptr<scene::Scene>> views_;
 };
 
-// Inside a stage, on each rank's first PE, across ranks: what rank 0 made reaches every other
-// rank as its encoding, booked as that broadcast between ranks (Runtime::broadcastToRanks).
-// encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others; nothing moves on one
-// rank.
-template <class Encode, class Decode>
-void shareEncodedFromRank0(par::Runtime& rt, par::Pe& pe, Encode&& encode, Decode&& decode) {
-  if (rt.ranks() == 1) return;
-  par::Bytes bytes;
-  if (rt.rank() == 0) {
-    par::WireWriter w(bytes);
-    encode(w);
-  }
-  rt.broadcastToRanks(pe, bytes);
-  if (rt.rank() == 0) return;
-  par::WireReader r(bytes);
-  decode(r);
-}
-
 // Throws pr::InputError for a ray batch size outside [1, kMaxRayBatch].
 inline void checkRayBatch(const TraceOptions& options, std::string_view method) {
   if (options.rayBatch < 1 || options.rayBatch > kMaxRayBatch)
