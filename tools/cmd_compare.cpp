@@ -63,10 +63,10 @@ std::string fileStem(const Combination& c) {
 void run(CompareArgs& a) {
   if (a.methods.empty())
     for (std::string_view m : renderMethods().names()) a.methods.emplace_back(m);
-  // Under mpirun, --threads is each rank's PEs (default one) and rank 0 prints and writes.
+  // Under mpirun, --threads is each rank's PEs and rank 0 prints and writes.
   const int ranks = par::ProcessGroup::get().ranks();
   const bool writes = holdsResults();
-  if (a.threads.empty()) a.threads = ranks > 1 ? std::vector<int>{1} : defaultThreadCounts();
+  if (a.threads.empty()) a.threads = defaultThreadCounts();
   ComparisonSpec spec;
   spec.methods = a.methods;
   spec.schedules = a.schedules;

@@ -25,6 +25,7 @@
 #include "tools/commands.h"
 #include "tools/lighting.h"
 #include "tools/render_methods.h"
+#include "tools/timed_render.h"
 
 namespace pr::cli {
 
@@ -103,8 +104,9 @@ void run(RenderArgs& a) {
   // Under mpirun, --threads is each rank's: P = R x T PEs, and rank 0 writes and prints.
   par::ProcessGroup& group = par::ProcessGroup::get();
   checkAcrossRanks(method, group.ranks());
-  const bool writes = group.rank() == 0;
-  const int pes = group.ranks() * a.threads;
+  const bool writes = holdsResults();
+  const Placement where = everyRank(a.threads);
+  const int pes = where.pes;
   checkRenderMemory(method, a.width, a.height, a.threads, samplesPerPixel(a.settings.ray));
   const scene::EffectOverrides overrides = scene::parseEffectOverrides(a.effects);
   if (a.output.empty()) a.output = defaultOutput(a.scene, a.method);
@@ -135,9 +137,8 @@ void run(RenderArgs& a) {
 
   const par::RunSummary summary = par::summarize(runtime.record());
   const double wall = summary.wallSeconds;
-  const std::string ranks = group.ranks() > 1 ? " (" + std::to_string(group.ranks()) + " ranks x " + std::to_string(a.threads) + " PEs)" : "";
   std::printf("method %s (%s), P %d%s, schedule %s, %dx%d -> %s\n", a.method.c_str(), std::string(toString(method.properties.family)).c_str(),
-              pes, ranks.c_str(), a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+              pes, where.acrossRanks().c_str(), a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
   std::printf("%s\n", lighting.c_str());
   std::printf("effects:\n");
   for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());

@@ -118,7 +118,7 @@ void run(ReportArgs& a) {
   // Under mpirun, --threads is each rank's PEs (default one); P = 1 runs on rank 0 alone, and
   // rank 0 alone reads and writes the report's folder while the other ranks wait.
   par::ProcessGroup& group = par::ProcessGroup::get();
-  if (a.spec.threads.empty()) a.spec.threads = group.ranks() > 1 ? std::vector<int>{1} : defaultThreadCounts();
+  if (a.spec.threads.empty()) a.spec.threads = defaultThreadCounts();
   if (group.ranks() == 1 && std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
     throw InputError("--threads must include 1: speed-up and efficiency are measured against P = 1");
   for (const std::string& scene : a.scenes) {
@@ -162,7 +162,7 @@ void run(ReportArgs& a) {
     }
     return par::Bytes();
   });
-  const bool writes = group.rank() == 0;
+  const bool writes = holdsResults();
   try {
     build(a, fresh);
     // The earlier report steps aside only once the new one is whole, and comes back if the

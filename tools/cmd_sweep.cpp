@@ -46,9 +46,7 @@ void run(SweepArgs& a) {
   const double referenceCpu = result.reference.cpuSeconds;
   const Placement where = everyRank(a.threads);
   std::printf("sweep of %s, %dx%d, method %s, P %d%s; reference: path tracing, %d spp%s\n", a.scene.c_str(), a.width,
-              a.height, a.method.c_str(), where.pes,
-              where.ranks > 1 ? (" (" + std::to_string(where.ranks) + " ranks x " + std::to_string(a.threads) + " PEs)").c_str() : "",
-              a.referenceSpp, cached ? " (cached)" : "");
+              a.height, a.method.c_str(), where.pes, where.acrossRanks().c_str(), a.referenceSpp, cached ? " (cached)" : "");
   std::printf("%-10s %-8s %10s %9s %9s %10s %10s %9s %12s\n", "integrator", "setting", "value", "cpu_s", "wall_s", "rmse",
               "rel_mse", "max_err", "caustic_rmse");
   for (const SweepRow& r : rows)
@@ -75,7 +73,7 @@ void run(SweepArgs& a) {
     writeFileAtomically(a.csv, out.str(), "CSV file");
   }
   if (!a.json.empty()) {
-    nlohmann::json j = {{"scene", a.scene}, {"method", a.method}, {"threads", a.threads}, {"pes", everyRank(a.threads).pes}, {"width", a.width},
+    nlohmann::json j = {{"scene", a.scene}, {"method", a.method}, {"threads", a.threads}, {"pes", where.pes}, {"width", a.width},
                         {"height", a.height}, {"vary", a.vary}, {"targetRmse", target}, {"cpuSecondsToTarget", toTarget},
                         {"reference", {{"integrator", "path"}, {"spp", a.referenceSpp}, {"maxDepth", a.referenceDepth},
                                        {"cached", bool(cached)}, {"cpuSeconds", referenceCpu}}},

@@ -4,6 +4,7 @@
 #include <sys/resource.h>
 
 #include <chrono>
+#include <string>
 #include <utility>
 
 #include "common/parallel/process_group.h"
@@ -15,6 +16,11 @@ double processCpuSeconds() {
   rusage usage{};
   getrusage(RUSAGE_SELF, &usage);
   return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
+}
+
+std::string Placement::acrossRanks() const {
+  if (ranks == 1) return {};
+  return " (" + std::to_string(ranks) + " ranks x " + std::to_string(pes / ranks) + " PEs)";
 }
 
 Placement everyRank(int threadsPerRank) {

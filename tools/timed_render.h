@@ -7,6 +7,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 
 #include "common/parallel/run_options.h"
 #include "common/parallel/run_record.h"
@@ -38,6 +39,8 @@ double processCpuSeconds();
 // rank 0 alone) or every rank of the run (ProcessGroup::ranks(), which must divide pes).
 struct Placement {
   int pes = 1, ranks = 1;
+  // " (R ranks x T PEs)" across ranks, else empty: what a summary line adds to "P N".
+  std::string acrossRanks() const;
 };
 
 // T PEs on every rank of the run: P = T without mpirun, R x T under it.

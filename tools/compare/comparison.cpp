@@ -55,6 +55,7 @@ double counterTotal(const ComparisonRow& row, const std::string& name) {
 }
 
 std::vector<int> defaultThreadCounts() {
+  if (par::ProcessGroup::get().ranks() > 1) return {1};
   const int cores = std::max(1, int(std::thread::hardware_concurrency()));
   std::vector<int> out;
   for (int p = 1; p < cores; p *= 2) out.push_back(p);

@@ -97,7 +97,8 @@ par::KindTraffic allTraffic(const ComparisonRow& row);
 // A named per-PE counter of the row's run, summed over the PEs (0 when the run has none).
 double counterTotal(const ComparisonRow& row, const std::string& name);
 
-// The default values of P: 1, 2, 4, ... up to this machine's cores, and the core count itself.
+// The default values of --threads: 1, 2, 4, ... up to this machine's cores, and the core count
+// itself; under mpirun, one PE per rank.
 std::vector<int> defaultThreadCounts();
 
 }  // namespace pr::cli
