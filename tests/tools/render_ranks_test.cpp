@@ -59,21 +59,26 @@ void checkEqualsOneProcess(const std::string& name, const std::string& method, c
 // The ray tracers' options of the record comparisons: 48x48, 1 spp, tiles of 8, a static schedule.
 const std::string kRayRecordArgs = "--integrator path --width 48 --height 48 --spp 1 --tile-size 8 --schedule balanced";
 
+// `command` (a render) with --threads T, in one process (R = 1) or under mpirun on R ranks,
+// its image and run record written into dir as NAME.png and NAME.json: what it printed and
+// the record.
+std::pair<std::string, pr::par::RunRecord> renderRecord(const std::string& command, int ranks, int threads,
+                                                        const std::filesystem::path& dir, const std::string& name) {
+  const std::string args = join({command, " --threads ", std::to_string(threads), " -o ", quoted(dir / (name + ".png")),
+                                 " --metrics ", quoted(dir / (name + ".json"))});
+  const CommandResult r = ranks == 1 ? pr::test::runParrender(args) : mpiParrender(ranks, args);
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  return {r.output, pr::par::readRunRecord(dir / (name + ".json"))};
+}
+
 // The run records of `method` on the Cornell box with `args` at P = 2: two PE threads in one
 // process, and two ranks of one PE under mpirun.
 std::pair<pr::par::RunRecord, pr::par::RunRecord> threadsAndRanksRecords(const std::filesystem::path& dir,
                                                                        const std::string& method,
                                                                        const std::string& args = kRayRecordArgs) {
   const std::string common = join({"render ", cornell(), " -m ", method, " ", args, " --quiet"});
-  const CommandResult threads = pr::test::runParrender(join({common, " --threads 2 -o ", quoted(dir / "t.png"), " --metrics ",
-                                                             quoted(dir / "threads.json")}));
-  INFO(threads.output);
-  REQUIRE(threads.exitStatus == 0);
-  const CommandResult ranks = mpiParrender(2, join({common, " --threads 1 -o ", quoted(dir / "r.png"), " --metrics ",
-                                                    quoted(dir / "ranks.json")}));
-  INFO(ranks.output);
-  REQUIRE(ranks.exitStatus == 0);
-  return {pr::par::readRunRecord(dir / "threads.json"), pr::par::readRunRecord(dir / "ranks.json")};
+  return {renderRecord(common, 1, 2, dir, "threads").second, renderRecord(common, 2, 1, dir, "ranks").second};
 }
 
 // The messages, and their bytes, of each channel in each stage of two records.
@@ -222,11 +227,7 @@ TEST_CASE("RenderRanks: the record of 2 ranks of one PE counts what the thread r
     }
   }
   // Four PEs on two ranks: the record has them all, each with its tasks.
-  const CommandResult four = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "f.png"), " --metrics ",
-                                                   quoted(dir / "four.json")}));
-  INFO(four.output);
-  REQUIRE(four.exitStatus == 0);
-  const pr::par::RunRecord f = pr::par::readRunRecord(dir / "four.json");
+  const pr::par::RunRecord f = renderRecord(common, 2, 2, dir, "four").second;
   CHECK(f.pes == 4);
   const pr::par::StageRecord& trace = f.stages.back();
   for (int p = 0; p < 4; ++p) CHECK(trace.pes[std::size_t(p)].tasks > 0);
@@ -298,16 +299,13 @@ TEST_CASE("RenderRanks: the record splits every kind of traffic into what crosse
   const std::filesystem::path dir = pr::test::scratchDir("render_ranks_split");
   const std::string common = join({"render ", cornell(), " -m object-space --integrator path --width 48 --height 48 --spp 1 "
                                    "--tile-size 8 --quiet"});
-  const CommandResult ranks = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "r.png"), " --metrics ",
-                                                    quoted(dir / "ranks.json")}));
-  INFO(ranks.output);
-  REQUIRE(ranks.exitStatus == 0);
-  CHECK(ranks.output.find("between ranks: ") != std::string::npos);
-  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const auto [printed, r] = renderRecord(common, 2, 2, dir, "ranks");
+  CHECK(printed.find("between ranks: ") != std::string::npos);
   REQUIRE(r.ranks == 2);
   REQUIRE(r.pes == 4);
   const auto rankOf = [](int pe) { return pe / 2; };
   std::uint64_t crossingPairs = 0, crossingChannels = 0, channels = 0, crossingBroadcasts = 0, taskCrossings = 0;
+  std::uint64_t askedTasks = 0;  // tasks rank 1's PEs got from rank 0's controller (demand)
   for (const pr::par::StageRecord& s : r.stages) {
     for (const pr::par::Traffic& t : s.traffic)
       if (rankOf(t.from) != rankOf(t.to)) crossingPairs += t.messages;
@@ -321,12 +319,15 @@ TEST_CASE("RenderRanks: the record splits every kind of traffic into what crosse
       if (p == 2) crossingBroadcasts += pe.broadcastsReceived;
       if (p < 2) CHECK(pe.schedulingMessagesBetweenRanks == 0);  // rank 0 asks its own controller
       taskCrossings += pe.schedulingMessagesBetweenRanks;
+      if (p >= 2 && s.schedule == "demand") askedTasks += pe.tasks;
     }
   }
   CHECK(crossingChannels > 0);
   CHECK(crossingChannels < channels);
   CHECK(crossingChannels == crossingPairs);
-  CHECK(taskCrossings > 0);
+  // Whether rank 1's PEs got any task depends on timing (rank 0's may take them all under
+  // load); each one it got crossed as a request and an answer.
+  if (askedTasks > 0) CHECK(taskCrossings > 0);
   CHECK(crossingBroadcasts > 0);
   const pr::par::RunSummary summary = pr::par::summarize(r);
   for (const pr::par::KindTraffic& k : summary.total.byKind) {
@@ -335,11 +336,7 @@ TEST_CASE("RenderRanks: the record splits every kind of traffic into what crosse
     if (k.kind == "tasks") CHECK(k.betweenRankMessages == taskCrossings);
   }
   // One process: ranks 1, nothing between ranks.
-  const CommandResult one = pr::test::runParrender(join({common, " --threads 4 -o ", quoted(dir / "t.png"), " --metrics ",
-                                                          quoted(dir / "threads.json")}));
-  INFO(one.output);
-  REQUIRE(one.exitStatus == 0);
-  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  const pr::par::RunRecord t = renderRecord(common, 1, 4, dir, "threads").second;
   CHECK(t.ranks == 1);
   for (const pr::par::KindTraffic& k : pr::par::summarize(t).total.byKind) {
     CAPTURE(k.kind);
@@ -355,11 +352,7 @@ TEST_CASE("RenderRanks: the photon map's share of the gathered photons between r
   const std::filesystem::path dir = pr::test::scratchDir("render_ranks_photon_share");
   const std::string common = join({"render ", cornellGlass(), " -m image-space --integrator photonmap --width 24 --height 20 "
                                    "--spp 1 --photons 4000 --caustic-photons 4000 --gather 8 --quiet"});
-  const CommandResult ranks = mpiParrender(2, join({common, " --threads 2 -o ", quoted(dir / "r.png"), " --metrics ",
-                                                    quoted(dir / "ranks.json")}));
-  INFO(ranks.output);
-  REQUIRE(ranks.exitStatus == 0);
-  const pr::par::RunRecord r = pr::par::readRunRecord(dir / "ranks.json");
+  const pr::par::RunRecord r = renderRecord(common, 2, 2, dir, "ranks").second;
   const auto share = std::find_if(r.stages.begin(), r.stages.end(),
                                   [](const pr::par::StageRecord& s) { return s.name.find("photon merge share") != std::string::npos; });
   REQUIRE(share != r.stages.end());
@@ -368,11 +361,7 @@ TEST_CASE("RenderRanks: the photon map's share of the gathered photons between r
   CHECK(share->pes[2].broadcastsReceived == 1);
   CHECK(share->pes[2].broadcastBytesReceived == share->broadcastBytes);
   for (int p : {0, 1, 3}) CHECK(share->pes[std::size_t(p)].broadcastsReceived == 0);
-  const CommandResult one = pr::test::runParrender(join({common, " --threads 4 -o ", quoted(dir / "t.png"), " --metrics ",
-                                                          quoted(dir / "threads.json")}));
-  INFO(one.output);
-  REQUIRE(one.exitStatus == 0);
-  const pr::par::RunRecord t = pr::par::readRunRecord(dir / "threads.json");
+  const pr::par::RunRecord t = renderRecord(common, 1, 4, dir, "threads").second;
   CHECK(std::none_of(t.stages.begin(), t.stages.end(),
                      [](const pr::par::StageRecord& s) { return s.name.find("share") != std::string::npos; }));
 }

@@ -246,7 +246,7 @@ TEST_CASE("RankStage: distributed task management steals between ranks by messag
     rt.runStage("tasks", TaskSet::uniform(kTasks), [&](Pe& pe, TaskId t) {
       runs[static_cast<std::size_t>(t)].fetch_add(1);
       ranOn[static_cast<std::size_t>(t)].store(pe.id());
-      if (t < 20) std::this_thread::sleep_for(std::chrono::milliseconds(3));
+      if (t < 20) std::this_thread::sleep_for(std::chrono::milliseconds(10));
     });
     const RunRecord& record = rt.gatherRecord();
     if (rt.rank() != 0) return;
@@ -288,9 +288,10 @@ TEST_CASE("RankStage: a task manager's local pools on other ranks are refilled f
   for (int p : {0, 1}) CHECK(between[std::size_t(p)] == 0);  // the controller's own rank
   for (int p : {2, 3}) {
     CAPTURE(p);
-    CHECK(tasksRun[std::size_t(p)] > 0);
-    // Every packet it ran came as a request and an answer (grain 2), and one more pair told it
-    // the pool was spent; all of it crossed between ranks.
+    // Its first ask finds its pool empty and goes to rank 0 whatever the timing (how many tasks
+    // it then gets is timing's). Every packet it ran came as a request and an answer (grain 2),
+    // and one more pair told it the pool was spent; all of it crossed between ranks.
+    CHECK(between[std::size_t(p)] >= 2);
     CHECK(between[std::size_t(p)] >= 2 * (tasksRun[std::size_t(p)] / 2));
     CHECK(between[std::size_t(p)] % 2 == 0);
     CHECK(scheduling[std::size_t(p)] == between[std::size_t(p)]);
