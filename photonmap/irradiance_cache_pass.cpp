@@ -258,10 +258,8 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
       if (uncovered[i]) chosen.push_back(candidates[i]);
     if (chosen.empty()) continue;
 
-    // Their gather rays, traced where the tracer traces them (every PE gets the chosen probes
-    // it may start rays from: a broadcast; across ranks every rank chose them from the shared
-    // probes and coverage); the samples go to PE 0.
-    rt.recordBroadcastWithinRanks(chosen.size() * sizeof(ProbeHit));
+    // Their gather rays, traced where the tracer traces them (every PE chose the same probes
+    // from the probes and coverage flags broadcast to it); the samples go to PE 0.
     const int gw = std::min<int>(kGatherWidth, int(chosen.size()));
     const int gh = int((chosen.size() + std::size_t(gw) - 1) / std::size_t(gw));
     const auto gather = std::make_shared<const GatherProgram>(scene, camera, gw, gh, chosen, global, options.gather, pes);
@@ -304,12 +302,10 @@ IrradianceCache buildIrradianceCache(const scene::Scene& scene, const scene::Cam
         made[i] = r;
       }
     });
-    const std::size_t before = cache.bytes();
+    // The new records reached every PE (the records merge's broadcast), where every rank's
+    // controlling thread inserts them for the next level's coverage and the render.
     for (const IrradianceRecord& r : made) cache.insert(r);
     records += double(made.size());
-    // The new records reach every PE (the next level's coverage and the render read them); across
-    // ranks every rank's controlling thread inserted them, from the records merge's share.
-    rt.recordBroadcastWithinRanks(cache.bytes() - before);
   }
   for (int p = 0; p < pes; ++p) {
     rt.addCounter("IrradianceCache/probes", p, probesPerPe[std::size_t(p)]);

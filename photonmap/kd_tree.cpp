@@ -118,25 +118,26 @@ KdTree KdTree::build(std::vector<Photon> photons, par::Runtime& runtime) {
   // README, bench_runtime): one thread builds it.
   constexpr std::size_t kMinParallelPhotons = std::size_t{1} << 15;
   if (runtime.pes() == 1 || photons.size() < kMinParallelPhotons) return build(std::move(photons));
-  if (runtime.ranks() > 1) {
-    // Across ranks every rank holds the photons (gathered to all) and a PE writes only its own
-    // rank's memory: each rank builds the whole tree on its first PE, a replicated
-    // computation (one task per rank in the record), the trees alike bit for bit.
-    KdTree tree;
-    runtime.runOncePerRank("photon-kd-build", [&](par::Pe&) { tree = build(std::move(photons)); });
-    return tree;
-  }
+  const int local = runtime.localPes();
+  // Every PE holds the photons (gathered to all, booked as their broadcast), so every rank
+  // builds the same tree, a replicated computation, bit for bit alike: its top levels on the
+  // controlling thread, the subtrees below them by the rank's PEs, each writing disjoint ranges
+  // of the rank's arrays. A subtree's task is pinned to a PE of the rank that holds it (with
+  // about 4 per PE, round robin evens out left-balanced subtrees, which differ in size by at
+  // most a factor of 2); the rank's tasks follow every other rank's in the stage.
   KdTree tree;
   tree.nodes_.resize(photons.size());
-  // Enough subtrees for the demand-driven schedule to even out the PEs (about 4 per PE; the
-  // left-balanced subtrees of one level differ in size by at most a factor of 2).
-  const int levels = std::bit_width(static_cast<unsigned>(4 * runtime.pes()) - 1);
+  const int levels = std::bit_width(static_cast<unsigned>(4 * local) - 1);
   const std::vector<Subtree> subtrees = splitTop(photons, tree.nodes_, levels);
   par::TaskSet tasks;
-  for (const Subtree& s : subtrees)
-    tasks.tasks.push_back({static_cast<double>(s.end - s.begin), static_cast<float>(tasks.tasks.size()), 0.0f});
-  runtime.runStage("photon-kd-build", tasks, [&](par::Pe&, par::TaskId t) {
-    const Subtree& s = subtrees[static_cast<std::size_t>(t)];
+  std::vector<int> owner;
+  for (int r = 0; r < runtime.ranks(); ++r)
+    for (std::size_t i = 0; i < subtrees.size(); ++i) {
+      tasks.tasks.push_back({static_cast<double>(subtrees[i].end - subtrees[i].begin), static_cast<float>(i), float(r)});
+      owner.push_back(r * local + int(i) % local);
+    }
+  runtime.runPinned("photon-kd-build", tasks, std::move(owner), [&](par::Pe&, par::TaskId t) {
+    const Subtree& s = subtrees[static_cast<std::size_t>(t) % subtrees.size()];
     balance(photons, s.begin, s.end, tree.nodes_, s.node);  // disjoint ranges of both arrays
   });
   return tree;

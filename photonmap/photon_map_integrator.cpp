@@ -141,11 +141,9 @@ void PhotonMapIntegrator::prePass(rt::PrePassTracer& tracer, par::Runtime& rt) c
   if (settings_.view == PhotonView::Full && settings_.irradianceStride > 0 && !state_->maps.global.empty())
     state_->irradiance = PrecomputedIrradiance::build(lists.global, lists.globalNormals, state_->maps.global,
                                                       globalDensity_, settings_.irradianceStride, rt);
-  // Every PE reads both maps and the precomputed points: replicated data, one broadcast from
-  // the PE that built them (across ranks each rank's first PE, from what reached it between
-  // ranks as the booked share of the photons and points).
-  const std::size_t replicated = state_->maps.global.bytes() + state_->maps.caustic.bytes() + state_->irradiance.bytes();
-  if (replicated > 0) rt.recordBroadcastWithinRanks(replicated);
+  // Every PE reads both maps and the precomputed points, which every rank built from the
+  // photons and points broadcast to every PE (booked there, gatherToAll): a replicated
+  // computation, no further transfer.
 
   state_->cache = IrradianceCache(ctx.scene().bounds, settings_.cacheAccuracy);
   if (settings_.view == PhotonView::Full && ctx.simulates(scene::Effect::IndirectDiffuse) && !state_->maps.global.empty()) {

@@ -30,7 +30,7 @@ bool SceneDistribution::firstFrame(const scene::Scene& s, const par::Runtime& rt
 }
 
 void distributeReplicated(par::Runtime& rt, const scene::Scene& s) {
-  rt.recordBroadcastWithinRanks(s.memoryBytes());  // across ranks, every rank loaded it
+  rt.recordReplicated(s.memoryBytes());  // across ranks, every rank loaded it
   for (int p = 0; p < rt.pes(); ++p) {
     rt.addCounter("Scene/geometry_bytes_held", p, double(geometryBytes(s)));
     rt.addCounter("Scene/primitives_held", p, double(s.triangles.size()));
@@ -39,7 +39,7 @@ void distributeReplicated(par::Runtime& rt, const scene::Scene& s) {
 
 std::vector<PrimitiveBatch> distributeShares(par::Runtime& rt, const scene::Scene& s, std::string_view stage) {
   const uint32_t total = static_cast<uint32_t>(s.triangles.size());
-  rt.recordBroadcastWithinRanks(shadingDataBytes(s));  // across ranks, every rank loaded it
+  rt.recordReplicated(shadingDataBytes(s));  // across ranks, every rank loaded it
   std::vector<PrimitiveBatch> received = scene::sendPrimitiveShares(rt, s, stage, [&](int p) {
     const auto [first, end] = primitiveShare(total, p, rt.pes());
     std::vector<uint32_t> ids(end - first);

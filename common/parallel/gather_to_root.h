@@ -72,35 +72,46 @@ std::vector<std::vector<T>> gatherToRoot(Runtime& rt, std::string_view stage, st
 
 // Inside a stage, on each rank's first PE, across ranks: what rank 0 made reaches every other
 // rank as its encoding, booked as that broadcast between ranks (Runtime::broadcastToRanks).
-// encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others; nothing moves on one
-// rank.
+// encode(WireWriter&) runs on rank 0, decode(WireReader&) on the others. Returns the
+// encoding's size, on one rank too (encoded there only to be measured, nothing moves), for
+// the caller to book what the rank's other PEs read (Runtime::recordBroadcastWithinRanks).
 template <class Encode, class Decode>
-void shareEncodedFromRank0(Runtime& rt, Pe& pe, Encode&& encode, Decode&& decode) {
-  if (rt.ranks() == 1) return;
+std::size_t shareEncodedFromRank0(Runtime& rt, Pe& pe, Encode&& encode, Decode&& decode) {
   Bytes bytes;
   if (rt.rank() == 0) {
     WireWriter w(bytes);
     encode(w);
   }
+  const std::size_t size = bytes.size();
+  if (rt.ranks() == 1) return size;
   rt.broadcastToRanks(pe, bytes);
-  if (rt.rank() == 0) return;
+  if (rt.rank() == 0) return size;
   WireReader r(bytes);
   decode(r);
+  return bytes.size();
 }
 
-// gatherToRoot to PE 0, then, across ranks, the lists rank 0 holds are sent to every other rank
-// in a stage of their own (`stage` + " share": a real broadcast of their bytes, from rank 0 to
-// each rank's first PE, booked as one), so every rank returns the lists indexed by source PE:
-// what a pre-pass needs where every rank's controlling thread then builds the same thing from
-// them. On one rank it is gatherToRoot: the one controlling thread already holds them.
+// gatherToRoot to PE 0, then PE 0 broadcasts the lists to every other PE, so every rank
+// returns the lists indexed by source PE: what a pre-pass needs where every PE then derives
+// the same thing from them (a photon map, the records of a cache), a replicated computation.
+// Across ranks they travel from rank 0 to every other rank in a stage of their own (`stage` +
+// " share": a real broadcast of their encoding, booked as one copy per other rank); within a
+// rank the other PEs read the rank's copy (booked as a broadcast per PE). So P - 1 copies are
+// booked whatever R, on one rank too, where nothing moves: the same record on any transport.
 template <class T>
   requires std::is_trivially_copyable_v<T>
 std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std::string channel, MessageKind kind,
                                         std::vector<std::vector<T>> perPe, std::size_t bytesPerItem) {
   std::vector<std::vector<T>> out = gatherToRoot(rt, stage, std::move(channel), kind, std::move(perPe), bytesPerItem);
-  if (rt.ranks() == 1) return out;
+  if (rt.ranks() == 1) {
+    std::size_t bytes = 0;  // their encoding's size, as below
+    for (const std::vector<T>& list : out) bytes += sizeof(std::uint64_t) + list.size() * sizeof(T);
+    rt.recordBroadcastWithinRanks(bytes);
+    return out;
+  }
+  std::size_t bytes = 0;
   rt.runOncePerRank(std::string(stage) + " share", [&](Pe& pe) {
-    shareEncodedFromRank0(
+    bytes = shareEncodedFromRank0(
         rt, pe,
         [&](WireWriter& w) {
           for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
@@ -110,29 +121,31 @@ std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std
           if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
         });
   });
+  rt.recordBroadcastWithinRanks(bytes);
   return out;
 }
 
-// Across ranks, after a stage in which the task that owns index i wrote values[i] on whichever
-// rank ran it: every rank gets every value (the indices this rank wrote, mine(i), gathered to
-// rank 0 and shared, gatherToAll). On one rank every value is in place already: nothing moves.
-template <class T, class Mine>
+// After a stage in which the task that owns index i wrote values[i] on whichever PE ran it:
+// every PE gets every value, each PE's values gathered to PE 0 and shared (gatherToAll), on
+// one rank as across ranks (where the values are in place already, they are booked as the
+// same messages and broadcast, so the record does not depend on the transport). writer(i): the
+// PE of this rank that wrote values[i], or -1 (another rank's). Nothing for one PE.
+template <class T, class Writer>
   requires std::is_trivially_copyable_v<T>
-void shareWrittenAcrossRanks(Runtime& rt, std::string_view stage, std::string channel, std::vector<T>& values,
-                             Mine&& mine) {
-  if (rt.ranks() == 1) return;
+void shareWrittenValues(Runtime& rt, std::string_view stage, std::string channel, std::vector<T>& values,
+                        Writer&& writer) {
+  if (rt.pes() == 1) return;
   struct At {
     std::uint32_t index;
     T value;
   };
   std::vector<std::vector<At>> perPe(std::size_t(rt.pes()));
-  std::vector<At>& list = perPe[std::size_t(rt.firstLocalPe())];
   for (std::size_t i = 0; i < values.size(); ++i)
-    if (mine(i)) {
+    if (const int p = writer(i); p >= 0) {
       At a{};  // zeroed, padding included: every byte that travels is defined
       a.index = std::uint32_t(i);
       a.value = values[i];
-      list.push_back(a);
+      perPe[std::size_t(p)].push_back(a);
     }
   for (const std::vector<At>& from : gatherToAll(rt, stage, std::move(channel), MessageKind::Data, std::move(perPe), sizeof(At)))
     for (const At& a : from) {
@@ -142,21 +155,20 @@ void shareWrittenAcrossRanks(Runtime& rt, std::string_view stage, std::string ch
 }
 
 // A stage of one task per `perTask` consecutive values, task t writing values[i] for its own
-// indices (work(pe, t)); across ranks every rank then holds every value (shareWrittenAcrossRanks,
-// in stage `mergeStage`). Nothing runs for no values.
+// indices (work(pe, t)); every PE then holds every value (shareWrittenValues, in stage
+// `mergeStage`). Nothing runs for no values.
 template <class T, class Work>
   requires std::is_trivially_copyable_v<T>
 void runStageSharingResults(Runtime& rt, const std::string& stage, const std::string& mergeStage, std::string channel,
                             std::vector<T>& values, std::size_t perTask, Work&& work) {
   if (values.empty()) return;
   const std::size_t tasks = (values.size() + perTask - 1) / perTask;
-  std::vector<char> ranHere(tasks, 0);  // per task: whether a PE of this rank ran it
+  std::vector<int> ranBy(tasks, -1);  // per task: the PE of this rank that ran it
   rt.runStage(stage, TaskSet::uniform(tasks), [&](Pe& pe, TaskId t) {
-    ranHere[std::size_t(t)] = 1;
+    ranBy[std::size_t(t)] = pe.id();
     work(pe, t);
   });
-  shareWrittenAcrossRanks(rt, mergeStage, std::move(channel), values,
-                          [&](std::size_t i) { return ranHere[i / perTask] != 0; });
+  shareWrittenValues(rt, mergeStage, std::move(channel), values, [&](std::size_t i) { return ranBy[i / perTask]; });
 }
 
 }  // namespace pr::par

@@ -48,6 +48,8 @@ const std::vector<PeFigure>& peFigures() {
        "modelled: 16-byte requests, 16-byte packet headers and 8 bytes per task id"},
       {"broadcastBytesReceived", [](const PeStageRecord& r) { return double(r.broadcastBytesReceived); },
        "measured: bytes of the replicated data each PE receives (every PE but the one that holds it)"},
+      {"replicatedBytes", [](const PeStageRecord& r) { return double(r.replicatedBytes); },
+       "measured: bytes of the replicated data another rank's first PE made itself (loaded, built) instead of receiving"},
       {"cacheHits", [](const PeStageRecord& r) { return double(r.cacheHits); }, kMeasured},
       {"cacheMisses", [](const PeStageRecord& r) { return double(r.cacheMisses); }, kMeasured},
       {"prefetches", [](const PeStageRecord& r) { return double(r.prefetches); }, kMeasured},
@@ -121,6 +123,8 @@ std::vector<PeStageRecord> peTotals(const RunRecord& record) {
       t.schedulingBytes += r.schedulingBytes;
       t.broadcastsReceived += r.broadcastsReceived;
       t.broadcastBytesReceived += r.broadcastBytesReceived;
+      t.replicatedCopies += r.replicatedCopies;
+      t.replicatedBytes += r.replicatedBytes;
       t.cacheHits += r.cacheHits;
       t.cacheMisses += r.cacheMisses;
       t.prefetches += r.prefetches;

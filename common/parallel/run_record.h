@@ -36,6 +36,11 @@ struct PeStageRecord {
   std::uint64_t schedulingMessagesBetweenRanks = 0, schedulingBytesBetweenRanks = 0;
   // Replicated read-only data received (scene, photon map), counted once per receiving PE.
   std::uint64_t broadcastsReceived = 0, broadcastBytesReceived = 0;
+  // Replicated data this PE's rank made itself (loaded the scene, built the BVH) where one
+  // process's PE receives it as a broadcast: a replicated computation, named here, not traffic.
+  // Only on the first PE of a rank other than 0, so these and broadcastsReceived together are
+  // the copies every P = R x T run of the same shape makes, across ranks or not.
+  std::uint64_t replicatedCopies = 0, replicatedBytes = 0;
   std::uint64_t cacheHits = 0, cacheMisses = 0, prefetches = 0;
 };
 

@@ -71,6 +71,8 @@ json peJson(const PeStageRecord& r) {
           {"schedulingBytesBetweenRanks", r.schedulingBytesBetweenRanks},
           {"broadcastsReceived", r.broadcastsReceived},
           {"broadcastBytesReceived", r.broadcastBytesReceived},
+          {"replicatedCopies", r.replicatedCopies},
+          {"replicatedBytes", r.replicatedBytes},
           {"cacheHits", r.cacheHits},
           {"cacheMisses", r.cacheMisses},
           {"prefetches", r.prefetches}};
@@ -270,6 +272,8 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       r.schedulingBytesBetweenRanks = count("schedulingBytesBetweenRanks");
       r.broadcastsReceived = count("broadcastsReceived");
       r.broadcastBytesReceived = count("broadcastBytesReceived");
+      r.replicatedCopies = count("replicatedCopies");
+      r.replicatedBytes = count("replicatedBytes");
       r.cacheHits = count("cacheHits");
       r.cacheMisses = count("cacheMisses");
       r.prefetches = count("prefetches");

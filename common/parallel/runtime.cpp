@@ -139,6 +139,11 @@ void Runtime::recordBroadcastWithinRanks(std::size_t bytes) {
   pendingBroadcasts_.push_back({bytes, 0, PendingBroadcast::To::WithinRanks});
 }
 
+void Runtime::recordReplicated(std::size_t bytes) {
+  PR_CHECK(!inStage_, "recordReplicated is called between stages");
+  pendingBroadcasts_.push_back({bytes, 0, PendingBroadcast::To::WithinRanksReplicated});
+}
+
 void Runtime::addCounter(std::string_view name, int pe, double value) {
   PR_CHECK(pe >= 0 && pe < options_.pes, "counter '" + std::string(name) + "' names PE " + std::to_string(pe));
   std::lock_guard<std::mutex> lock(counterMutex_);
@@ -458,11 +463,16 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
     r.schedulingBytesBetweenRanks = c.schedulingBytesBetweenRanks.load();
     const bool firstOfRank = p % localPes_ == 0, firstOfOtherRank = firstOfRank && p / localPes_ != 0;
     using To = PendingBroadcast::To;
-    for (const PendingBroadcast& b : pendingBroadcasts_)
-      if (b.to == To::OtherRanksFirstPe ? firstOfOtherRank : b.to == To::WithinRanks ? !firstOfRank : b.root != p) {
+    for (const PendingBroadcast& b : pendingBroadcasts_) {
+      const bool within = b.to == To::WithinRanks || b.to == To::WithinRanksReplicated;
+      if (b.to == To::OtherRanksFirstPe ? firstOfOtherRank : within ? !firstOfRank : b.root != p) {
         r.broadcastsReceived += 1;
         r.broadcastBytesReceived += b.bytes;
+      } else if (b.to == To::WithinRanksReplicated && firstOfOtherRank) {
+        r.replicatedCopies += 1;
+        r.replicatedBytes += b.bytes;
       }
+    }
     r.cacheHits = c.cacheHits.load();
     r.cacheMisses = c.cacheMisses.load();
     r.prefetches = c.prefetches.load();

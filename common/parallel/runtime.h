@@ -180,11 +180,16 @@ class Runtime {
   // to every other PE: counted as one broadcast message per receiving PE in the next stage run
   // (root receives nothing, so a P = 1 run has no broadcast traffic).
   void recordBroadcast(std::size_t bytes, int root = 0);
-  // Replicated data every rank's first PE holds already - built there from what reached it as a
-  // booked transfer (broadcastToRanks), or replicated work - read by the rank's other PEs: one
-  // broadcast message per receiving PE within each rank, none between ranks. On one rank it is
-  // recordBroadcast: PE 0 holds it, every other PE receives a copy.
+  // Replicated data every rank's first PE received as a booked transfer (broadcastToRanks),
+  // read by the rank's other PEs: one broadcast message per receiving PE within each rank,
+  // none between ranks. On one rank it is recordBroadcast: PE 0 holds it, every other PE
+  // receives a copy.
   void recordBroadcastWithinRanks(std::size_t bytes);
+  // Replicated data every rank made itself (the scene it loaded, a BVH it built from it), read
+  // by the rank's other PEs: booked as recordBroadcastWithinRanks, and on each other rank's
+  // first PE as a replicated copy (PeStageRecord::replicatedBytes), not traffic. So a P = R x T
+  // run books P - 1 copies whatever R: broadcasts within ranks, replicated between them.
+  void recordReplicated(std::size_t bytes);
 
   // Adds value to the named per-PE counter (created at zero for every PE on first use).
   // Thread-safe: callable from tasks, handlers or the controlling thread.
@@ -296,9 +301,10 @@ class Runtime {
   struct PendingBroadcast {
     std::size_t bytes;
     int root;
-    enum class To { EveryPe, OtherRanksFirstPe, WithinRanks };
+    enum class To { EveryPe, OtherRanksFirstPe, WithinRanks, WithinRanksReplicated };
     To to = To::EveryPe;  // every PE but root; each other rank's first PE (broadcastToRanks);
-                          // every PE but its rank's first (recordBroadcastWithinRanks)
+                          // every PE but its rank's first (recordBroadcastWithinRanks); that,
+                          // and each other rank's first PE made its own (recordReplicated)
   };
   std::vector<PendingBroadcast> pendingBroadcasts_;
 

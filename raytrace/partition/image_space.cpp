@@ -53,7 +53,7 @@ class ImageSpacePartition final : public Partition {
     const std::shared_ptr<const Integrator> shared = jobIntegrator(job);
     const Integrator& integrator = *shared;
     std::vector<TileTask> tiles = makeTiles(job);
-    if (!job.sceneResident) rt.recordBroadcastWithinRanks(job.scene.memoryBytes() + bvh.stats().memoryBytes);
+    if (!job.sceneResident) rt.recordReplicated(job.scene.memoryBytes() + bvh.stats().memoryBytes);
     // A pre-pass program gets no cost pre-pass: it would run the program's side effects twice.
     if (job.assembleImage && (par::scheduleNeedsCostEstimates(rt.options().schedule) || job.options.adaptive))
       estimateCosts(job, integrator, bvh, tiles, rt);

@@ -122,7 +122,7 @@ class ObjectFrame {
       if (rt_.rank() == 0)
         assignment_ = ObjectAssignment(
             job_.scene, {pes, maxPieceTriangles_, partitionMargin(job_.scene, job_.camera.position()), replicatedFraction_});
-      shareAssignment(pe);
+      assignmentBytes_ = shareAssignment(pe);
       directory_ = OwnerDirectory(assignment_);
       if (wantsTileAffinity(job_, pes)) probes = affinityProbes(*integrator_, tiles);
     });
@@ -180,7 +180,8 @@ class ObjectFrame {
     // Materials, textures, lights and the owner directory are replicated on every PE, and so
     // are the emitters (area-light sampling); the geometry, the replicated pieces included,
     // reached the PEs as messages (the distribute stage).
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), directory_.bytes());
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), 0);
+    rt_.recordBroadcastWithinRanks(assignmentBytes_);
     rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();
@@ -245,8 +246,8 @@ class ObjectFrame {
 
   // On each rank's first PE in the split stage, across ranks: rank 0's assignment reaches
   // every rank.
-  void shareAssignment(par::Pe& pe) {
-    par::shareEncodedFromRank0(
+  size_t shareAssignment(par::Pe& pe) {
+    return par::shareEncodedFromRank0(
         rt_, pe, [&](par::WireWriter& w) { assignment_.encode(w); },
         [&](par::WireReader& r) {
           assignment_ = ObjectAssignment::decode(r);
@@ -387,7 +388,8 @@ class ObjectFrame {
   uint32_t maxPieceTriangles_;
   double replicatedFraction_;
   ObjectAssignment assignment_;  // and directory_: made in the "split" stage
-  OwnerDirectory directory_;
+  OwnerDirectory directory_;      // derived by every PE's rank from the assignment
+  size_t assignmentBytes_ = 0;    // the assignment's encoding: what PE 0 shares
   std::shared_ptr<const Integrator> integrator_;  // shade: one call per hit message handled
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;

@@ -108,7 +108,7 @@ class ObjectSpaceFrame {
         owners_ = assignVoxelOwners(split_, pes, kBuildSamplesPerTriangle);
         if (wantsTileAffinity(job_, pes)) preferred = firstOwners(tiles);
       }
-      shareSplit(pe, preferred);
+      splitBytes_ = shareSplit(pe, preferred);
     });
     // Each owner's triangles leave PE 0 as messages; an owner builds from what it received.
     received_ = scene::sendPrimitiveShares(rt_, job_.scene, job_.stage("distribute"), [this](int p) { return trianglesOf(p); });
@@ -124,7 +124,8 @@ class ObjectSpaceFrame {
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), split_.treeBytes() + owners_.size() * sizeof(int));
+    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), 0);
+    rt_.recordBroadcastWithinRanks(splitBytes_);
     rt_.runStage(job_.stage("trace"), tasks, [this](par::Pe& pe) { buildOwnBvh(pe); }, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;
@@ -175,8 +176,8 @@ class ObjectSpaceFrame {
 
   // On each rank's first PE in the split stage, across ranks: rank 0's split, voxel owners and
   // the tiles' preferred PEs reach every rank.
-  void shareSplit(par::Pe& pe, std::vector<int>& preferred) {
-    par::shareEncodedFromRank0(
+  size_t shareSplit(par::Pe& pe, std::vector<int>& preferred) {
+    return par::shareEncodedFromRank0(
         rt_, pe,
         [&](par::WireWriter& w) {
           split_.encode(w);
@@ -377,6 +378,7 @@ class ObjectSpaceFrame {
   int voxelsPerPe_;
   VoxelSplit split_;  // and owners_: made in the "split" stage
   std::vector<int> owners_;
+  size_t splitBytes_ = 0;  // their encoding, with the tiles' preferred PEs: what PE 0 shares
   std::vector<std::unique_ptr<Film>> films_;  // per PE: what it shaded; the assembler's is the image
   std::vector<Bvh> bvhs_;                    // per PE, over its voxels' triangles and the emitters
   std::vector<std::vector<uint32_t>> held_;  // per PE: those triangles, ascending

@@ -64,16 +64,18 @@ inline uint64_t emitterBytes(const LightSampler& lights) {
   return lights.emitters().size() * kTriangleVertexBytes + lights.tableBytes();
 }
 
-// Counts what every PE of a partitioned tracer holds a copy of as one broadcast per PE: the
-// shading data, the emitters and the routing directory (directoryBytes: kd tree and voxel
-// owners, or piece bounds and owners). Called between stages, before the trace stage. Across
-// ranks each rank's first PE holds them already (the shading data and emitters from the scene
-// it loaded, the directory from what rank 0 sent it, booked there): booked within the ranks.
+// Counts what every PE of a partitioned tracer holds a copy of, one broadcast per PE: the
+// shading data and the emitters, with madeByEveryRank bytes of routing data every rank derives
+// itself (an item directory), from the scene every rank loads (Runtime::recordReplicated:
+// across ranks each rank made its own). Called between stages, before the trace stage. What
+// PE 0 makes and shares (the encoded voxel split or piece assignment, shareEncodedFromRank0)
+// its caller books: between ranks it travelled, booked there, and each rank's other PEs read
+// it (Runtime::recordBroadcastWithinRanks), at every trace, the scene resident or not.
 inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const LightSampler& lights,
-                                 uint64_t directoryBytes) {
+                                 uint64_t madeByEveryRank) {
   const uint64_t emitters = emitterBytes(lights);
   for (int p = 0; p < rt.pes(); ++p) rt.addCounter("Partition/emitter_bytes", p, double(emitters));
-  rt.recordBroadcastWithinRanks(shadingDataBytes(s) + emitters + directoryBytes);
+  rt.recordReplicated(shadingDataBytes(s) + emitters + madeByEveryRank);
 }
 
 // Counts the rays a camera-ray task starts by kind, as the world-model loop counts the rays it

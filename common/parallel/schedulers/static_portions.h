@@ -1,5 +1,8 @@
 // StaticPortionScheduler: the data-driven models' common mechanics — every PE's portion is
-// fixed in reset() and sent as one task packet on the PE's first request (seed 3.2.1, 3.4.1).
+// fixed in reset() before the computation starts (seed 3.2.1, 3.4.1), a pure function of the
+// task set and P that every PE holds, so each PE takes its own portion where it is: no task
+// request or packet travels, on threads, across ranks or in the simulator (what the seed's
+// initial distribution moves is the principal data, which the methods' own stages carry).
 // balanced.cpp, unbalanced.cpp and owner_pinned.cpp differ only in the split they pass in.
 #pragma once
 
@@ -29,8 +32,8 @@ class StaticPortionScheduler : public Scheduler {
     if (sent_[pe] || portions_[pe].empty()) return;
     sent_[pe] = 1;
     out.tasks = portions_[pe];
-    out.packets = 1;  // sent by the controller unprompted: no request
-    out.moved = out.tasks.size();
+    out.from = pe;  // its own portion: nothing is asked or sent
+    out.blocking = false;
   }
 
  private:

@@ -75,9 +75,10 @@ TEST_CASE("GatherToRoot: gatherToAll gives every rank every PE's list, by source
   for (int r = 0; r < kRanks; ++r) CHECK(got[size_t(r)] == expected);
 }
 
-// shareWrittenAcrossRanks: each rank wrote the values of the tasks its PEs ran (here: index i
-// on rank i mod R, the others left at -1); afterwards every rank holds every value. On one
-// rank nothing moves and nothing is counted.
+// shareWrittenValues: each rank wrote the values of the tasks its PEs ran (here: index i on
+// rank i mod R, the others left at -1); afterwards every rank holds every value. On one rank
+// the values are in place, and the record books what a run across ranks sends: each PE's
+// values to PE 0 as one message, and their broadcast to every other PE.
 TEST_CASE("GatherToRoot: values written where their tasks ran reach every rank") {
   constexpr int kRanks = 3, kThreads = 1, kValues = 17;
   std::vector<std::vector<double>> got(kRanks);
@@ -85,16 +86,27 @@ TEST_CASE("GatherToRoot: values written where their tasks ran reach every rank")
     std::vector<double> values(kValues, -1.0);
     for (int i = 0; i < kValues; ++i)
       if (i % kRanks == rt.rank()) values[size_t(i)] = 0.5 * i;
-    par::shareWrittenAcrossRanks(rt, "share", "values", values,
-                                 [&](std::size_t i) { return int(i) % kRanks == rt.rank(); });
+    par::shareWrittenValues(rt, "share", "values", values,
+                            [&](std::size_t i) { return int(i) % kRanks == rt.rank() ? rt.firstLocalPe() : -1; });
     got[size_t(rt.rank())] = values;
   });
   for (const std::string& e : errors) CHECK(e == "");
   for (int r = 0; r < kRanks; ++r)
     for (int i = 0; i < kValues; ++i) CHECK(got[size_t(r)][size_t(i)] == 0.5 * i);
   par::Runtime one(2, "demand");
-  std::vector<double> values{1.0, 2.0};
-  par::shareWrittenAcrossRanks(one, "share", "values", values, [](std::size_t) { return true; });
-  CHECK(values == std::vector<double>{1.0, 2.0});
-  CHECK(one.record().stages.empty());
+  std::vector<double> values{1.0, 2.0, 3.0};
+  par::shareWrittenValues(one, "share", "values", values, [](std::size_t i) { return int(i % 2); });
+  CHECK(values == std::vector<double>{1.0, 2.0, 3.0});
+  one.runOnEachPe("after", [](par::Pe&) {});  // where the broadcast is booked
+  const par::RunRecord& r = one.record();
+  REQUIRE(r.stages.size() == 2);
+  CHECK(r.stages[0].pes[1].messagesSent == 1);  // index 1, from PE 1
+  CHECK(r.stages[0].pes[1].bytesSent == 16);  // one (index, value): the items a gathered list counts
+  CHECK(r.stages[0].pes[0].messagesSent == 0);
+  CHECK(r.stages[1].pes[1].broadcastsReceived == 1);
+  CHECK(r.stages[1].pes[1].broadcastBytesReceived == 2 * 8 + 3 * 16);  // two lists: counts, entries
+  CHECK(r.stages[1].pes[0].broadcastsReceived == 0);
+  par::Runtime single(1, "demand");
+  par::shareWrittenValues(single, "share", "values", values, [](std::size_t) { return 0; });
+  CHECK(single.record().stages.empty());
 }

@@ -68,8 +68,10 @@ TEST_CASE("Simulator: data messages a task sent are charged to the sender") {
   options.network = NetworkModel{"t", 0.25, 1000.0, ""};
   options.params.grain = 2;
   const RunRecord r = simulate(w, "balanced", options);
-  // One static packet (1 message, 16 + 2 * 8 bytes), then task 0 pays 2 * 0.25 + 1000 / 1000.
-  CHECK(r.wallSeconds == doctest::Approx(0.25 + 32.0 / 1000.0 + 1.0 + 1.5 + 1.0));
+  // The PE takes its static portion where it is (nothing sent), then task 0 pays 2 * 0.25 +
+  // 1000 / 1000 for its messages.
+  CHECK(r.wallSeconds == doctest::Approx(1.0 + 1.5 + 1.0));
+  CHECK(r.stages[0].pes[0].schedulingMessages == 0);
   CHECK(r.stages[0].pes[0].messagesSent == 2);
   CHECK(r.stages[0].pes[0].bytesSent == 1000);
 }
@@ -115,10 +117,9 @@ TEST_CASE("Simulator: message-handler time is charged on its PE with its sends")
   options.network = NetworkModel{"t", 0.25, 1000.0, ""};
   options.recordTimeline = true;
   const RunRecord r = simulate(w, "", options);
-  // Each PE waits for its static packet (0.25 s + 24 bytes / 1000 B/s), runs its 1 s task; then
-  // PE 0 handles its message (2 s) and pays for the one it sends (0.25 s + 1000 / 1000 s).
-  const double packet = 0.25 + 24.0 / 1000.0;
-  CHECK(r.wallSeconds == doctest::Approx(packet + 1.0 + 2.0 + 1.25));
+  // Each PE takes its static portion (no message), runs its 1 s task; then PE 0 handles its
+  // message (2 s) and pays for the one it sends (0.25 s + 1000 / 1000 s).
+  CHECK(r.wallSeconds == doctest::Approx(1.0 + 2.0 + 1.25));
   CHECK(r.stages[0].pes[0].busySeconds == doctest::Approx(1.0 + 2.0 + 1.25));
   CHECK(r.stages[0].pes[0].messagesHandled == 1);
   CHECK(r.stages[0].pes[0].messagesSent == 1);
@@ -172,8 +173,8 @@ TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at
 
 TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arrived") {
   // 1 MB of scene from PE 0, which holds it, to each of the 3 other PEs at 1 ms + 1e6 / 12.5e6 s
-  // = 81 ms per copy, sent one after another: PE p has it at p x 81 ms. PE 3 then waits for its
-  // task packet (1 ms + 24 bytes / 12.5 MB/s) and runs its 1 s task.
+  // = 81 ms per copy, sent one after another: PE p has it at p x 81 ms. PE 3 then runs its 1 s
+  // task, its static portion taken where it is.
   pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
   w.stages[0].broadcasts = 1;
   w.stages[0].broadcastBytes = 1000000;
@@ -182,7 +183,7 @@ TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arr
   options.network = networkByName("100mbit");
   const RunRecord r = simulate(w, "balanced", options);
   const double copy = 1e-3 + 1e6 / 12.5e6;
-  CHECK(r.wallSeconds == doctest::Approx(3 * copy + 1e-3 + 24.0 / 12.5e6 + 1.0));
+  CHECK(r.wallSeconds == doctest::Approx(3 * copy + 1.0));
   CHECK(r.stages[0].pes[3].messageWaitSeconds == doctest::Approx(3 * copy));
   CHECK(r.stages[0].pes[1].messageWaitSeconds == doctest::Approx(copy));
   CHECK(r.stages[0].pes[2].broadcastBytesReceived == 1000000);
