@@ -171,6 +171,16 @@ void run(RenderArgs& a) {
         separator = ", ";
       }
       std::printf("; within ranks: the rest\n");
+      // What one process would book as broadcasts to these PEs and each rank made itself.
+      std::uint64_t copies = 0, bytes = 0;
+      for (const par::StageRecord& s : runtime.record().stages)
+        for (const par::PeStageRecord& pe : s.pes) {
+          copies += pe.replicatedCopies;
+          bytes += pe.replicatedBytes;
+        }
+      if (copies > 0)
+        std::printf("replicated on the other ranks (loaded or built there, not sent): %llu copies (%llu bytes)\n",
+                    (unsigned long long)copies, (unsigned long long)bytes);
     }
   }
 }

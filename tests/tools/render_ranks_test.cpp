@@ -331,6 +331,7 @@ TEST_CASE("RenderRanks: the record splits every kind of traffic into what crosse
                                    "--tile-size 8 --quiet"});
   const auto [printed, r] = renderRecord(common, 2, 2, dir, "ranks");
   CHECK(printed.find("between ranks: ") != std::string::npos);
+  CHECK(printed.find("replicated on the other ranks (loaded or built there, not sent): 1 copies") != std::string::npos);
   REQUIRE(r.ranks == 2);
   REQUIRE(r.pes == 4);
   const auto rankOf = [](int pe) { return pe / 2; };
