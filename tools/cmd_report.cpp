@@ -21,6 +21,7 @@
 #include "common/parallel/simulator.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
+#include "common/util/interrupt.h"
 #include "tools/commands.h"
 #include "tools/compare/comparison.h"
 #include "tools/report/classification.h"
@@ -131,6 +132,11 @@ void run(ReportArgs& a) {
       if (std::filesystem::path(a.scenes[i]).stem() == std::filesystem::path(a.scenes[j]).stem())
         throw InputError("scenes " + a.scenes[j] + " and " + a.scenes[i] + " share the name of their report folder");
   std::filesystem::path out, fresh, old;
+  // The new report's folder while it fills: an interrupt removes it (interrupt.h).
+  struct FolderSlot {
+    int slot = -1;
+    ~FolderSlot() { unregisterTemporary(slot); }
+  } freshSlot;
   group.onRank0Alone("rank 0's preparation of the report's folder", [&] {
     out = std::filesystem::absolute(a.output).lexically_normal();
     if (!out.has_filename()) out = out.parent_path();  // "report/" or "."
@@ -152,6 +158,7 @@ void run(ReportArgs& a) {
     old = parent / ("." + out.filename().string() + ".old-" + pid);
     std::filesystem::remove_all(fresh);
     std::filesystem::remove_all(old);
+    freshSlot.slot = registerTemporaryFolder(fresh.c_str());
     try {
       image::imageCodec();  // opened before the first timed render, never beside it
       prepare(fresh);

@@ -1,6 +1,9 @@
 #include "common/util/interrupt.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <signal.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <atomic>
@@ -17,23 +20,68 @@ struct Slot {
   std::atomic<bool> claimed{false};
   std::atomic<unsigned> generation{0};
   std::atomic<bool> used{false};
+  std::atomic<bool> folder{false};
   char path[4096] = {};
 };
 static_assert(std::atomic<unsigned>::is_always_lock_free && std::atomic<bool>::is_always_lock_free,
               "the handler needs lock-free atomics");
 Slot gSlots[kMaxTemporaries];
 
-// Async-signal-safe only: atomics, memcpy, unlink, write, _exit.
+// Removes what folder `dir` (open) holds, and the folders in it down to `depth` more levels,
+// then closes it. Async-signal-safe: raw getdents64, openat, unlinkat, lseek, close, and a
+// buffer on the stack; reading again from the start after each batch, since removing entries
+// while reading on may skip some.
+void removeContents(int dir, int depth) {
+  struct Entry {
+    unsigned long long ino;
+    long long off;
+    unsigned short reclen;
+    unsigned char type;
+    char name[1];
+  };
+  alignas(8) char buffer[2048];
+  for (;;) {
+    ::lseek(dir, 0, SEEK_SET);
+    const long n = ::syscall(SYS_getdents64, dir, buffer, sizeof buffer);
+    if (n <= 0) break;
+    bool removed = false;
+    for (long at = 0; at < n;) {
+      const Entry* e = reinterpret_cast<const Entry*>(buffer + at);
+      at += e->reclen;
+      if (e->name[0] == '.' && (e->name[1] == '\0' || (e->name[1] == '.' && e->name[2] == '\0'))) continue;
+      if (e->type == DT_DIR) {
+        if (depth > 0) {
+          const int sub = ::openat(dir, e->name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+          if (sub >= 0) removeContents(sub, depth - 1);
+        }
+        removed |= ::unlinkat(dir, e->name, AT_REMOVEDIR) == 0;
+      } else {
+        removed |= ::unlinkat(dir, e->name, 0) == 0;
+      }
+    }
+    if (!removed) break;  // only what cannot be removed is left
+  }
+  ::close(dir);
+}
+
+// Async-signal-safe only: atomics, memcpy, unlink, the system calls above, write, _exit.
 extern "C" void onInterrupt(int signal) {
   char copy[sizeof gSlots[0].path];
   for (Slot& slot : gSlots) {
     const unsigned before = slot.generation.load(std::memory_order_acquire);
     if ((before & 1u) || !slot.used.load(std::memory_order_acquire)) continue;
     std::memcpy(copy, slot.path, sizeof copy);
+    const bool folder = slot.folder.load(std::memory_order_relaxed);
     std::atomic_thread_fence(std::memory_order_acquire);
     if (slot.generation.load(std::memory_order_relaxed) != before) continue;
     copy[sizeof copy - 1] = '\0';
-    ::unlink(copy);
+    if (folder) {
+      const int dir = ::open(copy, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+      if (dir >= 0) removeContents(dir, kMaxFolderDepth);
+      ::rmdir(copy);
+    } else {
+      ::unlink(copy);
+    }
   }
   static const char kMessage[] = "\nparrender: interrupted; outputs in progress removed\n";
   ssize_t ignored = ::write(STDERR_FILENO, kMessage, sizeof kMessage - 1);
@@ -55,7 +103,9 @@ void installInterruptHandler() {
   }
 }
 
-int registerTemporary(const char* path) {
+namespace {
+
+int claimSlot(const char* path, bool folder) {
   const size_t length = std::strlen(path);
   if (length >= sizeof gSlots[0].path) return -1;
   for (int i = 0; i < kMaxTemporaries; ++i) {
@@ -64,12 +114,19 @@ int registerTemporary(const char* path) {
     Slot& slot = gSlots[i];
     slot.generation.fetch_add(1, std::memory_order_acq_rel);  // odd: writing
     std::memcpy(slot.path, path, length + 1);
+    slot.folder.store(folder, std::memory_order_relaxed);
     slot.generation.fetch_add(1, std::memory_order_release);  // even: complete
     slot.used.store(true, std::memory_order_release);
     return i;
   }
   return -1;
 }
+
+}  // namespace
+
+int registerTemporary(const char* path) { return claimSlot(path, false); }
+
+int registerTemporaryFolder(const char* path) { return claimSlot(path, true); }
 
 void unregisterTemporary(int slot) {
   if (slot < 0 || slot >= kMaxTemporaries) return;

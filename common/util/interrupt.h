@@ -13,9 +13,12 @@ void installInterruptHandler();
 
 // The temporaries the handler removes: at most kMaxTemporaries at once, paths up to 4095
 // bytes; registerTemporary returns a slot (or -1 when none is free or the path is too long:
-// the file is then only removed by its owner).
+// the file is then only removed by its owner). registerTemporaryFolder: a folder being filled
+// (a report's), removed with everything in it, down to kMaxFolderDepth levels below it.
 inline constexpr int kMaxTemporaries = 16;
+inline constexpr int kMaxFolderDepth = 8;
 int registerTemporary(const char* path);
+int registerTemporaryFolder(const char* path);
 void unregisterTemporary(int slot);
 
 }  // namespace pr

@@ -182,6 +182,34 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   CHECK(colours.size() > 50);
 }
 
+// Interrupted while it renders, the report leaves the earlier one in place and nothing of the
+// new one: its folder, filling beside the earlier one, goes with the interrupt.
+TEST_CASE("Report: an interrupted report leaves the earlier one in place and no half-written folder") {
+  const std::filesystem::path dir = pr::test::scratchDir("report_interrupt");
+  const std::filesystem::path out = dir / "report";
+  std::filesystem::create_directories(out);
+  { std::ofstream(out / "index.html") << "the earlier report"; }
+  { std::ofstream(out / ".parrender-report") << "a report"; }
+  const std::string report = join({quoted(PARRENDER_EXE), " report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"),
+                                   " -o ", quoted(out), " --width 64 --height 64 --threads 1 --repeat 1 --spp 4096 --reference-dir ",
+                                   quoted(dir / "refs")});
+  // Waits (up to 30 s) until the new report's folder has something in it, then interrupts.
+  const std::string script = "timeout 120 " + report + " & p=$!; for i in $(seq 300); do [ -n \"$(ls -A " +
+                             quoted(dir) + "/.report.new-* 2>/dev/null)\" ] && break; sleep 0.1; done; sleep 0.5; "
+                             "kill -INT $p; wait $p; echo status=$?";
+  const std::filesystem::path scriptFile = dir / "interrupt.sh";
+  std::ofstream(scriptFile) << script << "\n";
+  const auto r = runCommand("bash " + quoted(scriptFile));
+  INFO(r.output);
+  CHECK(r.output.find("status=130") != std::string::npos);
+  CHECK(readText(out / "index.html") == "the earlier report");
+  for (const auto& e : std::filesystem::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    CAPTURE(name);
+    CHECK(name.find(".report.") == std::string::npos);  // no new or old folder left beside it
+  }
+}
+
 TEST_CASE("Report: a report that fails leaves the earlier one in place and no half-written folder") {
   const std::filesystem::path dir = pr::test::scratchDir("report_atomic");
   const std::filesystem::path out = dir / "report";

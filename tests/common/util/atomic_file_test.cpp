@@ -59,3 +59,28 @@ TEST_CASE("AtomicFile: SIGINT while a temporary is in flight removes it, keeps t
   CHECK(contents(target) == "earlier good output");
   CHECK(filesIn(dir) == 1);  // the temporary is gone
 }
+
+TEST_CASE("AtomicFile: SIGINT while a temporary folder fills removes it with everything in it") {
+  auto dir = pr::test::scratchDir("atomic_file_interrupt_folder");
+  const auto folder = dir / ".report.new-1";
+  std::filesystem::create_directories(folder / "lib" / "deeper");
+  std::filesystem::create_directories(folder / "scene");
+  for (const auto& f : {folder / "index.html", folder / "lib" / "a.js", folder / "lib" / "deeper" / "b.js", folder / "scene" / "c.png"})
+    std::ofstream(f) << "part";
+  for (int i = 0; i < 300; ++i) std::ofstream(folder / "scene" / ("many" + std::to_string(i) + ".png")) << i;  // several batches
+  std::ofstream(dir / "kept.txt") << "not the folder's";
+  const pid_t child = fork();
+  REQUIRE(child >= 0);
+  if (child == 0) {
+    pr::installInterruptHandler();
+    pr::registerTemporaryFolder(folder.c_str());
+    ::raise(SIGINT);
+    ::_exit(0);  // not reached: the handler exits
+  }
+  int status = 0;
+  REQUIRE(waitpid(child, &status, 0) == child);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(!std::filesystem::exists(folder));
+  CHECK(contents(dir / "kept.txt") == "not the folder's");
+}
