@@ -36,6 +36,22 @@ Bvh Bvh::decode(par::WireReader& r, std::shared_ptr<const AlphaTest> alpha) {
   bvh.nodes_ = r.sequence<BvhNode>();
   bvh.leafBlocks_ = r.sequence<BvhLeafBlock>();
   bvh.alpha_ = std::move(alpha);
+  // What another rank sent is traversed as it is: every reference must name a leaf's blocks
+  // inside the leaf array or a node after the one that names it (depth-first order, so no
+  // cycle), or nothing. A reference that does not throws before any traversal reads it.
+  const std::size_t nodes = bvh.nodes_.size(), blocks = bvh.leafBlocks_.size();
+  const auto check = [&](uint32_t ref, std::size_t after) {
+    if (ref == BvhRef::kEmpty) return;
+    if (BvhRef::isLeaf(ref)) {
+      if (std::size_t(BvhRef::leafFirst(ref)) + rt::leafBlocks(BvhRef::leafCount(ref)) > blocks)
+        throw par::WireError("a BVH leaf beyond its leaf blocks");
+    } else if (ref >= nodes || (after < nodes && ref <= after)) {
+      throw par::WireError("a BVH node reference out of order or out of range");
+    }
+  };
+  check(bvh.root_, nodes);
+  for (std::size_t i = 0; i < nodes; ++i)
+    for (uint32_t child : bvh.nodes_[i].child) check(child, i);
   return bvh;
 }
 

@@ -2,6 +2,8 @@
 // loop over all triangles (same t, same triangle, same barycentrics), whatever the tree shape
 // or partitioning; any hit agrees with closest hit; ties and bad rays are handled.
 #include <doctest/doctest.h>
+#include <cstddef>
+#include <cstring>
 
 #include <cmath>
 #include <random>
@@ -264,6 +266,22 @@ TEST_CASE("BvhTraverse: a BVH decoded from its encoding answers every query as t
     hits += want.valid();
   }
   CHECK(hits > 500);
+  // References that would send a traversal out of the arrays or round in a cycle are refused.
+  const std::size_t root = 0;
+  const std::size_t firstChild = sizeof(uint32_t) + sizeof(pr::scene::Bounds) + sizeof(float) + sizeof(pr::rt::BvhStats) +
+                                 sizeof(uint64_t) + offsetof(pr::rt::BvhNode, child);
+  REQUIRE(built.nodes().size() > 1);
+  REQUIRE(!pr::rt::BvhRef::isLeaf(built.root()));
+  const auto decodesWith = [&](std::size_t at, uint32_t ref) {
+    pr::par::Bytes bad = bytes;
+    std::memcpy(bad.data() + at, &ref, sizeof ref);
+    pr::par::WireReader reader(bad);
+    (void)Bvh::decode(reader, nullptr);
+  };
+  CHECK_NOTHROW(decodesWith(firstChild, built.nodes()[0].child[0]));
+  CHECK_THROWS_AS(decodesWith(root, uint32_t(built.nodes().size())), pr::par::WireError);
+  CHECK_THROWS_AS(decodesWith(firstChild, 0u), pr::par::WireError);  // node 0 naming itself
+  CHECK_THROWS_AS(decodesWith(firstChild, pr::rt::BvhRef::leaf(uint32_t(built.leafBlocks().size()), 1)), pr::par::WireError);
   bytes.resize(bytes.size() - 1);
   pr::par::WireReader shortReader(bytes);
   CHECK_THROWS_AS(Bvh::decode(shortReader, nullptr), pr::par::WireError);
