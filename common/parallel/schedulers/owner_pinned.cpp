@@ -1,7 +1,8 @@
 // Owner-pinned scheduling: each task runs on the PE that owns its data (a screen region, a
 // voxel, a PE's own buffers), so the assignment is the data distribution's, not a strategy's.
-// Sent as one task packet per PE on its first request, like the data-driven portions (seed
-// 3.2.1); Runtime::runPinned and runOnEachPe are its users, and the stage record keeps the owners.
+// Each PE takes its own portion where it is, like the data-driven portions (seed 3.2.1; no
+// packet is sent); Runtime::runPinned and runOnEachPe are its users, and the stage record keeps
+// the owners.
 #include <string>
 
 #include "common/parallel/schedulers/scheduler.h"
