@@ -103,24 +103,20 @@ template <class T>
 std::vector<std::vector<T>> gatherToAll(Runtime& rt, std::string_view stage, std::string channel, MessageKind kind,
                                         std::vector<std::vector<T>> perPe, std::size_t bytesPerItem) {
   std::vector<std::vector<T>> out = gatherToRoot(rt, stage, std::move(channel), kind, std::move(perPe), bytesPerItem);
-  if (rt.ranks() == 1) {
-    std::size_t bytes = 0;  // their encoding's size, as below
-    for (const std::vector<T>& list : out) bytes += sizeof(std::uint64_t) + list.size() * sizeof(T);
-    rt.recordBroadcastWithinRanks(bytes);
-    return out;
-  }
-  std::size_t bytes = 0;
-  rt.runOncePerRank(std::string(stage) + " share", [&](Pe& pe) {
-    bytes = shareEncodedFromRank0(
-        rt, pe,
-        [&](WireWriter& w) {
-          for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
-        },
-        [&](WireReader& r) {
-          for (std::vector<T>& list : out) list = r.sequence<T>();
-          if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
-        });
-  });
+  if (rt.ranks() > 1)
+    rt.runOncePerRank(std::string(stage) + " share", [&](Pe& pe) {
+      (void)shareEncodedFromRank0(
+          rt, pe,
+          [&](WireWriter& w) {
+            for (const std::vector<T>& list : out) w.sequence(std::span<const T>(list));
+          },
+          [&](WireReader& r) {
+            for (std::vector<T>& list : out) list = r.sequence<T>();
+            if (r.remaining() != 0) throw WireError("rank 0's gathered lists have bytes left over");
+          });
+    });
+  std::size_t bytes = 0;  // the lists' encoding, as every rank now holds them
+  for (const std::vector<T>& list : out) bytes += sizeof(std::uint64_t) + list.size() * sizeof(T);
   rt.recordBroadcastWithinRanks(bytes);
   return out;
 }

@@ -251,9 +251,8 @@ class CachedImageSpaceFrame {
     FilmAssembly assembly(rt_, film);
     // Materials, textures, lights, the emitters and the item directory (bounds, owner and size
     // of every item) are replicated; the geometry items are not.
-    if (!job_.sceneResident)
-      recordReplicatedData(rt_, job_.scene, integrator_->context().lights(),
-                           directory_.bytes() + specs_.size() * (sizeof(int) + sizeof(uint64_t)));
+    recordReplicatedData(rt_, job_, integrator_->context().lights(),
+                         directory_.bytes() + specs_.size() * (sizeof(int) + sizeof(uint64_t)), 0);
     std::atomic<int64_t> done{0};
     const auto total = int64_t(tiles.size());
     rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {

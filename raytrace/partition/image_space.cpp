@@ -43,8 +43,9 @@ class ImageSpacePartition final : public Partition {
     // task per rank): sending rank 0's instead cost more (the landscape's 86 MB BVH, 2 ranks
     // on the 2-core machine: two builds side by side 0.65-0.82 s, build, encode, send and
     // decode 0.97 s), and builds on R nodes take the same time at any R, where a broadcast
-    // grows with R. Then only each rank's other PEs read its copy: the broadcast is booked
-    // within the ranks. A BVH handed in by the caller (TraceOptions::worldBvh) is not rebuilt:
+    // grows with R. The scene and BVH are booked as a broadcast to each rank's other PEs and as
+    // a replicated copy on each other rank (Runtime::recordReplicated), which one process books
+    // as a broadcast. A BVH handed in by the caller (TraceOptions::worldBvh) is not rebuilt:
     // its build is then outside the record.
     std::unique_ptr<Bvh> built;
     if (!job.options.worldBvh)

@@ -180,8 +180,7 @@ class ObjectFrame {
     // Materials, textures, lights and the owner directory are replicated on every PE, and so
     // are the emitters (area-light sampling); the geometry, the replicated pieces included,
     // reached the PEs as messages (the distribute stage).
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), 0);
-    rt_.recordBroadcastWithinRanks(assignmentBytes_);
+    recordReplicatedData(rt_, job_, integrator_->context().lights(), 0, assignmentBytes_);
     rt_.runStage(job_.stage("trace"), tasks, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       const size_t before = st.start.size();

@@ -124,8 +124,7 @@ class ObjectSpaceFrame {
     rays_ = &rays;
     // Materials, textures, lights and the kd tree with the voxels' owners are replicated on
     // every PE, and so are the emitters (area-light sampling); other geometry is not.
-    if (!job_.sceneResident) recordReplicatedData(rt_, job_.scene, integrator_->context().lights(), 0);
-    rt_.recordBroadcastWithinRanks(splitBytes_);
+    recordReplicatedData(rt_, job_, integrator_->context().lights(), 0, splitBytes_);
     rt_.runStage(job_.stage("trace"), tasks, [this](par::Pe& pe) { buildOwnBvh(pe); }, [&](par::Pe& pe, par::TaskId id) {
       PeState& st = state_[pe.id()];
       std::vector<RayMessage> camera;

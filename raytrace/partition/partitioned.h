@@ -64,18 +64,21 @@ inline uint64_t emitterBytes(const LightSampler& lights) {
   return lights.emitters().size() * kTriangleVertexBytes + lights.tableBytes();
 }
 
-// Counts what every PE of a partitioned tracer holds a copy of, one broadcast per PE: the
-// shading data and the emitters, with madeByEveryRank bytes of routing data every rank derives
-// itself (an item directory), from the scene every rank loads (Runtime::recordReplicated:
-// across ranks each rank made its own). Called between stages, before the trace stage. What
-// PE 0 makes and shares (the encoded voxel split or piece assignment, shareEncodedFromRank0)
-// its caller books: between ranks it travelled, booked there, and each rank's other PEs read
-// it (Runtime::recordBroadcastWithinRanks), at every trace, the scene resident or not.
-inline void recordReplicatedData(par::Runtime& rt, const scene::Scene& s, const LightSampler& lights,
-                                 uint64_t madeByEveryRank) {
-  const uint64_t emitters = emitterBytes(lights);
-  for (int p = 0; p < rt.pes(); ++p) rt.addCounter("Partition/emitter_bytes", p, double(emitters));
-  rt.recordReplicated(shadingDataBytes(s) + emitters + madeByEveryRank);
+// Counts what every PE of a partitioned tracer holds a copy of, one broadcast per PE, called
+// between stages, before the trace stage. Unless the scene is resident from an earlier trace:
+// the shading data and the emitters, with madeByEveryRank bytes of routing data every rank
+// derives itself (an item directory), from the scene every rank loads (Runtime::recordReplicated:
+// across ranks each rank made its own). At every trace: sharedBytes that PE 0 made and shared
+// (the encoded voxel split or piece assignment, shareEncodedFromRank0; between ranks it
+// travelled, booked there, and each rank's other PEs read it: recordBroadcastWithinRanks).
+inline void recordReplicatedData(par::Runtime& rt, const TraceJob& job, const LightSampler& lights,
+                                 uint64_t madeByEveryRank, uint64_t sharedBytes) {
+  if (!job.sceneResident) {
+    const uint64_t emitters = emitterBytes(lights);
+    for (int p = 0; p < rt.pes(); ++p) rt.addCounter("Partition/emitter_bytes", p, double(emitters));
+    rt.recordReplicated(shadingDataBytes(job.scene) + emitters + madeByEveryRank);
+  }
+  if (sharedBytes > 0) rt.recordBroadcastWithinRanks(sharedBytes);
 }
 
 // Counts the rays a camera-ray task starts by kind, as the world-model loop counts the rays it

@@ -182,14 +182,24 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   CHECK(colours.size() > 50);
 }
 
-// Interrupted while it renders, the report leaves the earlier one in place and nothing of the
-// new one: its folder, filling beside the earlier one, goes with the interrupt.
-TEST_CASE("Report: an interrupted report leaves the earlier one in place and no half-written folder") {
-  const std::filesystem::path dir = pr::test::scratchDir("report_interrupt");
+namespace {
+
+// An earlier report in dir/report (its page and marker), which a new one is to replace.
+std::filesystem::path earlierReport(const std::filesystem::path& dir) {
   const std::filesystem::path out = dir / "report";
   std::filesystem::create_directories(out);
   { std::ofstream(out / "index.html") << "the earlier report"; }
   { std::ofstream(out / ".parrender-report") << "a report"; }
+  return out;
+}
+
+}  // namespace
+
+// Interrupted while it renders, the report leaves the earlier one in place and nothing of the
+// new one: its folder, filling beside the earlier one, goes with the interrupt.
+TEST_CASE("Report: an interrupted report leaves the earlier one in place and no half-written folder") {
+  const std::filesystem::path dir = pr::test::scratchDir("report_interrupt");
+  const std::filesystem::path out = earlierReport(dir);
   const std::string report = join({quoted(PARRENDER_EXE), " report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"),
                                    " -o ", quoted(out), " --width 64 --height 64 --threads 1 --repeat 1 --spp 4096 --reference-dir ",
                                    quoted(dir / "refs")});
@@ -212,10 +222,7 @@ TEST_CASE("Report: an interrupted report leaves the earlier one in place and no 
 
 TEST_CASE("Report: a report that fails leaves the earlier one in place and no half-written folder") {
   const std::filesystem::path dir = pr::test::scratchDir("report_atomic");
-  const std::filesystem::path out = dir / "report";
-  std::filesystem::create_directories(out);
-  { std::ofstream(out / "index.html") << "the earlier report"; }
-  { std::ofstream(out / ".parrender-report") << "a report"; }
+  const std::filesystem::path out = earlierReport(dir);
   const std::string args = join({"report ", quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"), " -o ", quoted(out),
                                  " --width 8 --height 8 --threads 1 --repeat 1"});
   const auto failed = runCommand(join({"PARRENDER_REPORT_SCRIPTS=", quoted(dir / "nowhere"), " \"", PARRENDER_EXE, "\" ", args}));

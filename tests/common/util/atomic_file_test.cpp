@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <fstream>
+#include <functional>
 #include <iterator>
 
 #include "common/util/atomic_file.h"
@@ -19,6 +20,21 @@ std::string contents(const std::filesystem::path& path) {
 }
 size_t filesIn(const std::filesystem::path& dir) {
   return size_t(std::distance(std::filesystem::directory_iterator(dir), std::filesystem::directory_iterator()));
+}
+// The exit status of a child process that installs the interrupt handler, runs setUp (which
+// registers what is in flight) and raises SIGINT; -1 if it did not exit.
+int exitStatusAfterSigint(const std::function<void()>& setUp) {
+  const pid_t child = fork();
+  if (child < 0) return -1;
+  if (child == 0) {
+    pr::installInterruptHandler();
+    setUp();
+    ::raise(SIGINT);
+    ::_exit(0);  // not reached: the handler exits
+  }
+  int status = 0;
+  if (waitpid(child, &status, 0) != child || !WIFEXITED(status)) return -1;
+  return WEXITSTATUS(status);
 }
 }  // namespace
 
@@ -43,19 +59,11 @@ TEST_CASE("AtomicFile: SIGINT while a temporary is in flight removes it, keeps t
   auto dir = pr::test::scratchDir("atomic_file_interrupt");
   const auto target = dir / "out.png";
   pr::writeFileAtomically(target, "earlier good output");
-  const pid_t child = fork();
-  REQUIRE(child >= 0);
-  if (child == 0) {
-    pr::installInterruptHandler();
-    pr::TempFile temp(target, "image file");
-    std::ofstream(temp.path()) << "half written";
-    ::raise(SIGINT);
-    ::_exit(0);  // not reached: the handler exits
-  }
-  int status = 0;
-  REQUIRE(waitpid(child, &status, 0) == child);
-  REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(exitStatusAfterSigint([&] {
+          pr::TempFile temp(target, "image file");
+          std::ofstream(temp.path()) << "half written";
+          ::raise(SIGINT);  // while temp is in flight
+        }) == 130);
   CHECK(contents(target) == "earlier good output");
   CHECK(filesIn(dir) == 1);  // the temporary is gone
 }
@@ -69,18 +77,7 @@ TEST_CASE("AtomicFile: SIGINT while a temporary folder fills removes it with eve
     std::ofstream(f) << "part";
   for (int i = 0; i < 300; ++i) std::ofstream(folder / "scene" / ("many" + std::to_string(i) + ".png")) << i;  // several batches
   std::ofstream(dir / "kept.txt") << "not the folder's";
-  const pid_t child = fork();
-  REQUIRE(child >= 0);
-  if (child == 0) {
-    pr::installInterruptHandler();
-    pr::registerTemporaryFolder(folder.c_str());
-    ::raise(SIGINT);
-    ::_exit(0);  // not reached: the handler exits
-  }
-  int status = 0;
-  REQUIRE(waitpid(child, &status, 0) == child);
-  REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 130);
+  CHECK(exitStatusAfterSigint([&] { pr::registerTemporaryFolder(folder.c_str()); }) == 130);
   CHECK(!std::filesystem::exists(folder));
   CHECK(contents(dir / "kept.txt") == "not the folder's");
 }
