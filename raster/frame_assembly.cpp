@@ -15,20 +15,22 @@ void Wire<raster::RegionFramebuffer>::encode(const raster::RegionFramebuffer& b,
   w.raw(b.colours(), pixels * sizeof(glm::vec3));
 }
 
-raster::RegionFramebuffer Wire<raster::RegionFramebuffer>::decode(WireReader& r) {
-  const raster::Rect rect = r.value<raster::Rect>();
-  if (rect.width() < 0 || rect.height() < 0) throw WireError("a region message names an inverted rectangle");
-  const size_t pixels = static_cast<size_t>(rect.area());
-  if (pixels > r.remaining() / raster::kRegionPixelBytes) throw WireError("a region message is shorter than its rectangle");
-  raster::RegionFramebuffer b(rect);
-  r.raw(b.keys(), pixels * sizeof(uint64_t));
-  r.raw(b.colours(), pixels * sizeof(glm::vec3));
-  return b;
-}
+raster::RegionFramebuffer Wire<raster::RegionFramebuffer>::decode(WireReader& r) { return raster::decodeRegion(r, nullptr); }
 
 }  // namespace pr::par
 
 namespace pr::raster {
+
+RegionFramebuffer decodeRegion(par::WireReader& r, RegionBufferPool* pool) {
+  const Rect rect = r.value<Rect>();
+  if (rect.width() < 0 || rect.height() < 0) throw par::WireError("a region message names an inverted rectangle");
+  const size_t pixels = static_cast<size_t>(rect.area());
+  if (pixels > r.remaining() / kRegionPixelBytes) throw par::WireError("a region message is shorter than its rectangle");
+  RegionFramebuffer b = pool ? pool->take(rect) : RegionFramebuffer(rect);
+  r.raw(b.keys(), pixels * sizeof(uint64_t));
+  r.raw(b.colours(), pixels * sizeof(glm::vec3));
+  return b;
+}
 
 RegionFramebuffer RegionBufferPool::take(const Rect& rect) {
   RegionFramebuffer buffer;
@@ -53,7 +55,12 @@ FrameAssembly::FrameAssembly(par::Runtime& runtime, RegionFramebuffer& frame, Re
       frame_(frame),
       pool_(pool),
       regions_(runtime, "frame regions", par::MessageKind::Results,
-               [this](par::Pe&, RegionFramebuffer&& region) { store(std::move(region)); }) {}
+               [this](par::Pe&, RegionFramebuffer&& region) { store(std::move(region)); }) {
+  // A region from another rank lands in storage from the pool, where store() puts it back: a
+  // fresh buffer per message would grow the pool by a frame's regions every frame, each one
+  // faulted in page by page (sort-middle at 2 ranks: most of rank 0's time between regions).
+  regions_.decodeWith([this](par::WireReader& r) { return decodeRegion(r, &pool_); });
+}
 
 RegionFramebuffer& FrameAssembly::frame(const par::Pe& pe) {
   PR_CHECK(assembles(pe), "FrameAssembly: PE " + std::to_string(pe.id()) + " asked for the assembler's frame");

@@ -63,6 +63,10 @@ class RegionBufferPool {
   std::vector<RegionFramebuffer> free_;
 };
 
+// Reads a region message: into storage from pool when there is one (its triangle indices
+// unspecified), else into a new buffer. Throws par::WireError on a malformed message.
+RegionFramebuffer decodeRegion(par::WireReader& r, RegionBufferPool* pool);
+
 class FrameAssembly {
  public:
   // frame: the full-screen image the render returns, written by the assembler PE only.

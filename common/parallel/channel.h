@@ -138,8 +138,7 @@ class Channel : public ChannelBase {
   // To a PE on another rank: the message's encoding, behind room for the runtime's header.
   void sendToRank(int from, int to, const T& message, std::size_t counted) {
     if constexpr (HasWire<T>) {
-      Bytes framed;
-      reserveHugePages(framed, Runtime::kFrameBytes + Wire<T>::size(message));
+      Bytes framed = runtime_.sendStorage(Runtime::kFrameBytes + Wire<T>::size(message));
       framed.resize(Runtime::kFrameBytes);
       WireWriter w(framed);
       Wire<T>::encode(message, w);

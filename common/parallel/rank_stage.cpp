@@ -321,6 +321,7 @@ bool Runtime::pumpRankStage() {
   bool progressed = false;
   while (std::optional<Envelope> e = options_.transport->poll(kRuntimeTag)) {
     handleRankMessage(*e);
+    options_.transport->recycle(std::move(e->bytes));  // decoded: its storage serves later messages
     progressed = true;
   }
   const bool passive = outstanding_.finished();

@@ -222,6 +222,8 @@ class Runtime {
   // runtime's header, then the message's encoding. Counted by the caller (countMessage).
   static constexpr std::size_t kFrameBytes = 32;
   void sendToRank(const ChannelBase& channel, int from, int to, Bytes framed, std::size_t counted);
+  // Empty storage with room for a message of `bytes` to another rank (Transport::storage).
+  Bytes sendStorage(std::size_t bytes) { return options_.transport->storage(bytes); }
   // On arrival of a message from another rank: the receiving PE's figures.
   void countReceived(int to, std::size_t bytes);
   OutstandingWork& outstanding() { return outstanding_; }

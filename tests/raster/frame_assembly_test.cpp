@@ -58,6 +58,29 @@ TEST_CASE("FrameAssembly: a region message decodes to the keys and colours it wa
   CHECK_THROWS_AS(par::decodeMessage<RegionFramebuffer>(longer), par::WireError);
 }
 
+// The assembler decodes another rank's region into storage from the sort point's pool, which
+// store() gives back: the pool's buffer comes back holding the message's pixels, and the next
+// region that arrives reuses it rather than growing the pool every frame.
+TEST_CASE("FrameAssembly: a region from another rank is decoded into storage from the pool") {
+  RegionFramebuffer region(Rect{0, 0, 16, 8});
+  for (int i = 0; i < 16 * 8; ++i) {
+    region.keys()[i] = uint64_t(i + 1);
+    region.colours()[i] = glm::vec3(float(i), 0.5f, 1.0f);
+  }
+  const par::Bytes bytes = par::encodeMessage(region);
+  RegionBufferPool pool;
+  RegionFramebuffer storage(Rect{0, 0, 32, 32});
+  const uint64_t* storageKeys = storage.keys();
+  pool.give(std::move(storage));
+  par::WireReader r(bytes);
+  const RegionFramebuffer back = decodeRegion(r, &pool);
+  CHECK(r.remaining() == 0);
+  CHECK(identical(back, region));
+  CHECK(back.keys() == storageKeys);  // the pool's storage, not a new buffer
+  par::WireReader without(bytes);
+  CHECK(identical(decodeRegion(without, nullptr), region));
+}
+
 TEST_CASE("FrameAssembly: at P = 2 on static strips PE 1's region is one message of header + 64*16 pixels") {
   // Strips: PE 0 rows 0..15, PE 1 rows 16..31. Sort-last composites the same strips with
   // direct-send; binary-swap cuts 64 x 32 across its longer side into two 32 x 32 halves, PE 1
