@@ -79,7 +79,7 @@ double broadcastSeconds(const par::RunRecord& predicted, const par::NetworkModel
   double total = 0.0;
   for (const par::StageRecord& s : predicted.stages) {
     const par::PeStageRecord& last = s.pes.back();
-    total += network.broadcastArrival(predicted.pes - 1, last.broadcastsReceived, last.broadcastBytesReceived);
+    total += network.broadcastArrival(predicted.pes - 1, predicted.pes, last.broadcastsReceived, last.broadcastBytesReceived);
   }
   return total;
 }
@@ -162,8 +162,10 @@ void runSimulate(const SimulateArgs& args) {
                 (unsigned long long)(total.messages + total.schedulingMessages),
                 (unsigned long long)(total.bytes + total.schedulingBytes), broadcasts[i]);
   }
-  std::printf("\nbroadcast s: until the last PE has its copy of the replicated data (PE 0, which holds it, sends "
-              "the P - 1 copies one after another)\n");
+  std::printf("\nbroadcast s: until the last PE has its copy of the replicated data (%s)\n",
+              network.sharedMedium ? "on the shared medium PE 0, which holds it, sends the P - 1 copies one after another"
+                                   : "MPI's broadcast on a switched network: a binomial tree, or a scatter and an all-gather "
+                                     "for long data on 8 PEs or more");
   std::printf("best P: %d (makespan %.6f s); adding PEs beyond P = %d gains less than %.0f%%\n", table.bestPes,
               points[std::find(all.begin(), all.end(), table.bestPes) - all.begin()].seconds, table.saturationPes,
               par::kSaturationTolerance * 100.0);

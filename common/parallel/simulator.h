@@ -25,23 +25,29 @@ struct NetworkModel {
   double latencySeconds = 0.0;  // per message
   double bytesPerSecond = 0.0;  // 0: infinite bandwidth
   std::string_view description;
+  // One medium that carries one copy at a time (an Ethernet segment on a hub, a bus): the
+  // seed's setting, PVM over one segment. Otherwise the network is switched: disjoint pairs of
+  // PEs exchange messages at the same time.
+  bool sharedMedium = false;
 
   double seconds(std::uint64_t messages, std::uint64_t bytes) const {
     return messages * latencySeconds + (bytesPerSecond > 0.0 ? bytes / bytesPerSecond : 0.0);
   }
   // Replicated data (the scene, a photon map: `messages` messages of `bytes` in all per PE)
-  // reaches PE pe this long after the stage could start: PE 0, which holds it, sends the P - 1
-  // copies one after another, PE 1's first, each paying latency + bytes/bandwidth. One sender on a shared
-  // medium is the seed's setting (PVM over one Ethernet segment, where a tree would not help:
-  // the segment carries one copy at a time); on a switched network a binomial tree would take
-  // ceil(log2 P) steps instead of P, so there this is an upper bound. Task packets are not held
-  // up by the copies (the scheduler is taken to have a link of its own), and a stage lasts until
-  // every PE has its copy, work or not: the data is replicated on all of them.
-  double broadcastArrival(int pe, std::uint64_t messages, std::uint64_t bytes) const {
-    return messages == 0 && bytes == 0 ? 0.0 : pe * seconds(messages, bytes);
-  }
+  // reaches PE pe of `pes` this long after the stage could start, broadcast from PE 0, which
+  // holds it. On a shared medium PE 0 sends the P - 1 copies one after another, PE 1's first.
+  // On a switched network the broadcast is MPI's, as MPICH's MPI_Bcast chooses its algorithm
+  // (Thakur, Rabenseifner and Gropp 2005): a binomial tree for messages under 12 KiB or fewer
+  // than 8 PEs (PE p has the data after bit_width(p) steps of latency + bytes/bandwidth);
+  // otherwise a scatter followed by an all-gather (van de Geijn), by recursive doubling for
+  // messages under 512 KiB on a power-of-two P (2 log2 P latencies), else around a ring
+  // (log2 P + P - 1 latencies), each moving 2 (P - 1) / P of the bytes, every PE done at the
+  // end. Task packets are not held up by the broadcast (the scheduler is taken to have a link
+  // of its own), and a stage lasts until every PE has its copy, work or not.
+  double broadcastArrival(int pe, int pes, std::uint64_t messages, std::uint64_t bytes) const;
 };
-// Presets: zero, shared-memory, 10gbe, 1gbe, 100mbit (a 1990s workstation farm).
+// Presets: zero, shared-memory, 10gbe, 1gbe, 100mbit (switched), 100mbit-shared (a 1990s
+// workstation farm on one Ethernet segment).
 const std::vector<NetworkModel>& networks();
 // Throws pr::InputError naming the unknown network and listing the presets.
 const NetworkModel& networkByName(std::string_view name);

@@ -463,7 +463,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
               " PEs (speed-up " + fmt(last.speedup, "%.3g") + ", efficiency " + fmt(last.efficiency, "%.3f") + ", imbalance " +
               fmt(last.imbalance, "%.2f") + "); best at P = " + std::to_string(bestPoint->pes) + ", " +
               fmt(bestPoint->seconds, "%.4f") + " s. Each PE but PE 0 first receives " + formatBytes(perPeBytes) +
-              " of replicated data, " + fmt(network.broadcastArrival(topP - 1, perPeMessages, perPeBytes), "%.3g") +
+              " of replicated data, " + fmt(network.broadcastArrival(topP - 1, topP, perPeMessages, perPeBytes), "%.3g") +
               " s until the last of " + std::to_string(topP) + " PEs has it; measured at P = " + std::to_string(r.what.pes) + ", " +
               formatBytes(dataBytes) + " of other data between PEs, computation/communication " +
               (r.summary.total.computeToComm >= 0 ? fmt(r.summary.total.computeToComm, "%.1f") : std::string("- (no messages)")) +

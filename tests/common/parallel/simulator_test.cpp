@@ -44,7 +44,7 @@ TEST_CASE("Simulator: slower networks cost more, and zero cost is exact") {
   SimOptions options;
   options.pes = 8;
   double previous = 0.0;
-  for (const char* net : {"zero", "shared-memory", "10gbe", "1gbe", "100mbit"}) {
+  for (const char* net : {"zero", "shared-memory", "10gbe", "1gbe", "100mbit"}) {  // switched, slower and slower
     options.network = networkByName(net);
     const double t = simulate(w, "demand", options).wallSeconds;
     CAPTURE(net);
@@ -171,16 +171,16 @@ TEST_CASE("Simulator: a PE's set-up is replayed before its first task, per PE at
   CHECK(simulate(w, "", options).wallSeconds == doctest::Approx(8.0));
 }
 
-TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arrived") {
+TEST_CASE("Simulator: on a shared medium a PE starts a stage when its copy of the broadcast has arrived") {
   // 1 MB of scene from PE 0, which holds it, to each of the 3 other PEs at 1 ms + 1e6 / 12.5e6 s
-  // = 81 ms per copy, sent one after another: PE p has it at p x 81 ms. PE 3 then runs its 1 s
-  // task, its static portion taken where it is.
+  // = 81 ms per copy, sent one after another on the one segment: PE p has it at p x 81 ms.
+  // PE 3 then runs its 1 s task, its static portion taken where it is.
   pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
   w.stages[0].broadcasts = 1;
   w.stages[0].broadcastBytes = 1000000;
   SimOptions options;
   options.pes = 4;
-  options.network = networkByName("100mbit");
+  options.network = networkByName("100mbit-shared");
   const RunRecord r = simulate(w, "balanced", options);
   const double copy = 1e-3 + 1e6 / 12.5e6;
   CHECK(r.wallSeconds == doctest::Approx(3 * copy + 1.0));
@@ -188,9 +188,42 @@ TEST_CASE("Simulator: a PE starts a stage when its copy of the broadcast has arr
   CHECK(r.stages[0].pes[1].messageWaitSeconds == doctest::Approx(copy));
   CHECK(r.stages[0].pes[2].broadcastBytesReceived == 1000000);
   CHECK(r.stages[0].pes[0].broadcastBytesReceived == 0);  // the root
-  CHECK(options.network.broadcastArrival(1023, 1, 1000000) == doctest::Approx(1023 * copy));
+  CHECK(options.network.broadcastArrival(1023, 1024, 1, 1000000) == doctest::Approx(1023 * copy));
   options.network = networkByName("zero");
   CHECK(simulate(w, "balanced", options).wallSeconds == doctest::Approx(1.0));
+}
+
+// A switched network broadcasts as MPI does: a short message down a binomial tree (PE p has it
+// after bit_width(p) steps, the last of 1024 PEs after log2 1024 = 10), a long one as a scatter
+// and an all-gather, whose bytes do not grow with P (2 (P - 1) / P of them).
+TEST_CASE("Simulator: on a switched network a broadcast is a binomial tree, or a scatter and an all-gather when long") {
+  const NetworkModel& net = networkByName("1gbe");
+  const double hop = 50e-6 + 1000.0 / 125e6;  // 1000 bytes, one message
+  CHECK(net.broadcastArrival(0, 1024, 1, 1000) == 0.0);  // the root holds it
+  CHECK(net.broadcastArrival(1, 1024, 1, 1000) == doctest::Approx(hop));
+  CHECK(net.broadcastArrival(2, 1024, 1, 1000) == doctest::Approx(2 * hop));
+  CHECK(net.broadcastArrival(3, 1024, 1, 1000) == doctest::Approx(2 * hop));
+  CHECK(net.broadcastArrival(1023, 1024, 1, 1000) == doctest::Approx(10 * hop));
+  // Under 8 PEs a long message also goes down the tree: 3 PEs, PE 2 after two steps.
+  CHECK(net.broadcastArrival(2, 3, 1, 1000000) == doctest::Approx(2 * (50e-6 + 1e6 / 125e6)));
+  // 1 MB (long) to 1024 PEs: scatter + ring all-gather, (10 + 1023) latencies and 2 x 1023/1024 MB.
+  const double ring = 1033 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 1e6 / 125e6;
+  CHECK(net.broadcastArrival(1023, 1024, 1, 1000000) == doctest::Approx(ring));
+  CHECK(net.broadcastArrival(1, 1024, 1, 1000000) == doctest::Approx(ring));  // every PE done at the end
+  // 100 KB (medium) to 1024 PEs, a power of two: recursive doubling, 2 x 10 latencies.
+  CHECK(net.broadcastArrival(5, 1024, 1, 100000) ==
+        doctest::Approx(20 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 100000 / 125e6));
+  // The same record replayed: PE 3 of 4 starts after two tree steps, not three copies.
+  pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
+  w.stages[0].broadcasts = 1;
+  w.stages[0].broadcastBytes = 1000000;
+  SimOptions options;
+  options.pes = 4;
+  options.network = networkByName("100mbit");
+  const double step = 1e-3 + 1e6 / 12.5e6;
+  const RunRecord r = simulate(w, "balanced", options);
+  CHECK(r.stages[0].pes[3].messageWaitSeconds == doctest::Approx(2 * step));
+  CHECK(r.wallSeconds == doctest::Approx(2 * step + 1.0));
 }
 
 TEST_CASE("Simulator: broadcasts and the time between stages come from the run record") {
