@@ -321,7 +321,8 @@ bool Runtime::pumpRankStage() {
   bool progressed = false;
   while (std::optional<Envelope> e = options_.transport->poll(kRuntimeTag)) {
     handleRankMessage(*e);
-    options_.transport->recycle(std::move(e->bytes));  // decoded: its storage serves later messages
+    // Decoded (or kept for a later stage, which left nothing here): its storage serves later messages.
+    options_.transport->recycle(std::move(e->bytes));
     progressed = true;
   }
   const bool passive = outstanding_.finished();
@@ -370,7 +371,10 @@ void Runtime::driveRankStage(int stage) {
     rs.replies = 0;
     std::vector<Envelope> early = std::move(rs.early);
     rs.early.clear();
-    for (Envelope& e : early) handleRankMessage(e);
+    for (Envelope& e : early) {
+      handleRankMessage(e);
+      options_.transport->recycle(std::move(e.bytes));
+    }
     rs.pumping.store(true, std::memory_order_release);
   }
 

@@ -38,12 +38,17 @@ struct NetworkModel {
   // holds it. On a shared medium PE 0 sends the P - 1 copies one after another, PE 1's first.
   // On a switched network the broadcast is MPI's, as MPICH's MPI_Bcast chooses its algorithm
   // (Thakur, Rabenseifner and Gropp 2005): a binomial tree for messages under 12 KiB or fewer
-  // than 8 PEs (PE p has the data after bit_width(p) steps of latency + bytes/bandwidth);
-  // otherwise a scatter followed by an all-gather (van de Geijn), by recursive doubling for
-  // messages under 512 KiB on a power-of-two P (2 log2 P latencies), else around a ring
-  // (log2 P + P - 1 latencies), each moving 2 (P - 1) / P of the bytes, every PE done at the
-  // end. Task packets are not held up by the broadcast (the scheduler is taken to have a link
-  // of its own), and a stage lasts until every PE has its copy, work or not.
+  // than 8 PEs (numbered here so that PE p has the data after bit_width(p) steps of latency +
+  // bytes/bandwidth; MPICH serves the farthest subtree first, which changes which PE is early,
+  // not when the last one has it); otherwise a scatter followed by an all-gather (van de
+  // Geijn), by recursive doubling for messages under 512 KiB on a power-of-two P (2 log2 P
+  // latencies), else around a ring (log2 P + P - 1 latencies), each moving 2 (P - 1) / P of
+  // the bytes, every PE done at the end. The algorithm is chosen by the stage's mean message
+  // size (the record keeps a stage's broadcasts as one count and one byte total). This is a
+  // prediction for a program that broadcasts with MPI: the runtime's own broadcastToRanks sends
+  // rank 0's data to each other rank in turn. Task packets are not held up by the broadcast (the
+  // scheduler is taken to have a link of its own), and a stage lasts until every PE has its
+  // copy, work or not.
   double broadcastArrival(int pe, int pes, std::uint64_t messages, std::uint64_t bytes) const;
 };
 // Presets: zero, shared-memory, 10gbe, 1gbe, 100mbit (switched), 100mbit-shared (a 1990s

@@ -137,37 +137,43 @@ class MpiTransport final : public Transport {
     }
   }
 
-  // With mutex_ held: the smallest spare storage with room for `bytes`, else new storage
-  // (whose whole 2 MiB pages are backed by 2 MiB pages when it is large: a fresh 4 KiB page
-  // costs about 12 us on the 2-core development machine).
+  // With mutex_ held: for a message of kSmallestSpare bytes or more, the smallest spare with
+  // room for it and at most twice what new storage would get (a probe never takes a frame's
+  // strip); else new storage, whose whole 2 MiB pages are backed by 2 MiB pages when it is
+  // large (a fresh 4 KiB page costs about 12 us on the 2-core development machine), with room
+  // to spare: a message a little larger than the last (a frame's region as the view moves)
+  // then fits what was kept; pages beyond what is written are never touched.
   Bytes takeSpare(std::size_t bytes) {
-    auto best = spare_.end();
-    for (auto it = spare_.begin(); it != spare_.end(); ++it)
-      if (it->capacity() >= bytes && (best == spare_.end() || it->capacity() < best->capacity())) best = it;
-    if (best != spare_.end()) {
-      Bytes b = std::move(*best);
-      spare_.erase(best);
-      return b;
+    if (bytes >= kSmallestSpare) {
+      const std::size_t most = 2 * std::bit_ceil(bytes);
+      auto best = spare_.end();
+      for (auto it = spare_.begin(); it != spare_.end(); ++it)
+        if (it->capacity() >= bytes && it->capacity() <= most && (best == spare_.end() || it->capacity() < best->capacity()))
+          best = it;
+      if (best != spare_.end()) {
+        Bytes b = std::move(*best);
+        spare_.erase(best);
+        return b;
+      }
     }
-    // Room to spare: a message a little larger than the last (a frame's region as the view
-    // moves) then fits what was kept; pages beyond what is written are never touched.
     Bytes b;
     b.reserve(bytes < kSmallestSpare ? bytes : std::bit_ceil(bytes));
     adviseHugePages(b.data(), b.capacity());
     return b;
   }
 
-  // With mutex_ held: keeps storage for later messages, at most kSpares (the smallest goes).
+  // With mutex_ held: keeps storage for later messages, at most kSpares, the oldest leaving
+  // first. Not what is larger than kLargestSpare: such a message is a one-off (a first
+  // frame's geometry share), not one every frame.
   void keepSpare(Bytes&& bytes) {
-    if (bytes.capacity() < kSmallestSpare) return;
+    if (bytes.capacity() < kSmallestSpare || bytes.capacity() > kLargestSpare) return;
     spare_.push_back(std::move(bytes));
-    if (spare_.size() > kSpares)
-      spare_.erase(std::min_element(spare_.begin(), spare_.end(),
-                                    [](const Bytes& a, const Bytes& b) { return a.capacity() < b.capacity(); }));
+    if (spare_.size() > kSpares) spare_.erase(spare_.begin());
   }
 
   static constexpr std::size_t kSpares = 8;
-  static constexpr std::size_t kSmallestSpare = 64 << 10;  // smaller blocks are cheap to allocate
+  static constexpr std::size_t kSmallestSpare = std::size_t(64) << 10;  // smaller blocks are cheap to allocate
+  static constexpr std::size_t kLargestSpare = std::size_t(32) << 20;
 
   MPI_Comm comm_;
   int rank_ = 0, ranks_ = 1;

@@ -210,9 +210,18 @@ TEST_CASE("Simulator: on a switched network a broadcast is a binomial tree, or a
   const double ring = 1033 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 1e6 / 125e6;
   CHECK(net.broadcastArrival(1023, 1024, 1, 1000000) == doctest::Approx(ring));
   CHECK(net.broadcastArrival(1, 1024, 1, 1000000) == doctest::Approx(ring));  // every PE done at the end
-  // 100 KB (medium) to 1024 PEs, a power of two: recursive doubling, 2 x 10 latencies.
+  // 100 KB (medium) to 1024 PEs, a power of two: recursive doubling, 2 x 10 latencies; to 1000
+  // PEs around the ring, 10 + 999 latencies.
   CHECK(net.broadcastArrival(5, 1024, 1, 100000) ==
         doctest::Approx(20 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 100000 / 125e6));
+  CHECK(net.broadcastArrival(5, 1000, 1, 100000) ==
+        doctest::Approx(1009 * 50e-6 + 2.0 * 999.0 / 1000.0 * 100000 / 125e6));
+  // The thresholds: 12 KiB is no longer short, 512 KiB no longer medium, 8 PEs the first to scatter.
+  CHECK(net.broadcastArrival(1023, 1024, 1, 12287) == doctest::Approx(10 * (50e-6 + 12287 / 125e6)));
+  CHECK(net.broadcastArrival(1023, 1024, 1, 12288) == doctest::Approx(20 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 12288 / 125e6));
+  CHECK(net.broadcastArrival(1, 1024, 1, 524288) == doctest::Approx(1033 * 50e-6 + 2.0 * 1023.0 / 1024.0 * 524288 / 125e6));
+  CHECK(net.broadcastArrival(4, 7, 1, 1000000) == doctest::Approx(3 * (50e-6 + 1e6 / 125e6)));
+  CHECK(net.broadcastArrival(4, 8, 1, 1000000) == doctest::Approx(10 * 50e-6 + 2.0 * 7.0 / 8.0 * 1e6 / 125e6));
   // The same record replayed: PE 3 of 4 starts after two tree steps, not three copies.
   pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
   w.stages[0].broadcasts = 1;
