@@ -33,7 +33,9 @@ class WireWriter {
   // Room for n more bytes, so a large encoding grows its buffer once (in 2 MiB pages where
   // the system has them: a message of megabytes is written once, and first touches of 4 KiB
   // pages cost more than the copy; allocator.h).
+  // Storage that already has the room (a transport's reused buffer) is left as it is.
   void reserve(std::size_t n) {
+    if (out_.capacity() >= out_.size() + n) return;
     out_.reserve(out_.size() + n);
     adviseHugePages(out_.data(), out_.capacity());
   }

@@ -103,6 +103,14 @@ RunRecord handlerRecord() {
                         3.0);
 }
 
+// Four tasks of 1 s each, in a stage whose PEs first receive 1 MB of replicated data in one message.
+pr::par::Workload fourTasksAfterBroadcast() {
+  pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
+  w.stages[0].broadcasts = 1;
+  w.stages[0].broadcastBytes = 1000000;
+  return w;
+}
+
 }  // namespace
 
 TEST_CASE("Simulator: message-handler time is charged on its PE with its sends") {
@@ -175,9 +183,7 @@ TEST_CASE("Simulator: on a shared medium a PE starts a stage when its copy of th
   // 1 MB of scene from PE 0, which holds it, to each of the 3 other PEs at 1 ms + 1e6 / 12.5e6 s
   // = 81 ms per copy, sent one after another on the one segment: PE p has it at p x 81 ms.
   // PE 3 then runs its 1 s task, its static portion taken where it is.
-  pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
-  w.stages[0].broadcasts = 1;
-  w.stages[0].broadcastBytes = 1000000;
+  const pr::par::Workload w = fourTasksAfterBroadcast();
   SimOptions options;
   options.pes = 4;
   options.network = networkByName("100mbit-shared");
@@ -223,9 +229,7 @@ TEST_CASE("Simulator: on a switched network a broadcast is a binomial tree, or a
   CHECK(net.broadcastArrival(4, 7, 1, 1000000) == doctest::Approx(3 * (50e-6 + 1e6 / 125e6)));
   CHECK(net.broadcastArrival(4, 8, 1, 1000000) == doctest::Approx(10 * 50e-6 + 2.0 * 7.0 / 8.0 * 1e6 / 125e6));
   // The same record replayed: PE 3 of 4 starts after two tree steps, not three copies.
-  pr::par::Workload w = pr::test::workloadOf(std::vector<double>(4, 1.0));
-  w.stages[0].broadcasts = 1;
-  w.stages[0].broadcastBytes = 1000000;
+  const pr::par::Workload w = fourTasksAfterBroadcast();
   SimOptions options;
   options.pes = 4;
   options.network = networkByName("100mbit");
