@@ -23,6 +23,7 @@
 #include "common/scene/gltf_loader.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
+#include "tools/farm_render.h"
 #include "tools/lighting.h"
 #include "tools/render_methods.h"
 #include "tools/timed_render.h"
@@ -45,6 +46,7 @@ struct RenderArgs {
   RenderSettings settings;
   FamilyOptions family;
   LightingOptions lighting;
+  FarmArgs farm;
 };
 
 // A progress bar on stderr: appears once a render has run for a second, redrawn when the
@@ -103,6 +105,7 @@ void run(RenderArgs& a) {
   checkFamilyOptions(method, a.family);
   // Under mpirun, --threads is each rank's: P = R x T PEs, and rank 0 writes and prints.
   par::ProcessGroup& group = par::ProcessGroup::get();
+  checkFarm(a.farm, method, a.settings, group.ranks());
   checkAcrossRanks(method, group.ranks());
   const bool writes = holdsResults();
   const Placement where = everyRank(a.threads);
@@ -122,6 +125,21 @@ void run(RenderArgs& a) {
   const std::string lighting = applyLighting(scene, a.lighting);
   const scene::Camera camera = scene::selectCamera(scene, a.camera, float(a.width) / float(a.height));
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
+
+  if (a.farm.enabled) {
+    const par::RunRecord record =
+        renderOnFarm(a.farm, FarmInput{scene, camera, plan, a.width, a.height, a.settings, a.schedule, a.threads}, a.output);
+    if (!writes) return;
+    par::writeRunOutputs(record, a.outputs);
+    std::printf("method %s (%s) as a farm: a master and %d servers x %d PE%s, schedule %s among each server's PEs, %dx%d -> %s\n",
+                a.method.c_str(), std::string(toString(method.properties.family)).c_str(), group.ranks() - 1, a.threads,
+                a.threads == 1 ? "" : "s", a.schedule.schedule.c_str(), a.width, a.height, a.output.c_str());
+    std::printf("%s\n", lighting.c_str());
+    std::printf("effects:\n");
+    for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());
+    printFarmSummary(record);
+    return;
+  }
 
   par::Runtime runtime(par::RuntimeOptions{pes, a.schedule.schedule, a.schedule.params, true,
                                            group.ranks() > 1 ? &group.transport() : nullptr});
@@ -209,6 +227,7 @@ void addRenderCommand(CLI::App& app) {
   addLightingOptions(*cmd, args->lighting);
   addRayOptions(*cmd, args->settings, args->family);
   addRasterOptions(*cmd, args->settings, args->family);
+  addFarmOptions(*cmd, args->farm);
   cmd->callback([args] { run(*args); });
 }
 

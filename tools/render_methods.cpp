@@ -27,7 +27,9 @@ std::string notSimulated(const scene::RenderPlan& plan, scene::EffectSet simulat
   return out;
 }
 
-RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
+}  // namespace
+
+rt::TraceJob rayJobFor(const RenderRequest& r) {
   rt::TraceOptions options;
   options.integrator.effects = r.plan.enabled();
   options.integrator.spp = samplesPerPixel(r.settings.ray);
@@ -52,6 +54,16 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
   photonSettings.view = pm::parsePhotonView(r.settings.ray.view);
   job.integrator = integrators(photonSettings).find(r.settings.ray.integrator).make(
       rt::IntegratorSetup{r.scene, r.camera, r.width, r.height, options.integrator});
+  return job;
+}
+
+namespace {
+
+RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
+  const rt::TraceJob job = rayJobFor(r);
+  const rt::TraceOptions& options = job.options;
+  const bool photonmap = r.settings.ray.integrator == "photonmap";
+  const pm::PhotonView photonView = pm::parsePhotonView(r.settings.ray.view);
   rt::TraceResult result = rt::renderRays(job, name, r.runtime);
   r.runtime.gatherRecord();  // across ranks: rank 0's record becomes the whole run's
   RenderOutcome out;
@@ -95,7 +107,7 @@ RenderOutcome renderRay(std::string_view name, const RenderRequest& r) {
                    std::to_string(total("IrradianceCache/records")) + " from " +
                    std::to_string(total("IrradianceCache/probes")) + " probes, gather hits " +
                    std::to_string(total("IrradianceCache/gather_hits")) +
-                   (photonSettings.view != pm::PhotonView::Full ? "; view " + r.settings.ray.view : "");
+                   (photonView != pm::PhotonView::Full ? "; view " + r.settings.ray.view : "");
   return out;
 }
 

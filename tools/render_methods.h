@@ -91,6 +91,11 @@ struct RenderOutcome {
   std::string effects;   // which of the plan's effects the method simulates, and what it skipped
 };
 
+// The trace job a ray-tracing method renders for the request: its options from the settings
+// and its integrator from the program's registry. Throws pr::InputError for a photon-map option
+// given with another integrator.
+rt::TraceJob rayJobFor(const RenderRequest& request);
+
 // Registry: name -> render function -> description, and the method's family.
 struct MethodProperties {
   MethodFamily family = MethodFamily::Ray;

@@ -22,6 +22,9 @@ namespace {
 
 std::unique_ptr<ProcessGroup> group;
 
+// The verdict's text when a rank was lost: the others leave without MPI_Finalize.
+constexpr const char* kLeaveWithoutFinalize = "leave without finalize";
+
 // A status message: the exit status (4 bytes) and the failure's text.
 Bytes encodeStatus(int status, const std::string& text) {
   Bytes b(sizeof(std::int32_t) + text.size());
@@ -206,8 +209,16 @@ int ProcessGroup::finish(int status, const std::string& error) {
   int run = status;
   if (rank_ != 0) {
     transport_->send(0, kStatusTag, encodeStatus(status, error));
-    std::string ignored;
-    run = decodeStatus(receive(kFinishTag, "rank 0 to end the run").bytes, ignored);
+    std::string ending;
+    run = decodeStatus(receive(kFinishTag, "rank 0 to end the run").bytes, ending);
+    // A rank was lost (markLost): MPI_Finalize could wait for it for ever, and rank 0 ends the
+    // run by abortAll once every other rank has left, so this one leaves without MPI.
+    if (ending == kLeaveWithoutFinalize) {
+      (void)transport_->flush(timeout_);
+      std::fflush(stdout);
+      std::fflush(stderr);
+      std::_Exit(run);
+    }
   } else {
     // The failure to report, printed as soon as it is known (so a later rank that never
     // answers cannot hide it): rank 0's own, else the first to arrive.
@@ -217,8 +228,13 @@ int ProcessGroup::finish(int status, const std::string& error) {
       printFailure(status, 0, ranks_, error);
       reported = true;
     }
-    for (int got = 1; got < ranks_; ++got) {
+    const auto lost = [&](int r) { return r < int(lost_.size()) && lost_[std::size_t(r)]; };
+    int live = 0;
+    for (int r = 1; r < ranks_; ++r) live += lost(r) ? 0 : 1;
+    for (int got = 0; got < live;) {
       const Envelope e = receive(kStatusTag, "every rank's status at the end of the run");
+      if (lost(e.source)) continue;  // a lost rank that woke up: it is not part of the ending
+      ++got;
       std::string theirs;
       const int s = decodeStatus(e.bytes, theirs);
       if (s != 0 && !reported && !theirs.empty()) {
@@ -229,11 +245,25 @@ int ProcessGroup::finish(int status, const std::string& error) {
         run = s;
       }
     }
-    for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, ""));
+    const bool anyLost = live < ranks_ - 1;
+    // A lost rank gets the verdict too: one that woke up then leaves quietly before the abort.
+    for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, anyLost ? kLeaveWithoutFinalize : ""));
+    if (anyLost) {
+      (void)transport_->flush(std::min(timeout_, 10.0));
+      std::fflush(stdout);
+      std::fflush(stderr);
+      transport_->abortAll(run);
+    }
   }
   if (!transport_->flush(timeout_)) transport_->abortAll(run != 0 ? run : 1);
   transport_->finalize();
   return run;
+}
+
+void ProcessGroup::markLost(int rank) {
+  PR_CHECK(rank_ == 0 && rank > 0 && rank < ranks_, "rank 0 marks another rank lost");
+  lost_.resize(std::size_t(ranks_), false);
+  lost_[std::size_t(rank)] = true;
 }
 
 }  // namespace pr::par

@@ -9,6 +9,7 @@
 #include <functional>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "common/parallel/transport.h"
 
@@ -59,11 +60,20 @@ class ProcessGroup {
   // passed with an empty message.
   int finish(int status, const std::string& error);
 
+  // On rank 0: rank `rank` was lost during the run (a farm server that died or stopped
+  // answering, farm/farm.h). finish() then does not wait for its status, and since MPI_Finalize
+  // would wait for ever for a rank that still exists but does not answer, the run ends without
+  // it: the other ranks leave without MPI_Finalize once they have the verdict (a lost rank that
+  // woke up too), and rank 0 ends the job with abortAll(the run's status); under
+  // `mpirun --enable-recovery`, mpirun then exits with that status (0 for a run that completed).
+  void markLost(int rank);
+
  private:
   ProcessGroup() = default;
   int rank_ = 0, ranks_ = 1;
   double timeout_ = 300.0;
   Transport* transport_ = nullptr;
+  std::vector<bool> lost_;  // rank 0: ranks markLost named
 };
 
 // The ranks mpirun started and this process's rank among them, from the environment (before

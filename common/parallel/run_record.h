@@ -6,9 +6,11 @@
 
 #include <cstdint>
 #include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "common/parallel/farm/farm_record.h"
 #include "common/parallel/task.h"
 
 namespace pr::par {
@@ -107,6 +109,8 @@ struct RunRecord {
   std::vector<TaskSpan> timeline;
   std::vector<CounterRecord> counters;  // in the order first recorded
   std::string error;  // the error that ended the run, empty when it completed
+  // A farm run (farm/farm.h): its servers and jobs. Its PEs are then the servers, one per rank.
+  std::optional<FarmRecord> farm;
 };
 
 // Measured cost of every task of stage `stage` (sum of its spans), for an unbalanced

@@ -78,6 +78,31 @@ json peJson(const PeStageRecord& r) {
           {"prefetches", r.prefetches}};
 }
 
+json farmJson(const FarmRecord& f) {
+  json servers = json::array();
+  for (const FarmServerRecord& s : f.servers) {
+    json js = {{"rank", s.rank},
+               {"pes", s.pes},
+               {"prepareSeconds", s.prepareSeconds},
+               {"busySeconds", s.busySeconds},
+               {"idleSeconds", s.idleSeconds},
+               {"jobs", s.jobs},
+               {"lastHeardSeconds", s.lastHeardSeconds},
+               {"lateResults", s.lateResults}};
+    if (s.lost()) {
+      js["lostAtSeconds"] = s.lostAtSeconds;
+      js["handedOn"] = s.handedOn;
+    }
+    servers.push_back(js);
+  }
+  json jobs = json::array();
+  for (const FarmJobRecord& j : f.jobs)
+    jobs.push_back({j.job, j.server, j.sentSeconds, j.doneSeconds, j.busySeconds, j.attempts, j.resultBytes});
+  return {{"schedule", f.schedule},     {"deadlineSeconds", f.deadlineSeconds}, {"jobsAhead", f.jobsAhead},
+          {"jobShape", f.jobShape},     {"wallSeconds", f.wallSeconds},         {"servers", servers},
+          {"jobs", jobs}};  // jobs: [job, server, sentSeconds, doneSeconds, busySeconds, attempts, resultBytes]
+}
+
 json toJson(const RunRecord& record) {
   json j;
   j["pes"] = record.pes;
@@ -135,6 +160,7 @@ json toJson(const RunRecord& record) {
   json counters = json::array();
   for (const CounterRecord& c : record.counters) counters.push_back({{"name", c.name}, {"perPe", c.perPe}});
   j["counters"] = counters;
+  if (record.farm) j["farm"] = farmJson(*record.farm);
   return j;
 }
 
@@ -217,6 +243,55 @@ RunRecord runRecordFromJsonText(const std::string& text, const std::string& orig
 }
 
 namespace {
+
+std::vector<int> intList(const json& j, const char* key, const std::string& origin, const std::string& where) {
+  const json v = j.value(key, json::array());
+  if (!v.is_array()) throw InputError(origin + ": " + where + " \"" + key + "\" must be an array");
+  std::vector<int> out;
+  for (const json& x : v) out.push_back(numberAs<int>(x, origin + ": " + where + " \"" + key + "\""));
+  return out;
+}
+
+FarmRecord parseFarm(const json& jf, const std::string& origin) {
+  const std::string where = "farm";
+  if (!jf.is_object()) throw InputError(origin + ": \"farm\" must be an object");
+  FarmRecord f;
+  f.schedule = jf.value("schedule", std::string());
+  f.deadlineSeconds = optionalField(jf, "deadlineSeconds", 0.0, origin, where);
+  f.jobsAhead = optionalField(jf, "jobsAhead", 1, origin, where);
+  f.jobShape = jf.value("jobShape", std::string());
+  f.wallSeconds = optionalField(jf, "wallSeconds", 0.0, origin, where);
+  for (const json& js : jf.value("servers", json::array())) {
+    const std::string server = where + " server " + std::to_string(f.servers.size());
+    FarmServerRecord s;
+    s.rank = field<int>(js, "rank", origin, server);
+    s.pes = optionalField(js, "pes", 1, origin, server);
+    s.prepareSeconds = optionalField(js, "prepareSeconds", 0.0, origin, server);
+    s.busySeconds = optionalField(js, "busySeconds", 0.0, origin, server);
+    s.idleSeconds = optionalField(js, "idleSeconds", 0.0, origin, server);
+    s.jobs = intList(js, "jobs", origin, server);
+    s.lastHeardSeconds = optionalField(js, "lastHeardSeconds", 0.0, origin, server);
+    s.lateResults = optionalField(js, "lateResults", 0, origin, server);
+    s.lostAtSeconds = optionalField(js, "lostAtSeconds", -1.0, origin, server);
+    s.handedOn = intList(js, "handedOn", origin, server);
+    f.servers.push_back(std::move(s));
+  }
+  for (const json& jj : jf.value("jobs", json::array())) {
+    if (!jj.is_array() || jj.size() != 7)
+      throw InputError(origin + ": a farm job must be [job, server, sentSeconds, doneSeconds, busySeconds, attempts, resultBytes]");
+    const std::string job = origin + ": farm job " + std::to_string(f.jobs.size());
+    FarmJobRecord r;
+    r.job = numberAs<int>(jj[0], job);
+    r.server = numberAs<int>(jj[1], job + " server");
+    r.sentSeconds = numberAs<double>(jj[2], job + " sentSeconds");
+    r.doneSeconds = numberAs<double>(jj[3], job + " doneSeconds");
+    r.busySeconds = numberAs<double>(jj[4], job + " busySeconds");
+    r.attempts = numberAs<int>(jj[5], job + " attempts");
+    r.resultBytes = numberAs<std::size_t>(jj[6], job + " resultBytes");
+    f.jobs.push_back(r);
+  }
+  return f;
+}
 
 RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
   json j;
@@ -342,6 +417,7 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       throw InputError(origin + ": counter \"" + c.name + "\" needs one value per PE (" + std::to_string(record.pes) + ")");
     record.counters.push_back(std::move(c));
   }
+  if (j.contains("farm")) record.farm = parseFarm(j["farm"], origin);
   return record;
 }
 

@@ -47,6 +47,10 @@ class Transport {
   // Whether a send has not left yet (it moves only while some thread of this rank calls the
   // transport, without asynchronous progress). Any thread.
   virtual bool sending() { return false; }
+  // From now on a rank that died or stopped does not end this one: a send to it, or a receive
+  // its death disturbs, fails quietly (its message is dropped), and the caller's deadlines say
+  // when it is lost (the farm, farm/farm.h). Needs `mpirun --enable-recovery` under MPI.
+  virtual void tolerateLostRanks() {}
   // Ends the transport on this rank (after flush); the last call made on it.
   virtual void finalize() = 0;
   // Ends every rank of the run at once with `status` (a rank that cannot finish cleanly).

@@ -14,6 +14,7 @@
 #include "raytrace/partition/film_assembly.h"
 #include "raytrace/partition/partition.h"
 #include "raytrace/partition/partitioned.h"
+#include "raytrace/partition/tile_trace.h"
 
 namespace pr::rt {
 
@@ -72,11 +73,8 @@ class ImageSpacePartition final : public Partition {
     const int64_t total = int64_t(tiles.size());
     rt.runStage(job.stage("trace"), set, [&](par::Pe& pe, par::TaskId id) {
       const PixelRect& rect = tiles[size_t(id)].rect;
-      Film tile(rect, job.width, job.height, integrator.options().spp);
       TraceStats stats;
-      std::vector<RayMessage> queue;
-      integrator.cameraRays(rect, queue);
-      integrator.traceToCompletion(bvh, queue, tile, stats, pe.id());
+      const Film tile = traceTile(integrator, bvh, rect, job.width, job.height, pe.id(), stats);
       if (job.assembleImage) assembly.deliver(pe, tile, rect, false);
       counters.of(pe.id()) += stats;
       const int64_t n = done.fetch_add(1, std::memory_order_relaxed) + 1;
@@ -88,13 +86,9 @@ class ImageSpacePartition final : public Partition {
  private:
   static std::vector<TileTask> makeTiles(const TraceJob& job) {
     const int ts = job.options.tileSizePx;
-    const int cols = (job.width + ts - 1) / ts, rows = (job.height + ts - 1) / ts;
     std::vector<TileTask> tiles;
-    tiles.reserve(size_t(cols) * size_t(rows));
-    for (int r = 0; r < rows; ++r)
-      for (int c = 0; c < cols; ++c)
-        tiles.push_back({PixelRect{c * ts, r * ts, std::min(job.width, (c + 1) * ts), std::min(job.height, (r + 1) * ts)},
-                         c + 0.5f, r + 0.5f, 1.0});
+    for (const PixelRect& r : tilesOf(PixelRect{0, 0, job.width, job.height}, ts))
+      tiles.push_back({r, float(r.x0 / ts) + 0.5f, float(r.y0 / ts) + 0.5f, 1.0});
     return tiles;
   }
 

@@ -152,7 +152,17 @@ bool isPartition(std::string_view name);
 // Throws pr::InputError naming the unknown partition and listing the valid ones.
 std::unique_ptr<Partition> makePartition(std::string_view name);
 
-// Validates the job (size, options) and runs the named partition.
+// A render made ready for its tracer: validated (size, options), its BVH options set for the
+// scene, and the integrator's pre-passes run through the named partition on rt (for a
+// world-model partition, over a world BVH built here unless the job brought one, then kept in
+// worldBvh and named by job.options.worldBvh). Throws pr::InputError for a bad job.
+struct PreparedRays {
+  TraceJob job;
+  std::unique_ptr<Bvh> worldBvh;
+};
+PreparedRays prepareRays(const TraceJob& job, std::string_view partition, par::Runtime& rt);
+
+// Validates the job (size, options) and runs the named partition (prepareRays, then render).
 TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt);
 // The same for a job with the built-in integrator options.integrator.kind names.
 TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, int width, int height,

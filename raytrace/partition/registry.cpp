@@ -73,7 +73,7 @@ class PartitionPrePass final : public PrePassTracer {
 
 }  // namespace
 
-TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt) {
+PreparedRays prepareRays(const TraceJob& job, std::string_view partition, par::Runtime& rt) {
   auto range = [](const char* what, long value, long lo, long hi) {
     if (value < lo || value > hi)
       throw InputError(std::string(what) + " " + std::to_string(value) + " is out of range [" + std::to_string(lo) +
@@ -90,22 +90,25 @@ TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Run
   checkBvhLimit("scene " + job.scene.source.string(), job.scene.triangles.size());
   std::unique_ptr<Partition> p = makePartition(partition);
   // Every BVH a partition builds over this scene tests its alpha-cut surfaces.
-  TraceJob main = job;
+  PreparedRays prepared{job, nullptr};
+  TraceJob& main = prepared.job;
   if (!main.options.bvh.alpha) main.options.bvh.alpha = AlphaTest::forScene(job.scene);
-  if (!job.integrator || !job.integrator->hasPrePass()) return p->render(main, rt);
+  if (!job.integrator || !job.integrator->hasPrePass()) return prepared;
   // The integrator's pre-pass runs through this same tracer; a world-model tracer builds its
   // BVH once for the pre-pass's programs and the render.
-  std::unique_ptr<Bvh> built;
   if (p->holdsWorldModel() && !job.options.worldBvh) {
-    rt.runOncePerRank("build", [&](par::Pe&) {
-      built = std::make_unique<Bvh>(job.scene, main.options.bvh);
-    });
-    main.options.worldBvh = built.get();
+    rt.runOncePerRank("build", [&](par::Pe&) { prepared.worldBvh = std::make_unique<Bvh>(job.scene, main.options.bvh); });
+    main.options.worldBvh = prepared.worldBvh.get();
   }
   PartitionPrePass tracer(main, partition, rt);
   job.integrator->prePass(tracer, rt);
   main.sceneResident = tracer.traced();
-  return p->render(main, rt);
+  return prepared;
+}
+
+TraceResult renderRays(const TraceJob& job, std::string_view partition, par::Runtime& rt) {
+  const PreparedRays prepared = prepareRays(job, partition, rt);
+  return makePartition(partition)->render(prepared.job, rt);
 }
 
 TraceResult renderRays(const scene::Scene& scene, const scene::Camera& camera, int width, int height,

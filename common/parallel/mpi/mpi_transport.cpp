@@ -50,7 +50,8 @@ class MpiTransport final : public Transport {
     completeSends();
     Pending& p = pending_.emplace_back();
     p.bytes = std::move(bytes);
-    MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE, to, tag, comm_, &p.request);
+    if (MPI_Isend(p.bytes.data(), int(p.bytes.size()), MPI_BYTE, to, tag, comm_, &p.request) != MPI_SUCCESS)
+      pending_.pop_back();  // only with tolerateLostRanks: the receiver is gone
   }
 
   std::optional<Envelope> poll(int tag) override {
@@ -59,8 +60,7 @@ class MpiTransport final : public Transport {
     int found = 0;
     MPI_Message message;
     MPI_Status status;
-    MPI_Improbe(MPI_ANY_SOURCE, tag, comm_, &found, &message, &status);
-    if (!found) return std::nullopt;
+    if (MPI_Improbe(MPI_ANY_SOURCE, tag, comm_, &found, &message, &status) != MPI_SUCCESS || !found) return std::nullopt;
     int count = 0;
     MPI_Get_count(&status, MPI_BYTE, &count);
     Envelope e;
@@ -68,7 +68,7 @@ class MpiTransport final : public Transport {
     e.tag = tag;
     e.bytes = takeSpare(std::size_t(count));
     e.bytes.resize(std::size_t(count));  // zero-fills only beyond what the storage held before
-    MPI_Mrecv(e.bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE);
+    if (MPI_Mrecv(e.bytes.data(), count, MPI_BYTE, &message, MPI_STATUS_IGNORE) != MPI_SUCCESS) return std::nullopt;
     return e;
   }
 
@@ -110,6 +110,9 @@ class MpiTransport final : public Transport {
     }
   }
 
+  // MPI_ERRORS_RETURN instead of the default fatal handler: every call above checks its code.
+  void tolerateLostRanks() override { MPI_Comm_set_errhandler(comm_, MPI_ERRORS_RETURN); }
+
   void finalize() override {
     MPI_Comm_free(&comm_);
     MPI_Finalize();
@@ -130,8 +133,8 @@ class MpiTransport final : public Transport {
   void completeSends() {
     while (!pending_.empty()) {
       int done = 0;
-      MPI_Test(&pending_.front().request, &done, MPI_STATUS_IGNORE);
-      if (!done) return;
+      // A failed test (tolerateLostRanks: the receiver is gone) drops the send.
+      if (MPI_Test(&pending_.front().request, &done, MPI_STATUS_IGNORE) == MPI_SUCCESS && !done) return;
       keepSpare(std::move(pending_.front().bytes));
       pending_.pop_front();
     }

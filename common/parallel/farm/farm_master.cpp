@@ -1,0 +1,305 @@
+// The farm's master (farm.h): a pool of jobs ordered by a scheduler, one record of who holds
+// each job, and a loop that reads results, tops servers up and declares silent servers lost,
+// never waiting without a deadline.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <deque>
+#include <optional>
+#include <thread>
+
+#include "common/parallel/farm/farm.h"
+#include "common/parallel/farm/farm_messages.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+enum class JobState : std::uint8_t { InPool, Held, Requeued, Done };
+
+struct Server {
+  FarmServerRecord record;
+  bool hello = false, ready = false;
+  std::deque<int> holding;  // jobs sent and not yet done, oldest first
+  std::deque<TaskId> granted;  // the rest of a grab of several jobs (--grain)
+  bool scheduleDone = false;   // the schedule has nothing more for it
+  double silentSince = 0.0;  // the time from which its silence counts
+};
+
+class Master {
+ public:
+  Master(Transport& transport, const FarmOptions& options, std::uint64_t hash, const TaskSet& jobs, Scheduler& order,
+         const ScheduleParams& params)
+      : t_(transport), options_(options), hash_(hash), order_(order), start_(Clock::now()) {
+    const int servers = t_.ranks() - 1;
+    PR_CHECK(servers >= 1, "a farm needs a server besides the master");
+    order_.reset(jobs, servers, params);
+    state_.assign(jobs.size(), JobState::InPool);
+    holder_.assign(jobs.size(), -1);
+    record_.schedule = std::string(order.name());
+    record_.deadlineSeconds = options.deadlineSeconds;
+    record_.jobsAhead = options.jobsAhead;
+    record_.jobs.resize(jobs.size());
+    for (std::size_t j = 0; j < jobs.size(); ++j) record_.jobs[j].job = int(j), record_.jobs[j].attempts = 0;
+    servers_.resize(std::size_t(servers));
+    for (int s = 0; s < servers; ++s) servers_[std::size_t(s)].record.rank = s + 1;
+  }
+
+  FarmRecord run(const std::function<void(int, int, std::span<const std::byte>)>& accept,
+                 const std::function<void(const FarmProgress&)>& tick) {
+    double nextTick = options_.refreshSeconds;
+    try {
+      while (done_ < state_.size()) {
+        bool heard = false;
+        while (std::optional<Envelope> e = t_.poll(farm::kToMasterTag)) {
+          heard = true;
+          handle(*e, accept);
+        }
+        declareSilentServersLost();
+        checkSomeServerLeft();
+        const double now = seconds();
+        if (now >= nextTick) {
+          tick(progress());
+          keepIdleServersWaiting();
+          nextTick = now + options_.refreshSeconds;
+        }
+        if (!heard) std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+    } catch (...) {
+      stopAll(farm::MasterSays::StopFailed);
+      throw;
+    }
+    stopAll(farm::MasterSays::Stop);
+    record_.wallSeconds = seconds();
+    for (Server& s : servers_) record_.servers.push_back(std::move(s.record));
+    tick(progressOfRecord());
+    return std::move(record_);
+  }
+
+ private:
+  double seconds() const { return std::chrono::duration<double>(Clock::now() - start_).count(); }
+  Server& server(int rank) { return servers_[std::size_t(rank - 1)]; }
+
+  void handle(const Envelope& e, const std::function<void(int, int, std::span<const std::byte>)>& accept) {
+    if (e.source < 1 || e.source >= t_.ranks() || e.bytes.empty()) return;
+    Server& s = server(e.source);
+    WireReader r(e.bytes);
+    const auto kind = r.value<farm::ServerSays>();
+    const double now = seconds();
+    if (s.record.lost()) {
+      // A lost server that woke up: its results are late, anything else it says is moot.
+      if (kind == farm::ServerSays::Result) ++s.record.lateResults;
+      return;
+    }
+    s.record.lastHeardSeconds = now;
+    s.silentSince = now;
+    switch (kind) {
+      case farm::ServerSays::Hello: {
+        const auto hello = r.value<farm::Hello>();
+        s.hello = true;
+        s.record.pes = hello.pes;
+        if (hello.contentHash != hash_) {
+          t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Mismatch));
+          throw InputError("rank " + std::to_string(e.source) +
+                           " loaded a different scene from rank 0's (its content hash differs): every rank must read the same scene");
+        }
+        t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
+        return;
+      }
+      case farm::ServerSays::Ready:
+        s.ready = true;
+        s.record.prepareSeconds = r.value<farm::Ready>().prepareSeconds;
+        topUp(e.source);
+        return;
+      case farm::ServerSays::Result: {
+        const auto h = r.value<farm::ResultHeader>();
+        const std::span<const std::byte> result = std::span(e.bytes).subspan(1 + sizeof h);
+        const bool counts = h.job >= 0 && std::size_t(h.job) < state_.size() &&
+                            state_[std::size_t(h.job)] == JobState::Held && holder_[std::size_t(h.job)] == e.source;
+        if (!counts) {
+          ++s.record.lateResults;
+          return;
+        }
+        std::erase(s.holding, h.job);
+        state_[std::size_t(h.job)] = JobState::Done;
+        ++done_;
+        FarmJobRecord& j = record_.jobs[std::size_t(h.job)];
+        j.server = e.source;
+        j.doneSeconds = now;
+        j.busySeconds = h.busySeconds;
+        j.resultBytes = result.size();
+        s.record.jobs.push_back(h.job);
+        s.record.busySeconds += h.busySeconds;
+        s.record.idleSeconds = h.idleSeconds;
+        warnOfDeadline(h.busySeconds);
+        accept(h.job, e.source, result);
+        topUp(e.source);
+        return;
+      }
+      case farm::ServerSays::Failed: {
+        const auto f = r.value<farm::Failed>();
+        throw FarmServerFailed(f.status, "server rank " + std::to_string(e.source) + ": " + farm::textOf(r));
+      }
+    }
+  }
+
+  // One job's time near the deadline: a working server may then be taken for a lost one.
+  void warnOfDeadline(double busy) {
+    if (warned_ || busy < 0.5 * options_.deadlineSeconds) return;
+    warned_ = true;
+    std::fprintf(stderr,
+                 "parrender: warning: a farm job took %.1f s, over half the deadline of %.1f s: a server still working may be "
+                 "declared lost; raise --farm-deadline or make jobs smaller (--farm-job)\n",
+                 busy, options_.deadlineSeconds);
+  }
+
+  // The next job for a server: one handed on from a lost server first, then the schedule's,
+  // then (once a server has been lost) any job no one has been given, which may sit in a lost
+  // server's portion of a static schedule.
+  int nextJob(int rank) {
+    while (!requeued_.empty()) {
+      const int j = requeued_.front();
+      requeued_.pop_front();
+      if (state_[std::size_t(j)] == JobState::Requeued) return j;
+    }
+    Server& s = server(rank);
+    while (!s.scheduleDone) {
+      if (s.granted.empty()) {
+        Grab grab;
+        order_.next(rank - 1, seconds(), grab);
+        if (grab.tasks.empty()) {
+          s.scheduleDone = true;  // an empty answer is final
+          break;
+        }
+        s.granted.assign(grab.tasks.begin(), grab.tasks.end());
+      }
+      const int j = int(s.granted.front());
+      s.granted.pop_front();
+      if (state_[std::size_t(j)] == JobState::InPool) return j;  // else taken as an orphan already
+    }
+    if (!anyLost_) return -1;
+    for (; orphanScan_ < state_.size(); ++orphanScan_)
+      if (state_[orphanScan_] == JobState::InPool) return int(orphanScan_++);
+    return -1;
+  }
+
+  void topUp(int rank) {
+    Server& s = server(rank);
+    if (!s.ready || s.record.lost()) return;
+    if (s.holding.empty()) s.silentSince = seconds();
+    while (int(s.holding.size()) < options_.jobsAhead) {
+      const int j = nextJob(rank);
+      if (j < 0) return;
+      state_[std::size_t(j)] = JobState::Held;
+      holder_[std::size_t(j)] = rank;
+      FarmJobRecord& jr = record_.jobs[std::size_t(j)];
+      jr.sentSeconds = seconds();
+      ++jr.attempts;
+      s.holding.push_back(j);
+      t_.send(rank, farm::kToServerTag, farm::message(farm::MasterSays::Job, std::int32_t(j)));
+    }
+  }
+
+  void declareSilentServersLost() {
+    const double now = seconds();
+    bool handedOn = false;
+    for (Server& s : servers_) {
+      if (s.record.lost()) continue;
+      const bool holdsWork = s.ready && !s.holding.empty();
+      const bool neverReady = !s.ready && now > options_.readySeconds;
+      if (!(holdsWork && now - s.silentSince > options_.deadlineSeconds) && !neverReady) continue;
+      s.record.lostAtSeconds = now;
+      anyLost_ = true;
+      for (int j : s.holding) {
+        state_[std::size_t(j)] = JobState::Requeued;
+        holder_[std::size_t(j)] = -1;
+        requeued_.push_back(j);
+        s.record.handedOn.push_back(j);
+      }
+      s.holding.clear();
+      handedOn = true;
+      // Should it wake up, it finishes the job in hand, sends that (late) result and stops.
+      t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Stop));
+      std::fprintf(stderr, "parrender: farm: server rank %d declared lost after %.1f s of silence%s; %zu job(s) handed on\n",
+                   s.record.rank, now - s.silentSince, s.ready ? "" : " (never ready)", s.record.handedOn.size());
+    }
+    if (handedOn)
+      for (Server& s : servers_) topUp(s.record.rank);
+  }
+
+  void checkSomeServerLeft() {
+    for (const Server& s : servers_)
+      if (!s.record.lost()) return;
+    throw std::runtime_error("every farm server was lost with " + std::to_string(state_.size() - done_) +
+                             " job(s) not done");
+  }
+
+  // A server that holds no job hears from the master at every tick, so it can tell a master
+  // that has nothing for it yet from one that is gone.
+  void keepIdleServersWaiting() {
+    for (Server& s : servers_)
+      if (s.hello && !s.record.lost() && s.holding.empty())
+        t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Wait));
+  }
+
+  void stopAll(farm::MasterSays how) {
+    for (const Server& s : servers_) t_.send(s.record.rank, farm::kToServerTag, farm::message(how));
+  }
+
+  FarmProgress progress() const {
+    FarmProgress p;
+    p.jobsDone = int(done_);
+    p.jobs = int(state_.size());
+    p.seconds = seconds();
+    for (const Server& s : servers_) {
+      if (s.record.lost())
+        p.lostRanks.push_back(s.record.rank);
+      else if (s.ready)
+        ++p.serversWorking;
+      else
+        ++p.serversPreparing;
+    }
+    return p;
+  }
+
+  FarmProgress progressOfRecord() const {
+    FarmProgress p;
+    p.jobsDone = int(done_);
+    p.jobs = int(state_.size());
+    p.seconds = record_.wallSeconds;
+    for (const FarmServerRecord& s : record_.servers) {
+      if (s.lost())
+        p.lostRanks.push_back(s.rank);
+      else
+        ++p.serversWorking;
+    }
+    return p;
+  }
+
+  Transport& t_;
+  FarmOptions options_;
+  std::uint64_t hash_;
+  Scheduler& order_;
+  Clock::time_point start_;
+  std::vector<JobState> state_;
+  std::vector<int> holder_;
+  std::vector<Server> servers_;
+  std::deque<int> requeued_;
+  std::size_t done_ = 0, orphanScan_ = 0;
+  bool anyLost_ = false, warned_ = false;
+  FarmRecord record_;
+};
+
+}  // namespace
+
+FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::uint64_t contentHash,
+                         const TaskSet& jobs, Scheduler& order, const ScheduleParams& params,
+                         const std::function<void(int, int, std::span<const std::byte>)>& accept,
+                         const std::function<void(const FarmProgress&)>& tick) {
+  Master master(transport, options, contentHash, jobs, order, params);
+  return master.run(accept, tick);
+}
+
+}  // namespace pr::par

@@ -1,0 +1,62 @@
+// The farm's messages (farm.h), shared by the master and the server: one tag each way, the
+// first byte saying what the message is, then its fields (wire.h).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+
+#include "common/parallel/process_group.h"
+#include "common/parallel/wire.h"
+
+namespace pr::par::farm {
+
+inline constexpr int kToMasterTag = ProcessGroup::kFirstUserTag + 100;
+inline constexpr int kToServerTag = ProcessGroup::kFirstUserTag + 101;
+
+// Server to master.
+enum class ServerSays : std::uint8_t { Hello = 1, Ready = 2, Result = 3, Failed = 4 };
+// Master to server.
+enum class MasterSays : std::uint8_t { Welcome = 1, Mismatch = 2, Job = 3, Wait = 4, Stop = 5, StopFailed = 6 };
+
+struct Hello {
+  std::uint64_t contentHash = 0;
+  std::int32_t pes = 1;
+};
+struct Ready {
+  double prepareSeconds = 0.0;
+};
+// A result's header; the result's bytes follow.
+struct ResultHeader {
+  std::int32_t job = 0;
+  double busySeconds = 0.0;  // on this job
+  double idleSeconds = 0.0;  // waiting for jobs since ready, so far
+};
+struct Failed {
+  std::int32_t status = 1;  // the text follows
+};
+
+template <class Kind, class T>
+Bytes message(Kind kind, const T& fields, std::span<const std::byte> tail = {}) {
+  Bytes out;
+  WireWriter w(out);
+  w.reserve(1 + sizeof(T) + tail.size());
+  w.value(kind);
+  w.value(fields);
+  w.elements(tail);
+  return out;
+}
+
+template <class Kind>
+Bytes message(Kind kind) {
+  Bytes out(1);
+  out[0] = std::byte(kind);
+  return out;
+}
+
+inline std::string textOf(WireReader& r) {
+  const auto chars = r.elements<char>();
+  return std::string(chars.begin(), chars.end());
+}
+
+}  // namespace pr::par::farm

@@ -1,0 +1,148 @@
+// A farm server (farm.h): hello, pre-passes, then jobs as they come, each result sent back and
+// flushed before the next job starts (a large result moves only while this rank is inside MPI).
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdlib>
+#include <deque>
+#include <fstream>
+#include <thread>
+
+#include "common/parallel/farm/farm.h"
+#include "common/parallel/farm/farm_messages.h"
+#include "common/parallel/runtime.h"
+#include "common/util/error.h"
+
+namespace pr::par {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+class Server {
+ public:
+  Server(Transport& t, const FarmOptions& options) : t_(t), options_(options), lastHeard_(Clock::now()) {}
+
+  // The next message from the master, waiting at most `seconds` since it last heard from it.
+  Envelope await(double seconds, const char* what) {
+    for (;;) {
+      if (std::optional<Envelope> e = t_.poll(farm::kToServerTag)) {
+        lastHeard_ = Clock::now();
+        return std::move(*e);
+      }
+      if (since(lastHeard_) > seconds)
+        throw std::runtime_error("the farm's master (rank 0) sent nothing for " + std::to_string(int(seconds)) +
+                                 " s while this server waited for " + what + "; ending");
+      std::this_thread::sleep_for(std::chrono::microseconds(100));
+    }
+  }
+
+  // Files the master's message; false when it says stop.
+  bool take(const Envelope& e) {
+    WireReader r(e.bytes);
+    switch (r.value<farm::MasterSays>()) {
+      case farm::MasterSays::Job:
+        jobs_.push_back(r.value<std::int32_t>());
+        return true;
+      case farm::MasterSays::Wait:
+      case farm::MasterSays::Welcome:
+        return true;
+      case farm::MasterSays::Mismatch:
+        throw InputError("");  // rank 0 says which rank's scene differs
+      case farm::MasterSays::StopFailed:
+        throw FailedElsewhere("the farm stopped after a failure on another rank");
+      case farm::MasterSays::Stop:
+        return false;
+    }
+    return true;
+  }
+
+  void send(const Bytes& b) { t_.send(0, farm::kToMasterTag, b); }
+  void flush() {
+    if (!t_.flush(options_.deadlineSeconds))
+      throw std::runtime_error("a result to the farm's master (rank 0) had not left after " +
+                               std::to_string(int(options_.deadlineSeconds)) + " s; ending");
+  }
+
+  Transport& t_;
+  FarmOptions options_;
+  Clock::time_point lastHeard_;
+  std::deque<int> jobs_;
+};
+
+// Raises the test fault as the server starts a job, having sent `sent` results.
+void injectFault(const FarmFault& fault, int rank, int sent) {
+  if (fault.rank != rank || fault.afterJobs != sent) return;
+  if (!fault.pidFile.empty()) std::ofstream(fault.pidFile) << getpid() << "\n";
+  raise(fault.signal);
+}
+
+}  // namespace
+
+FarmFault farmFaultFromEnvironment() {
+  FarmFault f;
+  const char* v = std::getenv("PARRENDER_FARM_FAULT");
+  if (!v || !*v) return f;
+  const std::string text(v);
+  char pid[512] = {};
+  const int n = std::sscanf(v, "%d:%d:%d:%511s", &f.rank, &f.afterJobs, &f.signal, pid);
+  if (n < 3 || f.rank < 1 || f.afterJobs < 0 || f.signal <= 0 || f.signal >= 32)
+    throw InputError("PARRENDER_FARM_FAULT must be RANK:JOBS:SIGNAL[:PIDFILE] with RANK >= 1, not '" + text + "'");
+  if (n == 4) f.pidFile = pid;
+  return f;
+}
+
+void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64_t contentHash, int pes,
+                   const std::function<void()>& prepare, const std::function<Bytes(int)>& work) {
+  const FarmFault fault = farmFaultFromEnvironment();
+  Server s(transport, options);
+  const auto failed = [&](int status, const std::string& text) {
+    s.send(farm::message(farm::ServerSays::Failed, farm::Failed{status},
+                         std::as_bytes(std::span<const char>(text.data(), text.size()))));
+    (void)transport.flush(options.deadlineSeconds);
+  };
+  s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes}));
+  if (!s.take(s.await(options.readySeconds, "its welcome"))) return;
+  double idle = 0.0;
+  int sent = 0;
+  try {
+    const Clock::time_point started = Clock::now();
+    prepare();
+    s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started)}));
+    for (;;) {
+      // Every message already here first: a stop, or the next jobs.
+      while (std::optional<Envelope> e = transport.poll(farm::kToServerTag)) {
+        s.lastHeard_ = Clock::now();
+        if (!s.take(*e)) return;
+      }
+      if (s.jobs_.empty()) {
+        const Clock::time_point waiting = Clock::now();
+        const bool more = s.take(s.await(options.deadlineSeconds, "a job"));
+        idle += since(waiting);
+        if (!more) return;
+        continue;
+      }
+      const int job = s.jobs_.front();
+      s.jobs_.pop_front();
+      injectFault(fault, transport.rank(), sent);
+      const Clock::time_point begun = Clock::now();
+      const Bytes result = work(job);
+      const farm::ResultHeader header{job, since(begun), idle};
+      s.send(farm::message(farm::ServerSays::Result, header, result));
+      s.flush();
+      ++sent;
+    }
+  } catch (const FailedElsewhere&) {
+    throw;
+  } catch (const InputError& e) {
+    failed(kExitBadInput, e.what());
+    throw;
+  } catch (const std::exception& e) {
+    failed(1, e.what());
+    throw;
+  }
+}
+
+}  // namespace pr::par

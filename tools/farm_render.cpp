@@ -1,0 +1,247 @@
+// See farm_render.h.
+#include "tools/farm_render.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string_view>
+#include <memory>
+
+#include "common/image/image_io.h"
+#include "common/parallel/farm/farm.h"
+#include "common/parallel/process_group.h"
+#include "common/parallel/runtime.h"
+#include "common/parallel/wire.h"
+#include "common/scene/scene_hash.h"
+#include "common/util/error.h"
+#include "raytrace/partition/tile_trace.h"
+
+namespace pr::cli {
+
+namespace {
+
+constexpr std::string_view kFarmMethod = "image-space";
+
+struct JobSize {
+  int w = 0, h = 0;
+};
+
+JobSize parseJobSize(const std::string& text) {
+  JobSize s;
+  char x = 0, extra = 0;
+  if (std::sscanf(text.c_str(), "%d%c%d%c", &s.w, &x, &s.h, &extra) != 3 || (x != 'x' && x != 'X') || s.w < 1 ||
+      s.h < 1 || s.w > 16384 || s.h > 16384)
+    throw InputError("--farm-job must be WIDTHxHEIGHT in pixels, e.g. 32x24, not '" + text + "'");
+  return s;
+}
+
+// The jobs: screen areas in image order, each task at its area's centre in job units.
+struct FarmJobs {
+  std::vector<rt::PixelRect> areas;
+  par::TaskSet tasks;
+};
+
+FarmJobs makeJobs(int width, int height, JobSize size) {
+  FarmJobs jobs;
+  jobs.areas = rt::tilesOf(rt::PixelRect{0, 0, width, height}, size.w, size.h);
+  const int cols = (width + size.w - 1) / size.w, rows = (height + size.h - 1) / size.h;
+  jobs.tasks = par::TaskSet::grid(cols, rows);
+  return jobs;
+}
+
+par::FarmOptions farmOptions(const FarmArgs& farm) {
+  par::FarmOptions o;
+  o.deadlineSeconds = farm.deadlineSeconds;
+  o.jobsAhead = farm.jobsAhead;
+  o.refreshSeconds = farm.refreshSeconds;
+  o.readySeconds = par::ProcessGroup::get().timeoutSeconds();
+  return o;
+}
+
+// A server: its own runtime of `threads` PEs, the world BVH and the integrator's pre-passes,
+// then one stage per job over the job's tiles.
+void serve(const FarmArgs& farm, const FarmInput& in, const FarmJobs& jobs, std::uint64_t hash) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  par::Runtime runtime(par::RuntimeOptions{in.threads, in.schedule.schedule, in.schedule.params, false, nullptr});
+  const RenderRequest request{in.scene, in.camera, in.width, in.height, in.settings, in.plan, runtime, {}};
+  std::unique_ptr<rt::PreparedRays> prepared;
+  std::unique_ptr<rt::Bvh> bvh;
+  const auto prepare = [&] {
+    rt::TraceJob job = rayJobFor(request);
+    job.options.bvh.alpha = rt::AlphaTest::forScene(in.scene);
+    runtime.runOnOnePe("build", 0, [&](par::Pe&) { bvh = std::make_unique<rt::Bvh>(in.scene, job.options.bvh); });
+    job.options.worldBvh = bvh.get();
+    prepared = std::make_unique<rt::PreparedRays>(rt::prepareRays(job, kFarmMethod, runtime));
+  };
+  const auto work = [&](int id) {
+    const rt::TraceJob& job = prepared->job;
+    const rt::Integrator& integrator = *job.integrator;
+    const rt::PixelRect& area = jobs.areas[std::size_t(id)];
+    const std::vector<rt::PixelRect> tiles = rt::tilesOf(area, job.options.tileSizePx);
+    const int cols = (area.x1 - area.x0 + job.options.tileSizePx - 1) / job.options.tileSizePx;
+    rt::Film film(area, in.width, in.height, integrator.options().spp);
+    runtime.runStage("farm job", par::TaskSet::grid(cols, int(tiles.size()) / cols), [&](par::Pe& pe, par::TaskId t) {
+      rt::TraceStats stats;
+      const rt::Film tile = rt::traceTile(integrator, *job.options.worldBvh, tiles[t], in.width, in.height, pe.id(), stats);
+      film.addBlock(tile.block(tiles[t]));
+    });
+    return par::encodeMessage(film.block(area));
+  };
+  par::runFarmServer(group.transport(), farmOptions(farm), hash, in.threads, prepare, work);
+}
+
+// The master's run record: its PEs are the servers (one per rank), its stages the servers'
+// pre-passes and the jobs, each job a span on the server whose result counted.
+par::RunRecord farmRunRecord(par::FarmRecord farm, const par::TaskSet& tasks, std::size_t jobBytes) {
+  par::RunRecord r;
+  const int servers = int(farm.servers.size());
+  r.pes = servers;
+  r.ranks = servers;
+  r.schedule = farm.schedule;
+  r.wallSeconds = farm.wallSeconds;
+  par::StageRecord prepare;
+  prepare.name = "servers' pre-passes";
+  prepare.schedule = "each server";
+  par::StageRecord jobs;
+  jobs.name = "farm jobs";
+  jobs.schedule = farm.schedule;
+  jobs.tasks = tasks.tasks;
+  double firstSent = farm.wallSeconds;
+  for (const par::FarmJobRecord& j : farm.jobs) firstSent = std::min(firstSent, j.sentSeconds);
+  jobs.startSeconds = firstSent;
+  jobs.wallSeconds = farm.wallSeconds - firstSent;
+  for (const par::FarmServerRecord& s : farm.servers) prepare.wallSeconds = std::max(prepare.wallSeconds, s.prepareSeconds);
+  std::uint64_t results = 0, resultBytes = 0;
+  for (const par::FarmServerRecord& s : farm.servers) {
+    par::PeStageRecord p;
+    p.busySeconds = s.prepareSeconds;
+    p.idleSeconds = prepare.wallSeconds - s.prepareSeconds;
+    p.tasks = 1;
+    prepare.pes.push_back(p);
+    par::PeStageRecord q;
+    q.busySeconds = s.busySeconds;
+    q.idleSeconds = std::max(0.0, jobs.wallSeconds - s.busySeconds);
+    q.tasks = s.jobs.size();
+    for (int id : s.jobs) {
+      q.bytesSent += farm.jobs[std::size_t(id)].resultBytes;
+      ++q.messagesSent;
+    }
+    q.messagesReceived = q.tasks;
+    q.bytesReceived = q.tasks * jobBytes;
+    results += q.messagesSent;
+    resultBytes += q.bytesSent;
+    jobs.pes.push_back(q);
+  }
+  jobs.channels.push_back({"farm results", "results", results, resultBytes, results, resultBytes});
+  for (const par::FarmJobRecord& j : farm.jobs)
+    if (j.server > 0) r.timeline.push_back({j.server - 1, 1, par::TaskId(j.job), j.doneSeconds - j.busySeconds, j.doneSeconds});
+  r.stages = {std::move(prepare), std::move(jobs)};
+  r.farm = std::move(farm);
+  return r;
+}
+
+}  // namespace
+
+void addFarmOptions(CLI::App& command, FarmArgs& args) {
+  command.add_flag("--farm", args.enabled,
+                   "render as a farm under mpirun --enable-recovery: rank 0 hands out screen areas, the other ranks render "
+                   "them with --threads PEs each; a server that dies or stops answering loses no job (image-space only)");
+  command.add_option("--farm-job", args.job, "--farm: a job's screen area, WIDTHxHEIGHT pixels")->capture_default_str();
+  command.add_option("--farm-schedule", args.schedule,
+                     "--farm: the master's order of jobs, a demand-driven schedule (demand, spiral, random, preferred-bias, ...)")
+      ->check(CLI::Validator([](std::string& v) { return par::schedules().problem(v); }, "SCHEDULE"))
+      ->capture_default_str();
+  command.add_option("--farm-deadline", args.deadlineSeconds,
+                     "--farm: seconds a server holding jobs may send nothing before it is declared lost")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  command.add_option("--farm-refresh", args.refreshSeconds, "--farm: seconds between rewrites of the image (and --progress lines)")
+      ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  command.add_option("--farm-ahead", args.jobsAhead, "--farm: jobs a server holds at once (the next ones wait there while it works)")
+      ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+  command.add_flag("--progress", args.progress, "--farm: a progress line on stderr at every refresh (jobs done, servers working and lost)");
+}
+
+void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSettings& settings, int ranks) {
+  if (!farm.enabled) {
+    if (farm.progress) throw InputError("--progress applies to --farm");
+    return;
+  }
+  if (method.name != kFarmMethod)
+    throw InputError("--farm renders with image-space only, whose every server holds all a job needs; " + method.name +
+                     (method.properties.family == MethodFamily::Raster ? " is a rasterizer"
+                                                                        : "'s data is partitioned among PEs and would be lost with a server"));
+  if (ranks < 2)
+    throw InputError("--farm needs a master and at least one server: launch it as mpirun --enable-recovery -np N parrender "
+                     "render ... --farm, with N >= 2");
+  if (par::scheduleNeedsCostEstimates(farm.schedule))
+    throw InputError("--farm-schedule " + farm.schedule + " orders jobs by cost estimates, which the farm's master (which traces nothing) does not have");
+  if (settings.ray.adaptive) throw InputError("--adaptive splits tiles by a cost pre-pass, which the farm does not run");
+  (void)parseJobSize(farm.job);
+}
+
+par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std::string& output) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  par::Transport& transport = group.transport();
+  transport.tolerateLostRanks();
+  const JobSize size = parseJobSize(farm.job);
+  const FarmJobs jobs = makeJobs(in.width, in.height, size);
+  const std::uint64_t hash = scene::contentHash(in.scene);
+  if (group.rank() != 0) {
+    serve(farm, in, jobs, hash);
+    return {};
+  }
+  // Open MPI's mpirun passes --enable-recovery to its ranks as this variable.
+  const char* recovery = std::getenv("OMPI_MCA_orte_enable_recovery");
+  if (!recovery || std::string_view(recovery) != "1")
+    std::fprintf(stderr, "parrender: warning: --farm without mpirun --enable-recovery: a server that dies ends every rank "
+                         "(Open MPI's default); launch it as mpirun --enable-recovery ...\n");
+  rt::Film film(in.width, in.height, samplesPerPixel(in.settings.ray));
+  std::unique_ptr<par::Scheduler> order = par::makeScheduler(farm.schedule);
+  int written = 0;
+  const auto accept = [&](int, int, std::span<const std::byte> result) {
+    film.addBlock(par::decodeMessage<rt::FilmBlock>(result));
+  };
+  const auto tick = [&](const par::FarmProgress& p) {
+    if (p.jobsDone != written) {
+      image::writeImage(output, film.toImage());
+      written = p.jobsDone;
+    }
+    if (!farm.progress) return;
+    std::string lost;
+    for (int r : p.lostRanks) lost += (lost.empty() ? "" : ", ") + std::to_string(r);
+    std::fprintf(stderr, "farm: %d/%d jobs done, %d server(s) working, %d preparing, lost: %s, %.1f s\n", p.jobsDone, p.jobs,
+                 p.serversWorking, p.serversPreparing, lost.empty() ? "none" : lost.c_str(), p.seconds);
+  };
+  par::FarmRecord record = par::runFarmMaster(transport, farmOptions(farm), hash, jobs.tasks, *order,
+                                              in.schedule.params, accept, tick);
+  record.jobShape = "screen area " + std::to_string(size.w) + "x" + std::to_string(size.h);
+  for (const par::FarmServerRecord& s : record.servers)
+    if (s.lost()) group.markLost(s.rank);
+  return farmRunRecord(std::move(record), jobs.tasks, 1 + sizeof(std::int32_t));
+}
+
+void printFarmSummary(const par::RunRecord& record) {
+  if (!record.farm) return;
+  const par::FarmRecord& f = *record.farm;
+  std::printf("farm: %zu jobs (%s) in the order of %s, %zu servers, deadline %.1f s, wall %.3f s\n", f.jobs.size(),
+              f.jobShape.c_str(), f.schedule.c_str(), f.servers.size(), f.deadlineSeconds, f.wallSeconds);
+  int handedOn = 0, late = 0;
+  for (const par::FarmServerRecord& s : f.servers) {
+    std::printf("  server rank %d (%d PE%s): %zu jobs, pre-passes %.3f s, busy %.3f s, idle %.3f s", s.rank, s.pes,
+                s.pes == 1 ? "" : "s", s.jobs.size(), s.prepareSeconds, s.busySeconds, s.idleSeconds);
+    if (s.lost()) std::printf("; lost at %.2f s (last heard %.2f s), %zu job(s) handed on", s.lostAtSeconds, s.lastHeardSeconds, s.handedOn.size());
+    if (s.lateResults > 0) std::printf("; %d late result(s) discarded", s.lateResults);
+    std::printf("\n");
+    handedOn += int(s.handedOn.size());
+    late += s.lateResults;
+  }
+  std::uint64_t bytes = 0;
+  for (const par::FarmJobRecord& j : f.jobs) bytes += j.resultBytes;
+  std::printf("results: %zu messages (%llu bytes) to the master; jobs handed on %d, late results discarded %d\n", f.jobs.size(),
+              (unsigned long long)bytes, handedOn, late);
+}
+
+}  // namespace pr::cli

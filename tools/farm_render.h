@@ -1,0 +1,54 @@
+// `parrender render --farm`: the image-space ray tracer (every integrator, the photon map's
+// pre-passes included) as Jensen's render farm (common/parallel/farm/farm.h). Under
+// `mpirun --enable-recovery -np N`, rank 0 is the master: it hands out screen areas (jobs) in
+// the order of --farm-schedule, assembles the image as results arrive and rewrites it every
+// --farm-refresh seconds; every other rank is a server with --threads PEs of its own, which runs
+// the pre-passes itself from the same seed (so every server holds the same photon maps and
+// irradiance cache, and the image is bit-identical to a single process's) and renders each job
+// as a stage of its own runtime, its tiles ordered by --schedule among its PEs.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "common/parallel/run_options.h"
+#include "tools/render_methods.h"
+
+namespace pr::cli {
+
+struct FarmArgs {
+  bool enabled = false;
+  std::string job = "32x24";  // the seed's photon-map farm used 32x24 and 40x30
+  std::string schedule = "demand";
+  double deadlineSeconds = 30.0;
+  double refreshSeconds = 2.0;
+  int jobsAhead = 2;
+  bool progress = false;
+};
+void addFarmOptions(CLI::App& command, FarmArgs& args);
+
+// Bad use, refused before the scene is loaded (pr::InputError naming the reason): one rank only
+// (no mpirun), a method other than image-space (a server must hold all a job needs), a
+// master's schedule that needs cost estimates, --adaptive, a malformed job size.
+void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSettings& settings, int ranks);
+
+// The render as a farm, on every rank (the master's image and record are written to `output`
+// and outputs.metricsFile, the image also every --farm-refresh seconds). On rank 0 returns the
+// farm's run record, whose PEs are the servers; elsewhere an empty record. Marks lost servers
+// in the ProcessGroup, so the run's ending does not wait for them.
+struct FarmInput {
+  const scene::Scene& scene;
+  const scene::Camera& camera;
+  const scene::RenderPlan& plan;
+  int width = 0, height = 0;
+  const RenderSettings& settings;
+  par::ScheduleOptions schedule;  // among each server's PEs
+  int threads = 1;                // each server's PEs
+};
+par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& input, const std::string& output);
+
+// The summary's farm lines: servers, their jobs, busy and idle time, the lost ones.
+void printFarmSummary(const par::RunRecord& record);
+
+}  // namespace pr::cli
