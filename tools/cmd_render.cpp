@@ -105,6 +105,7 @@ void run(RenderArgs& a) {
   checkFamilyOptions(method, a.family);
   // Under mpirun, --threads is each rank's: P = R x T PEs, and rank 0 writes and prints.
   par::ProcessGroup& group = par::ProcessGroup::get();
+  reportFarmStatus(a.farm);
   checkFarm(a.farm, method, a.settings, group.ranks());
   checkAcrossRanks(method, group.ranks());
   const bool writes = holdsResults();

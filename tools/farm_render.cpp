@@ -161,12 +161,30 @@ void addFarmOptions(CLI::App& command, FarmArgs& args) {
   command.add_option("--farm-ahead", args.jobsAhead, "--farm: jobs a server holds at once (the next ones wait there while it works)")
       ->check(CLI::Range(1, 64))
       ->capture_default_str();
+  command.add_option("--farm-status", args.statusFile,
+                     "--farm: write the run's exit status (0: complete) to this file at the end; under mpirun --enable-recovery, "
+                     "Open MPI 4.1's mpirun exits 0 whatever the ranks' status");
   command.add_flag("--progress", args.progress, "--farm: a progress line on stderr at every refresh (jobs done, servers working and lost)");
+}
+
+void reportFarmStatus(const FarmArgs& farm) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  if (farm.statusFile.empty() || group.rank() != 0) return;
+  group.atVerdict([file = farm.statusFile](int status) {
+    std::FILE* f = std::fopen(file.c_str(), "w");
+    if (!f) {
+      std::fprintf(stderr, "parrender: cannot write the run's status to %s\n", file.c_str());
+      return;
+    }
+    std::fprintf(f, "%d\n", status);
+    std::fclose(f);
+  });
 }
 
 void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSettings& settings, int ranks) {
   if (!farm.enabled) {
     if (farm.progress) throw InputError("--progress applies to --farm");
+    if (!farm.statusFile.empty()) throw InputError("--farm-status applies to --farm");
     return;
   }
   if (method.name != kFarmMethod)

@@ -25,12 +25,17 @@ struct FarmArgs {
   double refreshSeconds = 2.0;
   int jobsAhead = 2;
   bool progress = false;
+  std::string statusFile;  // --farm-status: the run's exit status, written by rank 0 at the end
 };
 void addFarmOptions(CLI::App& command, FarmArgs& args);
 
 // Bad use, refused before the scene is loaded (pr::InputError naming the reason): one rank only
 // (no mpirun), a method other than image-space (a server must hold all a job needs), a
 // master's schedule that needs cost estimates, --adaptive, a malformed job size.
+// With --farm-status, has rank 0 write the run's exit status to that file as the run ends
+// (ProcessGroup::atVerdict): mpirun --enable-recovery exits 0 whatever the ranks' status.
+void reportFarmStatus(const FarmArgs& farm);
+
 void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSettings& settings, int ranks);
 
 // The render as a farm, on every rank (the master's image and record are written to `output`

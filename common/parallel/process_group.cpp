@@ -204,6 +204,7 @@ Bytes ProcessGroup::onRank0Alone(std::string_view what, const std::function<Byte
 int ProcessGroup::finish(int status, const std::string& error) {
   if (ranks_ == 1) {
     if (status != 0 && !error.empty()) printFailure(status, 0, 1, error);
+    if (atVerdict_) atVerdict_(status);
     return status;
   }
   int run = status;
@@ -245,6 +246,7 @@ int ProcessGroup::finish(int status, const std::string& error) {
         run = s;
       }
     }
+    if (atVerdict_) atVerdict_(run);
     const bool anyLost = live < ranks_ - 1;
     // A lost rank gets the verdict too: one that woke up then leaves quietly before the abort.
     for (int r = 1; r < ranks_; ++r) transport_->send(r, kFinishTag, encodeStatus(run, anyLost ? kLeaveWithoutFinalize : ""));

@@ -68,12 +68,18 @@ class ProcessGroup {
   // `mpirun --enable-recovery`, mpirun then exits with that status (0 for a run that completed).
   void markLost(int rank);
 
+  // On rank 0: called by finish() with the run's exit status once it is known, before the run
+  // ends (a farm's --farm-status file: under `mpirun --enable-recovery`, Open MPI 4.1's mpirun
+  // exits 0 whatever the ranks' status, so the status has to reach the user another way).
+  void atVerdict(std::function<void(int status)> hook) { atVerdict_ = std::move(hook); }
+
  private:
   ProcessGroup() = default;
   int rank_ = 0, ranks_ = 1;
   double timeout_ = 300.0;
   Transport* transport_ = nullptr;
   std::vector<bool> lost_;  // rank 0: ranks markLost named
+  std::function<void(int)> atVerdict_;
 };
 
 // The ranks mpirun started and this process's rank among them, from the environment (before

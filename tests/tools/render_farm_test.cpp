@@ -1,0 +1,192 @@
+// `parrender render --farm` under mpirun (--enable-recovery, loopback, --oversubscribe, every
+// command under `timeout`): the farm's image equals the single-process image at 2, 3, 4 and 8
+// ranks, with the path tracer and the photon map; a server killed (SIGKILL) or stopped (SIGSTOP,
+// continued after the master declared it lost) while it holds a job leaves the image complete
+// and identical, the run exits 0 and the record names the lost server, the jobs handed on and
+// the late result discarded; bad use is refused with one message. The protocol's guarantees
+// in one process: tests/common/parallel/farm_test.cpp.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "common/image/image_io.h"
+#include "common/parallel/run_record.h"
+#include "mpirun_support.h"
+
+using pr::test::CommandResult;
+using pr::test::join;
+using pr::test::occurrences;
+using pr::test::quoted;
+
+namespace {
+
+std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
+
+CommandResult farmRun(int ranks, const std::string& args, const std::string& env = "", int limit = 180) {
+  return pr::test::mpirun(ranks, "--enable-recovery " + quoted(PARRENDER_EXE), args, limit, env);
+}
+
+// What --farm-status wrote ("" when there is no such file): under mpirun --enable-recovery the
+// run's exit status reaches the user only that way.
+std::string statusIn(const std::filesystem::path& file) {
+  std::ifstream in(file);
+  std::string status;
+  std::getline(in, status);
+  return status;
+}
+
+// The single-process reference image of `args`, written into dir.
+pr::image::Image reference(const std::filesystem::path& dir, const std::string& args) {
+  const CommandResult one = pr::test::runParrender(join({args, " --quiet -o ", quoted(dir / "reference.exr")}));
+  INFO(one.output);
+  REQUIRE(one.exitStatus == 0);
+  return pr::image::readImage(dir / "reference.exr");
+}
+
+// The farm's record: every job counted once, on a server.
+void checkEveryJobOnce(const pr::par::RunRecord& record, int servers) {
+  REQUIRE(record.farm.has_value());
+  const pr::par::FarmRecord& farm = *record.farm;
+  CHECK(int(farm.servers.size()) == servers);
+  std::size_t counted = 0;
+  for (const pr::par::FarmServerRecord& s : farm.servers) counted += s.jobs.size();
+  CHECK(counted == farm.jobs.size());
+  for (const pr::par::FarmJobRecord& j : farm.jobs) CHECK(j.server >= 1);
+}
+
+}  // namespace
+
+TEST_CASE("render --farm: the image equals the single-process image at 2, 3, 4 and 8 ranks") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_equal");
+  const std::string common = join({"render ", cornell(), " --width 64 --height 48 --spp 2"});
+  const pr::image::Image expected = reference(dir, common);
+  for (int ranks : {2, 3, 4, 8}) {
+    CAPTURE(ranks);
+    const std::filesystem::path out = dir / ("farm" + std::to_string(ranks) + ".exr");
+    const std::filesystem::path record = dir / ("farm" + std::to_string(ranks) + ".json");
+    // Jobs of 16x8 so that even 7 servers share them; 2 PEs per server at 3 ranks.
+    const CommandResult r = farmRun(ranks, join({common, " --farm --farm-job 16x8 --threads ", ranks == 3 ? "2" : "1",
+                                                 " -o ", quoted(out), " --metrics ", quoted(record)}));
+    INFO(r.output);
+    REQUIRE(r.exitStatus == 0);
+    CHECK(occurrences(r.output, "as a farm: a master and " + std::to_string(ranks - 1) + " servers") == 1);
+    CHECK(pr::image::readImage(out).pixels == expected.pixels);
+    checkEveryJobOnce(pr::par::readRunRecord(record), ranks - 1);
+  }
+}
+
+TEST_CASE("render --farm: the photon map's pre-passes on every server give the single-process image") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_photonmap");
+  const std::string common =
+      join({"render ", cornell(), " --width 48 --height 36 --integrator photonmap --spp 2 --photons 4000"});
+  const pr::image::Image expected = reference(dir, common);
+  const CommandResult r = farmRun(3, join({common, " --farm --farm-job 16x12 -o ", quoted(dir / "farm.exr")}));
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  CHECK(pr::image::readImage(dir / "farm.exr").pixels == expected.pixels);
+}
+
+// The render of the loss tests: long enough (jobs of 32x24, about 0.1 s each here) that the
+// master is still at work when a lost server wakes up.
+const std::string kLossArgs = " --width 160 --height 120 --spp 128 --farm-deadline 1";
+
+TEST_CASE("render --farm: a server killed while it holds a job loses no job, and the run exits 0") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_kill");
+  const std::string common = join({"render ", cornell(), kLossArgs});
+  const pr::image::Image expected = reference(dir, common);
+  // Server rank 2 kills itself (signal 9) as it starts the job after its second result.
+  const CommandResult r = farmRun(3, join({common, " --farm -o ", quoted(dir / "farm.exr"), " --metrics ", quoted(dir / "farm.json"),
+                                            " --farm-status ", quoted(dir / "status")}),
+                                  "PARRENDER_FARM_FAULT=2:2:9");
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  CHECK(statusIn(dir / "status") == "0");
+  CHECK(r.output.find("server rank 2 declared lost") != std::string::npos);
+  CHECK(pr::image::readImage(dir / "farm.exr").pixels == expected.pixels);
+  const pr::par::RunRecord record = pr::par::readRunRecord(dir / "farm.json");
+  checkEveryJobOnce(record, 2);
+  const pr::par::FarmServerRecord& killed = record.farm->servers[1];
+  REQUIRE(killed.lost());
+  CHECK(killed.jobs.size() == 2);
+  CHECK_FALSE(killed.handedOn.empty());
+  // Noticed within the deadline of its last message (and not before it).
+  CHECK(killed.lostAtSeconds - killed.lastHeardSeconds >= 1.0);
+  CHECK(killed.lostAtSeconds - killed.lastHeardSeconds < 1.5);
+  for (int j : killed.handedOn) CHECK(record.farm->jobs[std::size_t(j)].server == 1);
+}
+
+TEST_CASE("render --farm: a server stopped and continued after it was declared lost has its late result discarded") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_stop");
+  const std::string common = join({"render ", cornell(), kLossArgs});
+  const pr::image::Image expected = reference(dir, common);
+  const std::filesystem::path pid = dir / "server.pid", log = dir / "farm.log";
+  // Server rank 2 stops itself (signal 19) as it starts the job after its second result; once
+  // the master has declared it lost, the test continues it (SIGCONT) and it finishes that job.
+  const std::string farm = pr::test::kMpiEnv + "PARRENDER_FARM_FAULT=2:2:19:" + quoted(pid) +
+                           " timeout 180 mpirun --oversubscribe --enable-recovery -np 3 " + quoted(PARRENDER_EXE) + " " + common +
+                           " --farm -o " + quoted(dir / "farm.exr") + " --metrics " + quoted(dir / "farm.json") +
+                           " --farm-status " + quoted(dir / "status");
+  const std::string script = "(" + farm + " > " + quoted(log) + " 2>&1; echo \"exit $?\" >> " + quoted(log) +
+                             ") & for i in $(seq 1 600); do grep -q \"declared lost\" " + quoted(log) +
+                             " 2>/dev/null && break; sleep 0.1; done; kill -CONT $(cat " + quoted(pid) + "); wait";
+  (void)pr::test::runCommand("bash -c '" + script + "'");  // the script has no single quote
+  std::ifstream in(log);
+  const std::string output((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  INFO(output);
+  REQUIRE(output.find("exit 0") != std::string::npos);
+  CHECK(statusIn(dir / "status") == "0");
+  CHECK(pr::image::readImage(dir / "farm.exr").pixels == expected.pixels);
+  const pr::par::RunRecord record = pr::par::readRunRecord(dir / "farm.json");
+  checkEveryJobOnce(record, 2);
+  const pr::par::FarmServerRecord& stopped = record.farm->servers[1];
+  REQUIRE(stopped.lost());
+  CHECK(stopped.jobs.size() == 2);
+  CHECK(stopped.lateResults == 1);
+}
+
+TEST_CASE("render --farm: bad use is refused with one message") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_bad");
+  const std::string out = " -o " + quoted(dir / "out.png");
+  struct Case {
+    int ranks;
+    std::string args, message;
+  };
+  const Case cases[] = {
+      {1, "--farm", "--farm needs a master and at least one server"},
+      {2, "--farm -m object-space", "--farm renders with image-space only"},
+      {2, "--farm -m sort-middle", "sort-middle is a rasterizer"},
+      {2, "--farm --farm-schedule hot-spots", "orders jobs by cost estimates"},
+      {2, "--farm --farm-job 0x24", "--farm-job must be WIDTHxHEIGHT"},
+      {2, "--farm --adaptive", "--adaptive splits tiles"},
+      {1, "--progress", "--progress applies to --farm"},
+  };
+  // Under mpirun --enable-recovery, mpirun exits 0 whatever the ranks' status: --farm-status says it.
+  const std::filesystem::path status = dir / "status";
+  for (const Case& c : cases) {
+    CAPTURE(c.args);
+    std::filesystem::remove(status);
+    const std::string args = join({"render ", cornell(), " --width 32 --height 24 ", c.args, out});
+    const CommandResult r = c.ranks == 1 ? pr::test::runParrender(args) : farmRun(c.ranks, args + " --farm-status " + quoted(status), "", 60);
+    INFO(r.output);
+    if (c.ranks == 1)
+      CHECK(r.exitStatus == 2);
+    else
+      CHECK(statusIn(status) == "2");
+    CHECK(occurrences(r.output, c.message) == 1);
+  }
+  // The same command line in two working directories whose scene.gltf differ: the hash says so.
+  std::filesystem::create_directories(dir / "a");
+  std::filesystem::create_directories(dir / "b");
+  std::filesystem::copy_file(pr::test::sourceDir() / "scenes" / "cornell.gltf", dir / "a" / "scene.gltf");
+  std::filesystem::copy_file(pr::test::sourceDir() / "scenes" / "hotspot.gltf", dir / "b" / "scene.gltf");
+  const std::string command =
+      quoted(PARRENDER_EXE) + " render scene.gltf --width 32 --height 24 --farm -o out.png --farm-status " + quoted(status);
+  std::filesystem::remove(status);
+  const CommandResult r = pr::test::runCommand(pr::test::kMpiEnv + "timeout 60 mpirun --oversubscribe --enable-recovery -np 1 -wdir " +
+                                               quoted(dir / "a") + " " + command + " : -np 1 -wdir " + quoted(dir / "b") + " " + command);
+  INFO(r.output);
+  CHECK(statusIn(status) == "2");
+  CHECK(occurrences(r.output, "rank 1 loaded a different scene from rank 0's") == 1);
+}
