@@ -97,13 +97,14 @@ TEST_CASE("render --farm: a server killed while it holds a job loses no job, and
   const std::string common = join({"render ", cornell(), kLossArgs});
   const pr::image::Image expected = reference(dir, common);
   // Server rank 2 kills itself (signal 9) as it starts the job after its second result.
-  const CommandResult r = farmRun(3, join({common, " --farm -o ", quoted(dir / "farm.exr"), " --metrics ", quoted(dir / "farm.json"),
-                                            " --farm-status ", quoted(dir / "status")}),
+  const CommandResult r = farmRun(3, join({common, " --farm --progress --farm-refresh 0.2 -o ", quoted(dir / "farm.exr"),
+                                            " --metrics ", quoted(dir / "farm.json"), " --farm-status ", quoted(dir / "status")}),
                                   "PARRENDER_FARM_FAULT=2:2:9");
   INFO(r.output);
   REQUIRE(r.exitStatus == 0);
   CHECK(statusIn(dir / "status") == "0");
   CHECK(r.output.find("server rank 2 declared lost") != std::string::npos);
+  CHECK(r.output.find("1 server(s) working, 0 preparing, lost: 2") != std::string::npos);  // a --progress line
   CHECK(pr::image::readImage(dir / "farm.exr").pixels == expected.pixels);
   const pr::par::RunRecord record = pr::par::readRunRecord(dir / "farm.json");
   checkEveryJobOnce(record, 2);

@@ -19,8 +19,9 @@ jobs="${JOBS:-2}"
 # in the build stage; ObjectSpace (raytrace/partition): owners building their BVHs as the trace
 # stage's set-up while the other PEs already trace and send them rays; RankStage
 # (common/parallel): ranks in one process, their controlling threads passing messages;
-# SortFirst (raster/sort): PEs installing what they receive into their own copies of the scene.
-runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*,ObjectSpace*,RankStage*,SortFirst*"
+# SortFirst (raster/sort): PEs installing what they receive into their own copies of the scene;
+# Farm (common/parallel): a farm's master and servers on threads, passing messages.
+runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*,ObjectSpace*,RankStage*,SortFirst*,Farm*"
 
 cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests

@@ -42,6 +42,9 @@ struct FarmRun {
   bool resultsRight = true;       // every accepted result was its job's
   std::string masterError;
   std::vector<std::string> serverErrors;  // per rank ("" for rank 0 and servers that ended well)
+  int ticks = 0;                          // progress reports
+  int ticksNamingLost = 0;                // of them, those that name a lost server
+  int lastDone = 0;                       // jobs done at the last report
 };
 
 FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vector<ServerPlan>& plans,
@@ -89,7 +92,11 @@ FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vec
                 run.resultsRight = run.resultsRight && got == job;
                 ++run.accepted[std::size_t(job)];
               },
-              [](const pr::par::FarmProgress&) {});
+              [&](const pr::par::FarmProgress& p) {
+                ++run.ticks;
+                run.ticksNamingLost += p.lostRanks.empty() ? 0 : 1;
+                run.lastDone = p.jobsDone;
+              });
         } catch (const std::exception& e) {
           run.masterError = e.what();
         }
@@ -158,6 +165,11 @@ TEST_CASE("Farm: a server that stalls past the deadline and wakes up has its lat
   CHECK(stalled.lateResults >= 1);
   CHECK(stalled.jobs.size() == 2);  // its late result is not among the ones that counted
   CHECK(run.serverErrors[2].empty());  // told to stop, it ended without a failure
+  // Progress every refresh (0.05 s of a run of over a second), the lost server named, the last
+  // report the whole image.
+  CHECK(run.ticks >= 10);
+  CHECK(run.ticksNamingLost >= 1);
+  CHECK(run.lastDone == 120);
 }
 
 TEST_CASE("Farm: a server's failure ends the farm on every rank with its reason") {
