@@ -32,7 +32,7 @@ run() {
     line="$(python3 -c "
 import json, sys
 r = json.load(open(sys.argv[1]))
-print(r['stages'][1]['wallSeconds'], r['farm']['wallSeconds'])" "$out/run.json")"
+print('%.3f %.3f' % (r['stages'][1]['wallSeconds'], r['farm']['wallSeconds']))" "$out/run.json")"
     if [ -z "$best" ] || python3 -c "import sys; sys.exit(0 if float(sys.argv[1]) < float(sys.argv[2]) else 1)" "${line%% *}" "${best%% *}"; then
       best="$line"
     fi
