@@ -147,6 +147,24 @@ TEST_CASE("render --farm: a server stopped and continued after it was declared l
   CHECK(stopped.lateResults == 1);
 }
 
+TEST_CASE("render --farm: when the master dies the servers end the run within the deadline, the image left whole") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_master");
+  // The master kills itself once it has accepted 10 results, after a refresh or two.
+  const CommandResult r =
+      farmRun(3, join({"render ", cornell(), kLossArgs, " --farm --farm-refresh 0.1 -o ", quoted(dir / "farm.png"),
+                       " --farm-status ", quoted(dir / "status")}),
+              "PARRENDER_FARM_FAULT=0:10:9", 60);
+  INFO(r.output);
+  CHECK(r.exitStatus != 124);  // ended by the servers, not by timeout
+  CHECK(r.output.find("the farm's master (rank 0) ") != std::string::npos);  // sent nothing, or took no result
+  CHECK(r.output.find("; ending every rank") != std::string::npos);
+  CHECK_FALSE(std::filesystem::exists(dir / "status"));  // no status: the run did not complete
+  // The image on disk is the last one the master wrote whole (or none), never a partial file.
+  if (std::filesystem::exists(dir / "farm.png")) CHECK(pr::image::readImage(dir / "farm.png").width == 160);
+  for (const auto& entry : std::filesystem::directory_iterator(dir))
+    CHECK(entry.path().filename().string().find(".tmp") == std::string::npos);
+}
+
 TEST_CASE("render --farm: bad use is refused with one message") {
   const std::filesystem::path dir = pr::test::scratchDir("render_farm_bad");
   const std::string out = " -o " + quoted(dir / "out.png");

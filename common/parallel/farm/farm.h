@@ -9,7 +9,7 @@
 // - a result counts only from the server that holds its job now: a lost server that wakes up
 //   and sends late results has them discarded by job, never added twice;
 // - the master never waits without a deadline, and a server that hears nothing from the master
-//   for deadlineSeconds (the master keeps idle servers told to wait) ends with a failure.
+//   for deadlineSeconds (the master keeps idle servers told to wait) ends the run.
 // The transport must tolerate lost ranks (Transport::tolerateLostRanks) and the run must be
 // launched with `mpirun --enable-recovery`, or a dead server takes every rank with it.
 #pragma once
@@ -66,16 +66,17 @@ FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::
 // On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes),
 // then does the jobs it is sent, work(job) making each one's result, until the master says stop.
 // A failure of prepare or work is reported to the master and rethrown; a master that stops
-// answering for deadlineSeconds ends the server with std::runtime_error; when the master stops
-// the farm because of another rank's failure, throws FailedElsewhere (runtime.h).
+// answering for deadlineSeconds (readySeconds for the welcome) ends every rank
+// (Transport::abortAll, status 1); when the master stops the farm because of another rank's
+// failure, throws FailedElsewhere (runtime.h).
 void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64_t contentHash, int pes,
                    const std::function<void()>& prepare, const std::function<Bytes(int job)>& work);
 
 // A fault for tests (PARRENDER_FARM_FAULT="RANK:JOBS:SIGNAL[:PIDFILE]"): the server on rank RANK,
 // having sent JOBS results, as it starts its next job (so it holds at least that one), writes
 // its process id to PIDFILE (when given) and raises SIGNAL (a number: 9 kills it, 19 stops it
-// until a SIGCONT, after which it finishes the job and sends a late result). Read by
-// runFarmServer.
+// until a SIGCONT, after which it finishes the job and sends a late result). RANK 0: the master,
+// once it has accepted JOBS results. Read by runFarmServer and runFarmMaster.
 struct FarmFault {
   int rank = -1, afterJobs = 0, signal = 0;
   std::string pidFile;

@@ -1,6 +1,8 @@
 // The farm's master (farm.h): a pool of jobs ordered by a scheduler, one record of who holds
 // each job, and a loop that reads results, tops servers up and declares silent servers lost,
 // never waiting without a deadline.
+#include <signal.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -50,6 +52,9 @@ class Master {
   FarmRecord run(const std::function<void(int, int, std::span<const std::byte>)>& accept,
                  const std::function<void(const FarmProgress&)>& tick) {
     double nextTick = options_.refreshSeconds;
+    // Idle servers hear from the master well within their deadline, whatever the refresh.
+    const double keepAlive = std::min(options_.refreshSeconds, options_.deadlineSeconds / 4.0);
+    double nextKeepAlive = keepAlive;
     try {
       while (done_ < state_.size()) {
         bool heard = false;
@@ -62,8 +67,11 @@ class Master {
         const double now = seconds();
         if (now >= nextTick) {
           tick(progress());
-          keepIdleServersWaiting();
           nextTick = now + options_.refreshSeconds;
+        }
+        if (now >= nextKeepAlive) {
+          keepIdleServersWaiting();
+          nextKeepAlive = now + keepAlive;
         }
         if (!heard) std::this_thread::sleep_for(std::chrono::microseconds(200));
       }
@@ -135,6 +143,7 @@ class Master {
         s.record.idleSeconds = h.idleSeconds;
         warnOfDeadline(h.busySeconds);
         accept(h.job, e.source, result);
+        if (fault_.rank == 0 && fault_.afterJobs == int(done_)) raise(fault_.signal);
         topUp(e.source);
         return;
       }
@@ -236,8 +245,8 @@ class Master {
                              " job(s) not done");
   }
 
-  // A server that holds no job hears from the master at every tick, so it can tell a master
-  // that has nothing for it yet from one that is gone.
+  // A server that holds no job hears from the master every quarter deadline (or refresh), so it
+  // can tell a master that has nothing for it yet from one that is gone.
   void keepIdleServersWaiting() {
     for (Server& s : servers_)
       if (s.hello && !s.record.lost() && s.holding.empty())
@@ -289,6 +298,7 @@ class Master {
   std::deque<int> requeued_;
   std::size_t done_ = 0, orphanScan_ = 0;
   bool anyLost_ = false, warned_ = false;
+  FarmFault fault_ = farmFaultFromEnvironment();
   FarmRecord record_;
 };
 

@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <deque>
 #include <fstream>
@@ -32,9 +33,7 @@ class Server {
         lastHeard_ = Clock::now();
         return std::move(*e);
       }
-      if (since(lastHeard_) > seconds)
-        throw std::runtime_error("the farm's master (rank 0) sent nothing for " + std::to_string(int(seconds)) +
-                                 " s while this server waited for " + what + "; ending");
+      if (since(lastHeard_) > seconds) masterLost("sent nothing for " + std::to_string(int(seconds)) + " s while this server waited for " + what);
       std::this_thread::sleep_for(std::chrono::microseconds(100));
     }
   }
@@ -62,8 +61,15 @@ class Server {
   void send(const Bytes& b) { t_.send(0, farm::kToMasterTag, b); }
   void flush() {
     if (!t_.flush(options_.deadlineSeconds))
-      throw std::runtime_error("a result to the farm's master (rank 0) had not left after " +
-                               std::to_string(int(options_.deadlineSeconds)) + " s; ending");
+      masterLost("took no result for " + std::to_string(int(options_.deadlineSeconds)) + " s");
+  }
+
+  // The master is gone or hung: nothing this server does can reach the user, and the ending
+  // protocol would wait for the master too, so the server ends every rank at once.
+  [[noreturn]] void masterLost(const std::string& how) {
+    std::fprintf(stderr, "parrender: failed (rank %d of %d): the farm's master (rank 0) %s; ending every rank\n", t_.rank(),
+                 t_.ranks(), how.c_str());
+    t_.abortAll(1);
   }
 
   Transport& t_;
@@ -88,8 +94,8 @@ FarmFault farmFaultFromEnvironment() {
   const std::string text(v);
   char pid[512] = {};
   const int n = std::sscanf(v, "%d:%d:%d:%511s", &f.rank, &f.afterJobs, &f.signal, pid);
-  if (n < 3 || f.rank < 1 || f.afterJobs < 0 || f.signal <= 0 || f.signal >= 32)
-    throw InputError("PARRENDER_FARM_FAULT must be RANK:JOBS:SIGNAL[:PIDFILE] with RANK >= 1, not '" + text + "'");
+  if (n < 3 || f.rank < 0 || f.afterJobs < 0 || f.signal <= 0 || f.signal >= 32)
+    throw InputError("PARRENDER_FARM_FAULT must be RANK:JOBS:SIGNAL[:PIDFILE] with RANK >= 0, not '" + text + "'");
   if (n == 4) f.pidFile = pid;
   return f;
 }
