@@ -6,13 +6,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <fstream>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
 
+#include "common/parallel/farm/farm.h"
+#include "common/parallel/farm/farm_replay.h"
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_options.h"
 #include "common/parallel/simulator.h"
@@ -84,9 +88,59 @@ double broadcastSeconds(const par::RunRecord& predicted, const par::NetworkModel
   return total;
 }
 
+// The run record in `file` when it is one of a farm (render --farm), else nothing.
+std::optional<par::RunRecord> farmRecordIn(const std::string& file) {
+  std::ifstream in(file);
+  char first = 0;
+  in >> first;
+  if (first != '{') return std::nullopt;
+  par::RunRecord record = par::readRunRecord(file);
+  if (!record.farm) return std::nullopt;
+  return record;
+}
+
+// A farm's record at other numbers of servers (common/parallel/farm/farm_replay.h): --pes
+// counts servers, each with the recorded servers' PEs.
+void simulateFarm(const par::RunRecord& record, const std::vector<int>& serversList, const par::NetworkModel& network,
+                  const SimulateArgs& args) {
+  const par::FarmRecord& farm = *record.farm;
+  if (record.stages.size() < 2) throw InputError(args.input + ": a farm record has its jobs as its second stage");
+  const par::StageRecord& jobs = record.stages[1];
+  const std::string schedule = args.scheduleGiven ? args.schedule.schedule : farm.schedule;
+  const int pes = farm.servers.empty() ? 1 : farm.servers.front().pes;
+  par::TaskSet tasks;
+  tasks.tasks = jobs.tasks;
+  std::printf("recorded farm: %zu servers of %d PE%s, %zu jobs (%s) in the order of %s; jobs stage %.6f s, farm %.6f s\n",
+              farm.servers.size(), pes, pes == 1 ? "" : "s", farm.jobs.size(), farm.jobShape.c_str(), farm.schedule.c_str(),
+              jobs.wallSeconds, farm.wallSeconds);
+  std::printf("schedule %s; network %s (%s); results reach the master one after another over its link\n",
+              schedule.c_str(), std::string(network.name).c_str(), std::string(network.description).c_str());
+  const auto predictAt = [&](int servers) {
+    std::unique_ptr<par::Scheduler> order = par::makeScheduler(schedule);
+    return par::predictFarm(farm, tasks, par::kFarmJobBytes, servers, network, *order, args.schedule.params);
+  };
+  const par::FarmPrediction one = predictAt(1);
+  const par::FarmPrediction recorded = predictAt(int(farm.servers.size()));
+  std::printf("at the recorded %zu servers: jobs stage predicted %.6f s, measured %.6f s (%+.1f%%)\n\n", farm.servers.size(),
+              recorded.jobsSeconds, jobs.wallSeconds,
+              jobs.wallSeconds > 0.0 ? 100.0 * (recorded.jobsSeconds - jobs.wallSeconds) / jobs.wallSeconds : 0.0);
+  std::printf("%8s %14s %12s %14s %16s\n", "servers", "makespan s", "jobs s", "jobs speed-up", "master link s");
+  for (int servers : serversList) {
+    const par::FarmPrediction p = predictAt(servers);
+    std::printf("%8d %14.6f %12.6f %14.3f %16.6f\n", servers, p.makespanSeconds, p.jobsSeconds,
+                p.jobsSeconds > 0.0 ? one.jobsSeconds / p.jobsSeconds : 0.0, p.masterLinkSeconds);
+  }
+  std::printf("\nmakespan: every server's pre-passes (the recorded mean, %.6f s: each server runs them itself) and the jobs\n",
+              one.prepareSeconds);
+}
+
 void runSimulate(const SimulateArgs& args) {
   const par::NetworkModel& network = par::networkByName(args.network);
   const std::vector<int> pesList = parsePesList(args.pes);
+  if (const std::optional<par::RunRecord> farm = farmRecordIn(args.input)) {
+    simulateFarm(*farm, pesList, network, args);
+    return;
+  }
   const par::Workload workload = par::readWorkload(args.input);
   const bool fromRecord = workload.recordedPes > 0;
 

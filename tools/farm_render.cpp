@@ -238,7 +238,7 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
   record.jobShape = "screen area " + std::to_string(size.w) + "x" + std::to_string(size.h);
   for (const par::FarmServerRecord& s : record.servers)
     if (s.lost()) group.markLost(s.rank);
-  return farmRunRecord(std::move(record), jobs.tasks, 1 + sizeof(std::int32_t));
+  return farmRunRecord(std::move(record), jobs.tasks, par::kFarmJobBytes);
 }
 
 void printFarmSummary(const par::RunRecord& record) {

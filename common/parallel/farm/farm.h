@@ -28,6 +28,9 @@
 
 namespace pr::par {
 
+// A job message's size: its kind and the job's id (farm_messages.h).
+inline constexpr std::size_t kFarmJobBytes = 1 + sizeof(std::int32_t);
+
 struct FarmOptions {
   double deadlineSeconds = 30.0;  // a server holding jobs that sends nothing this long is lost
   int jobsAhead = 2;              // jobs a server holds at once: one in work, the next ones already there

@@ -70,6 +70,7 @@ class Server {
     std::fprintf(stderr, "parrender: failed (rank %d of %d): the farm's master (rank 0) %s; ending every rank\n", t_.rank(),
                  t_.ranks(), how.c_str());
     t_.abortAll(1);
+    std::_Exit(1);  // abortAll does not return; the compiler cannot see that through the virtual call
   }
 
   Transport& t_;

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "common/parallel/farm/farm.h"
+#include "common/parallel/farm/farm_replay.h"
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
 #include "in_process_ranks.h"
@@ -189,4 +190,31 @@ TEST_CASE("Farm: a server whose scene differs fails the run, naming its rank") {
 TEST_CASE("Farm: when every server is lost the master says so instead of waiting") {
   const FarmRun run = runFarm(3, 20, "demand", {{1, true}, {1, true}}, 0.2);
   CHECK(run.masterError.find("every farm server was lost") != std::string::npos);
+}
+
+TEST_CASE("Farm replay: jobs shared among servers, results one after another into the master's link") {
+  // Eight jobs of 1 s each, one held at a time, results of 1.25 MB (0.1 s at 100 Mbit/s).
+  pr::par::FarmRecord farm;
+  farm.jobsAhead = 1;
+  farm.servers.resize(2);
+  for (pr::par::FarmServerRecord& s : farm.servers) s.prepareSeconds = 0.5;
+  for (int j = 0; j < 8; ++j) farm.jobs.push_back({j, 1, 0.0, 0.0, 1.0, 1, 1250000});
+  const pr::par::TaskSet tasks = pr::par::TaskSet::grid(8, 1);
+  const auto predict = [&](int servers, const pr::par::NetworkModel& network) {
+    std::unique_ptr<pr::par::Scheduler> order = pr::par::makeScheduler("demand");
+    return pr::par::predictFarm(farm, tasks, pr::par::kFarmJobBytes, servers, network, *order, pr::par::ScheduleParams{});
+  };
+  const pr::par::NetworkModel free{"free", 0.0, 0.0, ""};
+  CHECK(predict(1, free).jobsSeconds == doctest::Approx(8.0));
+  CHECK(predict(2, free).jobsSeconds == doctest::Approx(4.0));
+  CHECK(predict(8, free).jobsSeconds == doctest::Approx(1.0));
+  CHECK(predict(8, free).makespanSeconds == doctest::Approx(1.5));  // the pre-passes first
+  CHECK(predict(16, free).jobsSeconds == doctest::Approx(1.0));     // no job to share further
+  // 8 servers finish together; their results queue at the master's link: the last arrives
+  // 8 x 0.1 s later, plus one latency; the job messages (5 bytes) cost a latency each.
+  const pr::par::NetworkModel slow{"slow", 0.001, 12.5e6, ""};
+  const pr::par::FarmPrediction p = predict(8, slow);
+  CHECK(p.masterLinkSeconds == doctest::Approx(0.8));
+  CHECK(p.jobsSeconds == doctest::Approx(0.001 + 5 / 12.5e6 + 1.0 + 0.8 + 0.001));
+  CHECK_THROWS_AS(predict(0, free), pr::InputError);
 }
