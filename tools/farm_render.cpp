@@ -9,6 +9,8 @@
 
 #include "common/image/image_io.h"
 #include "common/parallel/farm/farm.h"
+#include "common/parallel/farm/server_group.h"
+#include "common/parallel/metrics.h"
 #include "common/parallel/process_group.h"
 #include "common/parallel/runtime.h"
 #include "common/parallel/wire.h"
@@ -55,10 +57,22 @@ par::FarmOptions farmOptions(const FarmArgs& farm) {
   o.jobsAhead = farm.jobsAhead;
   o.refreshSeconds = farm.refreshSeconds;
   o.readySeconds = par::ProcessGroup::get().timeoutSeconds();
+  o.sharedPrepass = farm.prepass == "shared";
   return o;
 }
 
-// A server: its own runtime of `threads` PEs, the world BVH and the integrator's pre-passes,
+// What the run record of shared pre-passes booked between ranks (servers): messages and bytes.
+par::PrepareTraffic betweenServers(const par::RunRecord& record) {
+  par::PrepareTraffic t;
+  for (const par::KindTraffic& k : par::summarize(record).total.byKind) {
+    t.messages += k.betweenRankMessages;
+    t.bytes += k.betweenRankBytes;
+  }
+  return t;
+}
+
+// A server: its own runtime of `threads` PEs, the world BVH and the integrator's pre-passes
+// (on that runtime, or shared: on a runtime across the servers, the master not among them),
 // then one stage per job over the job's tiles.
 void serve(const FarmArgs& farm, const FarmInput& in, const FarmJobs& jobs, std::uint64_t hash) {
   par::ProcessGroup& group = par::ProcessGroup::get();
@@ -66,12 +80,21 @@ void serve(const FarmArgs& farm, const FarmInput& in, const FarmJobs& jobs, std:
   const RenderRequest request{in.scene, in.camera, in.width, in.height, in.settings, in.plan, runtime, {}};
   std::unique_ptr<rt::PreparedRays> prepared;
   std::unique_ptr<rt::Bvh> bvh;
+  par::ServerGroupTransport servers(group.transport());
+  std::unique_ptr<par::Runtime> shared;
   const auto prepare = [&] {
+    par::Runtime* pre = &runtime;
+    if (farm.prepass == "shared") {
+      shared = std::make_unique<par::Runtime>(par::RuntimeOptions{servers.ranks() * in.threads, in.schedule.schedule,
+                                                                  in.schedule.params, false, &servers});
+      pre = shared.get();
+    }
     rt::TraceJob job = rayJobFor(request);
     job.options.bvh.alpha = rt::AlphaTest::forScene(in.scene);
-    runtime.runOnOnePe("build", 0, [&](par::Pe&) { bvh = std::make_unique<rt::Bvh>(in.scene, job.options.bvh); });
+    pre->runOncePerRank("build", [&](par::Pe&) { bvh = std::make_unique<rt::Bvh>(in.scene, job.options.bvh); });
     job.options.worldBvh = bvh.get();
-    prepared = std::make_unique<rt::PreparedRays>(rt::prepareRays(job, kFarmMethod, runtime));
+    prepared = std::make_unique<rt::PreparedRays>(rt::prepareRays(job, kFarmMethod, *pre));
+    return shared ? betweenServers(shared->record()) : par::PrepareTraffic{};
   };
   const auto work = [&](int id) {
     const rt::TraceJob& job = prepared->job;
@@ -157,6 +180,12 @@ void addFarmOptions(CLI::App& command, FarmArgs& args) {
       ->capture_default_str();
   command.add_option("--farm-refresh", args.refreshSeconds, "--farm: seconds between rewrites of the image (and --progress lines)")
       ->check(CLI::Range(0.1, 86400.0))
+      ->capture_default_str();
+  command.add_option("--farm-prepass", args.prepass,
+                     "--farm: each server runs the pre-passes whole (replicated: no traffic, survives any server's loss) or "
+                     "its share of them, the results all-gathered among the servers (shared: less work; a server lost before "
+                     "they are done fails the run)")
+      ->check(CLI::IsMember({"replicated", "shared"}))
       ->capture_default_str();
   command.add_option("--farm-ahead", args.jobsAhead, "--farm: jobs a server holds at once (the next ones wait there while it works)")
       ->check(CLI::Range(1, 64))
@@ -244,12 +273,17 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
 void printFarmSummary(const par::RunRecord& record) {
   if (!record.farm) return;
   const par::FarmRecord& f = *record.farm;
-  std::printf("farm: %zu jobs (%s) in the order of %s, %zu servers, deadline %.1f s, wall %.3f s\n", f.jobs.size(),
-              f.jobShape.c_str(), f.schedule.c_str(), f.servers.size(), f.deadlineSeconds, f.wallSeconds);
+  std::printf("farm: %zu jobs (%s) in the order of %s, %zu servers, pre-passes %s, deadline %.1f s, wall %.3f s\n",
+              f.jobs.size(), f.jobShape.c_str(), f.schedule.c_str(), f.servers.size(), f.prepass.c_str(), f.deadlineSeconds,
+              f.wallSeconds);
   int handedOn = 0, late = 0;
   for (const par::FarmServerRecord& s : f.servers) {
-    std::printf("  server rank %d (%d PE%s): %zu jobs, pre-passes %.3f s, busy %.3f s, idle %.3f s", s.rank, s.pes,
-                s.pes == 1 ? "" : "s", s.jobs.size(), s.prepareSeconds, s.busySeconds, s.idleSeconds);
+    std::printf("  server rank %d (%d PE%s): %zu jobs, pre-passes %.3f s", s.rank, s.pes, s.pes == 1 ? "" : "s", s.jobs.size(),
+                s.prepareSeconds);
+    if (f.prepass == "shared")
+      std::printf(" (shared: %llu messages, %llu bytes between servers)", (unsigned long long)s.prepareMessages,
+                  (unsigned long long)s.prepareBytes);
+    std::printf(", busy %.3f s, idle %.3f s", s.busySeconds, s.idleSeconds);
     if (s.lost()) std::printf("; lost at %.2f s (last heard %.2f s), %zu job(s) handed on", s.lostAtSeconds, s.lastHeardSeconds, s.handedOn.size());
     if (s.lateResults > 0) std::printf("; %d late result(s) discarded", s.lateResults);
     std::printf("\n");

@@ -4,8 +4,10 @@
 // the order of --farm-schedule, assembles the image as results arrive and rewrites it every
 // --farm-refresh seconds; every other rank is a server with --threads PEs of its own, which runs
 // the pre-passes itself from the same seed (so every server holds the same photon maps and
-// irradiance cache, and the image is bit-identical to a single process's) and renders each job
-// as a stage of its own runtime, its tiles ordered by --schedule among its PEs.
+// irradiance cache, and the image is bit-identical to a single process's) - or, with
+// --farm-prepass shared, runs them as one computation across the servers (each its share, the
+// results all-gathered, as the runtime across processes does) - and renders each job as a stage
+// of its own runtime, its tiles ordered by --schedule among its PEs.
 #pragma once
 
 #include <string>
@@ -26,6 +28,7 @@ struct FarmArgs {
   int jobsAhead = 2;
   bool progress = false;
   std::string statusFile;  // --farm-status: the run's exit status, written by rank 0 at the end
+  std::string prepass = "replicated";  // --farm-prepass: replicated | shared
 };
 void addFarmOptions(CLI::App& command, FarmArgs& args);
 

@@ -84,6 +84,8 @@ json farmJson(const FarmRecord& f) {
     json js = {{"rank", s.rank},
                {"pes", s.pes},
                {"prepareSeconds", s.prepareSeconds},
+               {"prepareMessages", s.prepareMessages},
+               {"prepareBytes", s.prepareBytes},
                {"busySeconds", s.busySeconds},
                {"idleSeconds", s.idleSeconds},
                {"jobs", s.jobs},
@@ -98,7 +100,7 @@ json farmJson(const FarmRecord& f) {
   json jobs = json::array();
   for (const FarmJobRecord& j : f.jobs)
     jobs.push_back({j.job, j.server, j.sentSeconds, j.doneSeconds, j.busySeconds, j.attempts, j.resultBytes});
-  return {{"schedule", f.schedule},     {"deadlineSeconds", f.deadlineSeconds}, {"jobsAhead", f.jobsAhead},
+  return {{"schedule", f.schedule},     {"prepass", f.prepass}, {"deadlineSeconds", f.deadlineSeconds}, {"jobsAhead", f.jobsAhead},
           {"jobShape", f.jobShape},     {"wallSeconds", f.wallSeconds},         {"servers", servers},
           {"jobs", jobs}};  // jobs: [job, server, sentSeconds, doneSeconds, busySeconds, attempts, resultBytes]
 }
@@ -257,6 +259,7 @@ FarmRecord parseFarm(const json& jf, const std::string& origin) {
   if (!jf.is_object()) throw InputError(origin + ": \"farm\" must be an object");
   FarmRecord f;
   f.schedule = jf.value("schedule", std::string());
+  f.prepass = jf.value("prepass", std::string("replicated"));
   f.deadlineSeconds = optionalField(jf, "deadlineSeconds", 0.0, origin, where);
   f.jobsAhead = optionalField(jf, "jobsAhead", 1, origin, where);
   f.jobShape = jf.value("jobShape", std::string());
@@ -267,6 +270,8 @@ FarmRecord parseFarm(const json& jf, const std::string& origin) {
     s.rank = field<int>(js, "rank", origin, server);
     s.pes = optionalField(js, "pes", 1, origin, server);
     s.prepareSeconds = optionalField(js, "prepareSeconds", 0.0, origin, server);
+    s.prepareMessages = optionalField(js, "prepareMessages", std::uint64_t{0}, origin, server);
+    s.prepareBytes = optionalField(js, "prepareBytes", std::uint64_t{0}, origin, server);
     s.busySeconds = optionalField(js, "busySeconds", 0.0, origin, server);
     s.idleSeconds = optionalField(js, "idleSeconds", 0.0, origin, server);
     s.jobs = intList(js, "jobs", origin, server);

@@ -88,6 +88,54 @@ TEST_CASE("render --farm: the photon map's pre-passes on every server give the s
   CHECK(pr::image::readImage(dir / "farm.exr").pixels == expected.pixels);
 }
 
+TEST_CASE("render --farm: pre-passes shared among the servers give the single-process image, their traffic counted") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_shared");
+  const std::string common =
+      join({"render ", cornell(), " --width 48 --height 36 --integrator photonmap --spp 2 --photons 4000"});
+  const pr::image::Image expected = reference(dir, common);
+  for (const char* prepass : {"replicated", "shared"}) {
+    CAPTURE(prepass);
+    const std::filesystem::path out = dir / (std::string(prepass) + ".exr"), record = dir / (std::string(prepass) + ".json");
+    const CommandResult r = farmRun(4, join({common, " --farm --farm-job 16x12 --farm-prepass ", prepass, " -o ", quoted(out),
+                                             " --metrics ", quoted(record)}));
+    INFO(r.output);
+    REQUIRE(r.exitStatus == 0);
+    CHECK(pr::image::readImage(out).pixels == expected.pixels);
+    const pr::par::RunRecord run = pr::par::readRunRecord(record);
+    REQUIRE(run.farm.has_value());
+    CHECK(run.farm->prepass == prepass);
+    for (const pr::par::FarmServerRecord& s : run.farm->servers) {
+      // Shared: every server sends its share of the photons and records to the others.
+      if (std::string(prepass) == "shared")
+        CHECK(s.prepareBytes > 0);
+      else
+        CHECK(s.prepareBytes == 0);
+    }
+  }
+}
+
+TEST_CASE("render --farm: a server killed before its pre-passes are done: replicated goes on, shared fails at once") {
+  const std::filesystem::path dir = pr::test::scratchDir("render_farm_prepass_loss");
+  const std::string common =
+      join({"render ", cornell(), " --width 48 --height 36 --integrator photonmap --spp 2 --photons 4000 --farm --farm-deadline 1"});
+  const pr::image::Image expected = reference(dir, join({"render ", cornell(), " --width 48 --height 36 --integrator photonmap --spp 2 --photons 4000"}));
+  // Server rank 2 kills itself as it starts its pre-passes.
+  const CommandResult replicated = farmRun(3, join({common, " -o ", quoted(dir / "replicated.exr"), " --farm-status ", quoted(dir / "status")}),
+                                           "PARRENDER_FARM_FAULT=2:-1:9", 60);
+  INFO(replicated.output);
+  CHECK(statusIn(dir / "status") == "0");
+  CHECK(replicated.output.find("server rank 2 declared lost") != std::string::npos);
+  CHECK(pr::image::readImage(dir / "replicated.exr").pixels == expected.pixels);
+  std::filesystem::remove(dir / "status");
+  const CommandResult shared = farmRun(3, join({common, " --farm-prepass shared -o ", quoted(dir / "shared.exr"), " --farm-status ",
+                                                quoted(dir / "status")}),
+                                       "PARRENDER_FARM_FAULT=2:-1:9", 60);
+  INFO(shared.output);
+  CHECK(shared.exitStatus != 124);  // ended by the master within the deadline, not by timeout
+  CHECK(occurrences(shared.output, "farm server rank 2 was lost before its shared pre-passes were done") == 1);
+  CHECK_FALSE(std::filesystem::exists(dir / "status"));
+}
+
 // The render of the loss tests: long enough (jobs of 32x24, about 0.1 s each here) that the
 // master is still at work when a lost server wakes up.
 const std::string kLossArgs = " --width 160 --height 120 --spp 128 --farm-deadline 1";

@@ -35,7 +35,16 @@ struct FarmOptions {
   double deadlineSeconds = 30.0;  // a server holding jobs that sends nothing this long is lost
   int jobsAhead = 2;              // jobs a server holds at once: one in work, the next ones already there
   double refreshSeconds = 2.0;    // how often the master reports progress (and keeps idle servers waiting)
-  double readySeconds = 300.0;    // how long a server may take to load and run its pre-passes
+  double readySeconds = 300.0;    // how long a server may take to load the scene and say hello
+  // The servers' pre-passes are one computation shared among them (each traces its share, the
+  // results all-gathered): a server lost before it is ready then ends every rank at once,
+  // since the others wait for its share. Otherwise each server's pre-passes are its own.
+  bool sharedPrepass = false;
+};
+
+// What a server's pre-passes sent to other servers (shared pre-passes; zero otherwise).
+struct PrepareTraffic {
+  std::uint64_t messages = 0, bytes = 0;
 };
 
 // The master's view at a progress tick.
@@ -66,20 +75,23 @@ FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::
                          const std::function<void(int job, int server, std::span<const std::byte> result)>& accept,
                          const std::function<void(const FarmProgress&)>& tick);
 
-// On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes),
-// then does the jobs it is sent, work(job) making each one's result, until the master says stop.
+// On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes,
+// telling the master it is alive every quarter deadline meanwhile), then does the jobs it is
+// sent, work(job) making each one's result, until the master says stop. A server that says
+// hello and then falls silent for deadlineSeconds before it is ready is lost like one holding jobs.
 // A failure of prepare or work is reported to the master and rethrown; a master that stops
 // answering for deadlineSeconds (readySeconds for the welcome) ends every rank
 // (Transport::abortAll, status 1); when the master stops the farm because of another rank's
 // failure, throws FailedElsewhere (runtime.h).
 void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64_t contentHash, int pes,
-                   const std::function<void()>& prepare, const std::function<Bytes(int job)>& work);
+                   const std::function<PrepareTraffic()>& prepare, const std::function<Bytes(int job)>& work);
 
 // A fault for tests (PARRENDER_FARM_FAULT="RANK:JOBS:SIGNAL[:PIDFILE]"): the server on rank RANK,
 // having sent JOBS results, as it starts its next job (so it holds at least that one), writes
 // its process id to PIDFILE (when given) and raises SIGNAL (a number: 9 kills it, 19 stops it
-// until a SIGCONT, after which it finishes the job and sends a late result). RANK 0: the master,
-// once it has accepted JOBS results. Read by runFarmServer and runFarmMaster.
+// until a SIGCONT, after which it finishes the job and sends a late result); JOBS -1: as it
+// starts its pre-passes. RANK 0: the master, once it has accepted JOBS results. Read by
+// runFarmServer and runFarmMaster.
 struct FarmFault {
   int rank = -1, afterJobs = 0, signal = 0;
   std::string pidFile;

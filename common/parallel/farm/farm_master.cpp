@@ -27,6 +27,7 @@ struct Server {
   std::deque<int> holding;  // jobs sent and not yet done, oldest first
   std::deque<TaskId> granted;  // the rest of a grab of several jobs (--grain)
   bool scheduleDone = false;   // the schedule has nothing more for it
+  bool goodbye = false;        // it answered the stop at the end
   double silentSince = 0.0;  // the time from which its silence counts
 };
 
@@ -41,6 +42,7 @@ class Master {
     state_.assign(jobs.size(), JobState::InPool);
     holder_.assign(jobs.size(), -1);
     record_.schedule = std::string(order.name());
+    record_.prepass = options.sharedPrepass ? "shared" : "replicated";
     record_.deadlineSeconds = options.deadlineSeconds;
     record_.jobsAhead = options.jobsAhead;
     record_.jobs.resize(jobs.size());
@@ -81,6 +83,7 @@ class Master {
     }
     stopAll(farm::MasterSays::Stop);
     record_.wallSeconds = seconds();
+    awaitGoodbyes();
     for (Server& s : servers_) record_.servers.push_back(std::move(s.record));
     tick(progressOfRecord());
     return std::move(record_);
@@ -116,11 +119,19 @@ class Master {
         t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
         return;
       }
-      case farm::ServerSays::Ready:
+      case farm::ServerSays::Ready: {
+        const auto ready = r.value<farm::Ready>();
         s.ready = true;
-        s.record.prepareSeconds = r.value<farm::Ready>().prepareSeconds;
+        s.record.prepareSeconds = ready.prepareSeconds;
+        s.record.prepareMessages = ready.prepareMessages;
+        s.record.prepareBytes = ready.prepareBytes;
         topUp(e.source);
         return;
+      }
+      case farm::ServerSays::Preparing:
+        return;  // alive: heard above
+      case farm::ServerSays::Bye:
+        return;  // only after the stop (awaitGoodbyes)
       case farm::ServerSays::Result: {
         const auto h = r.value<farm::ResultHeader>();
         const std::span<const std::byte> result = std::span(e.bytes).subspan(1 + sizeof h);
@@ -217,8 +228,18 @@ class Master {
     for (Server& s : servers_) {
       if (s.record.lost()) continue;
       const bool holdsWork = s.ready && !s.holding.empty();
-      const bool neverReady = !s.ready && now > options_.readySeconds;
-      if (!(holdsWork && now - s.silentSince > options_.deadlineSeconds) && !neverReady) continue;
+      const bool preparing = s.hello && !s.ready;
+      const bool neverHello = !s.hello && now > options_.readySeconds;
+      if (!((holdsWork || preparing) && now - s.silentSince > options_.deadlineSeconds) && !neverHello) continue;
+      if (!s.ready && options_.sharedPrepass) {
+        // The other servers wait in the shared pre-passes for its share: no job can be done.
+        std::fprintf(stderr,
+                     "parrender: failed (rank 0 of %d): farm server rank %d was lost before its shared pre-passes were done "
+                     "(the other servers need its share of them); ending every rank\n",
+                     t_.ranks(), s.record.rank);
+        std::fflush(stderr);
+        t_.abortAll(1);
+      }
       s.record.lostAtSeconds = now;
       anyLost_ = true;
       for (int j : s.holding) {
@@ -232,10 +253,39 @@ class Master {
       // Should it wake up, it finishes the job in hand, sends that (late) result and stops.
       t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Stop));
       std::fprintf(stderr, "parrender: farm: server rank %d declared lost after %.1f s of silence%s; %zu job(s) handed on\n",
-                   s.record.rank, now - s.silentSince, s.ready ? "" : " (never ready)", s.record.handedOn.size());
+                   s.record.rank, now - s.silentSince, s.ready ? "" : " (before it was ready)", s.record.handedOn.size());
     }
     if (handedOn)
       for (Server& s : servers_) topUp(s.record.rank);
+  }
+
+  // After the stop: every server not lost says goodbye within the deadline. One that does not
+  // (it died after its last message, stopped, or is still in its pre-passes) is lost too, so
+  // that the run's end does not wait for it.
+  void awaitGoodbyes() {
+    const double until = seconds() + options_.deadlineSeconds;
+    for (;;) {
+      while (std::optional<Envelope> e = t_.poll(farm::kToMasterTag)) {
+        if (e->source < 1 || e->source >= t_.ranks() || e->bytes.empty()) continue;
+        Server& s = server(e->source);
+        const auto kind = farm::ServerSays(e->bytes[0]);
+        if (kind == farm::ServerSays::Bye) s.goodbye = true;
+        if (kind == farm::ServerSays::Result) ++s.record.lateResults;
+      }
+      bool waiting = false;
+      for (const Server& s : servers_) waiting = waiting || (!s.record.lost() && !s.goodbye);
+      if (!waiting) return;
+      if (seconds() > until) break;
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    for (Server& s : servers_) {
+      if (s.record.lost() || s.goodbye) continue;
+      s.record.lostAtSeconds = seconds();
+      std::fprintf(stderr,
+                   "parrender: farm: server rank %d declared lost: it did not answer the stop within %.1f s (dead, stopped, or "
+                   "still in its pre-passes)\n",
+                   s.record.rank, options_.deadlineSeconds);
+    }
   }
 
   void checkSomeServerLeft() {

@@ -3,6 +3,7 @@
 // every job, who did it and when. Times are seconds on the master's clock since the farm began.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,8 @@ struct FarmServerRecord {
   int rank = 0;
   int pes = 1;                  // the server's own PEs (--threads)
   double prepareSeconds = 0.0;  // its pre-passes (BVH, photon maps, irradiance cache), as it measured them
+  // Shared pre-passes: the messages and bytes between servers its run record booked.
+  std::uint64_t prepareMessages = 0, prepareBytes = 0;
   double busySeconds = 0.0;     // doing jobs whose results counted
   double idleSeconds = 0.0;     // waiting for a job after its pre-passes, as it last reported
   std::vector<int> jobs;        // the jobs whose results counted, in the order they arrived
@@ -34,6 +37,7 @@ struct FarmJobRecord {
 
 struct FarmRecord {
   std::string schedule;  // the master's order of jobs
+  std::string prepass = "replicated";  // every server runs the pre-passes whole, or "shared" among them
   double deadlineSeconds = 0.0;
   int jobsAhead = 1;
   std::string jobShape;  // what a job is, e.g. "screen area 32x24"

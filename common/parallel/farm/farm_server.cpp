@@ -4,6 +4,8 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <condition_variable>
+#include <mutex>
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
@@ -86,6 +88,35 @@ void injectFault(const FarmFault& fault, int rank, int sent) {
   raise(fault.signal);
 }
 
+// Runs prepare() while a thread tells the master every quarter deadline that this server is
+// alive (its pre-passes may take far longer than the deadline).
+PrepareTraffic preparing(Server& s, const std::function<PrepareTraffic()>& prepare) {
+  std::mutex mutex;
+  std::condition_variable finished;
+  bool done = false;
+  const auto every = std::chrono::duration<double>(s.options_.deadlineSeconds / 4.0);
+  std::thread heartbeat([&] {
+    std::unique_lock<std::mutex> lock(mutex);
+    while (!finished.wait_for(lock, every, [&] { return done; })) s.send(farm::message(farm::ServerSays::Preparing));
+  });
+  const auto stop = [&] {
+    {
+      std::lock_guard<std::mutex> lock(mutex);
+      done = true;
+    }
+    finished.notify_one();
+    heartbeat.join();
+  };
+  try {
+    const PrepareTraffic traffic = prepare();
+    stop();
+    return traffic;
+  } catch (...) {
+    stop();
+    throw;
+  }
+}
+
 }  // namespace
 
 FarmFault farmFaultFromEnvironment() {
@@ -95,14 +126,14 @@ FarmFault farmFaultFromEnvironment() {
   const std::string text(v);
   char pid[512] = {};
   const int n = std::sscanf(v, "%d:%d:%d:%511s", &f.rank, &f.afterJobs, &f.signal, pid);
-  if (n < 3 || f.rank < 0 || f.afterJobs < 0 || f.signal <= 0 || f.signal >= 32)
+  if (n < 3 || f.rank < 0 || f.afterJobs < -1 || f.signal <= 0 || f.signal >= 32)
     throw InputError("PARRENDER_FARM_FAULT must be RANK:JOBS:SIGNAL[:PIDFILE] with RANK >= 0, not '" + text + "'");
   if (n == 4) f.pidFile = pid;
   return f;
 }
 
 void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64_t contentHash, int pes,
-                   const std::function<void()>& prepare, const std::function<Bytes(int)>& work) {
+                   const std::function<PrepareTraffic()>& prepare, const std::function<Bytes(int)>& work) {
   const FarmFault fault = farmFaultFromEnvironment();
   Server s(transport, options);
   const auto failed = [&](int status, const std::string& text) {
@@ -111,24 +142,30 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
     (void)transport.flush(options.deadlineSeconds);
   };
   s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes}));
-  if (!s.take(s.await(options.readySeconds, "its welcome"))) return;
+  // Told to stop: it says so, so the master knows it is not waiting for a lost rank.
+  const auto leave = [&] {
+    s.send(farm::message(farm::ServerSays::Bye));
+    (void)transport.flush(options.deadlineSeconds);
+  };
+  if (!s.take(s.await(options.readySeconds, "its welcome"))) return leave();
   double idle = 0.0;
   int sent = 0;
   try {
     const Clock::time_point started = Clock::now();
-    prepare();
-    s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started)}));
+    injectFault(fault, transport.rank(), -1);
+    const PrepareTraffic traffic = preparing(s, prepare);
+    s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started), traffic.messages, traffic.bytes}));
     for (;;) {
       // Every message already here first: a stop, or the next jobs.
       while (std::optional<Envelope> e = transport.poll(farm::kToServerTag)) {
         s.lastHeard_ = Clock::now();
-        if (!s.take(*e)) return;
+        if (!s.take(*e)) return leave();
       }
       if (s.jobs_.empty()) {
         const Clock::time_point waiting = Clock::now();
         const bool more = s.take(s.await(options.deadlineSeconds, "a job"));
         idle += since(waiting);
-        if (!more) return;
+        if (!more) return leave();
         continue;
       }
       const int job = s.jobs_.front();

@@ -66,7 +66,7 @@ FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vec
             const ServerPlan plan = plans.empty() ? ServerPlan{} : plans[std::size_t(r - 1)];
             int done = 0;
             try {
-              pr::par::runFarmServer(net.rank(r), options, plan.hash, 1, [] {}, [&](int job) {
+              pr::par::runFarmServer(net.rank(r), options, plan.hash, 1, [] { return pr::par::PrepareTraffic{}; }, [&](int job) {
                 if (plan.fails) throw std::runtime_error("no memory for job " + std::to_string(job));
                 if (done == plan.afterJobs) {
                   if (plan.dies) throw DeathOfServer{};
