@@ -262,11 +262,18 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
     std::fprintf(stderr, "farm: %d/%d jobs done, %d server(s) working, %d preparing, lost: %s, %.1f s\n", p.jobsDone, p.jobs,
                  p.serversWorking, p.serversPreparing, lost.empty() ? "none" : lost.c_str(), p.seconds);
   };
-  par::FarmRecord record = par::runFarmMaster(transport, farmOptions(farm), hash, jobs.tasks, *order,
-                                              in.schedule.params, accept, tick);
+  // A lost server is marked at once, so that any ending (a failure too) does not wait for it.
+  const auto lost = [&group](int rank) { group.markLost(rank); };
+  par::FarmRecord record;
+  try {
+    record = par::runFarmMaster(transport, farmOptions(farm), hash, jobs.tasks, *order, in.schedule.params, accept, tick, lost);
+  } catch (const par::FarmSharedPrepassLost& e) {
+    group.abortRun(1, e.what());
+  } catch (const par::FarmServerFailed& e) {
+    if (e.status == kExitBadInput) throw InputError(e.what());
+    throw;
+  }
   record.jobShape = "screen area " + std::to_string(size.w) + "x" + std::to_string(size.h);
-  for (const par::FarmServerRecord& s : record.servers)
-    if (s.lost()) group.markLost(s.rank);
   return farmRunRecord(std::move(record), jobs.tasks, par::kFarmJobBytes);
 }
 

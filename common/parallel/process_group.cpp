@@ -15,6 +15,7 @@
 
 #include "common/parallel/runtime.h"
 #include "common/util/error.h"
+#include "common/util/hash.h"
 #include "common/util/module_loader.h"
 
 namespace pr::par {
@@ -43,13 +44,9 @@ int decodeStatus(const Bytes& b, std::string& text) {
 
 // FNV-1a over the arguments after the program name, each ended by a zero byte.
 std::uint64_t commandLineHash(int argc, char** argv) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (int i = 1; i < argc; ++i)
-    for (const char* c = argv[i];; ++c) {
-      h = (h ^ std::uint8_t(*c)) * 1099511628211ull;
-      if (!*c) break;
-    }
-  return h;
+  Fnv1a h;
+  for (int i = 1; i < argc; ++i) h.bytes(argv[i], std::strlen(argv[i]) + 1);
+  return h.value();
 }
 
 }  // namespace
@@ -260,6 +257,15 @@ int ProcessGroup::finish(int status, const std::string& error) {
   if (!transport_->flush(timeout_)) transport_->abortAll(run != 0 ? run : 1);
   transport_->finalize();
   return run;
+}
+
+void ProcessGroup::abortRun(int status, const std::string& error) {
+  printFailure(status, rank_, ranks_, error);
+  if (atVerdict_) atVerdict_(status);
+  std::fflush(stdout);
+  std::fflush(stderr);
+  if (ranks_ > 1) transport_->abortAll(status);
+  std::_Exit(status);
 }
 
 void ProcessGroup::markLost(int rank) {

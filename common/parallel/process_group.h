@@ -65,13 +65,18 @@ class ProcessGroup {
   // would wait for ever for a rank that still exists but does not answer, the run ends without
   // it: the other ranks leave without MPI_Finalize once they have the verdict (a lost rank that
   // woke up too), and rank 0 ends the job with abortAll(the run's status); under
-  // `mpirun --enable-recovery`, mpirun then exits with that status (0 for a run that completed).
+  // `mpirun --enable-recovery`, Open MPI 4.1's mpirun exits 0 whatever that status is.
   void markLost(int rank);
 
-  // On rank 0: called by finish() with the run's exit status once it is known, before the run
-  // ends (a farm's --farm-status file: under `mpirun --enable-recovery`, Open MPI 4.1's mpirun
-  // exits 0 whatever the ranks' status, so the status has to reach the user another way).
+  // On rank 0: called by finish() (or abortRun) with the run's exit status once it is known,
+  // before the run ends (a farm's --farm-status file: under `mpirun --enable-recovery`, Open
+  // MPI 4.1's mpirun exits 0 whatever the ranks' status, so it has to reach the user another way).
   void atVerdict(std::function<void(int status)> hook) { atVerdict_ = std::move(hook); }
+
+  // Ends every rank now with `status`, printing `error` as this rank's failure and running the
+  // verdict hook first: for a rank that knows the others cannot take part in an ending (they
+  // wait for a rank that is gone).
+  [[noreturn]] void abortRun(int status, const std::string& error);
 
  private:
   ProcessGroup() = default;

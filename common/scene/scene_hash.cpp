@@ -4,15 +4,14 @@
 #include <span>
 #include <string_view>
 
+#include "common/util/hash.h"
+
 namespace pr::scene {
 namespace {
 
-class Fnv {
+// FNV-1a over sequences, each preceded by its length.
+class Fnv : public Fnv1a {
  public:
-  void bytes(const void* data, std::size_t n) {
-    const auto* p = static_cast<const unsigned char*>(data);
-    for (std::size_t i = 0; i < n; ++i) h_ = (h_ ^ p[i]) * 1099511628211ull;
-  }
   template <class T>
   void all(std::span<const T> items) {
     const std::uint64_t n = items.size();
@@ -20,10 +19,6 @@ class Fnv {
     bytes(items.data(), items.size_bytes());
   }
   void text(std::string_view s) { all(std::span<const char>(s.data(), s.size())); }
-  std::uint64_t value() const { return h_; }
-
- private:
-  std::uint64_t h_ = 1469598103934665603ull;
 };
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include "common/image/image_io.h"
 #include "common/util/atomic_file.h"
 #include "common/util/error.h"
+#include "common/util/hash.h"
 
 namespace pr::cli {
 
@@ -22,10 +23,11 @@ std::filesystem::path ReferenceCache::defaultDir() {
 }
 
 std::filesystem::path ReferenceCache::stem(const nlohmann::json& settings) const {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : settings.dump()) h = (h ^ c) * 1099511628211ull;
+  const std::string text = settings.dump();
+  Fnv1a h;
+  h.bytes(text.data(), text.size());
   char name[32];
-  std::snprintf(name, sizeof name, "ref-%016llx", static_cast<unsigned long long>(h));
+  std::snprintf(name, sizeof name, "ref-%016llx", static_cast<unsigned long long>(h.value()));
   return dir_ / name;
 }
 

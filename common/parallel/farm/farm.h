@@ -56,6 +56,14 @@ struct FarmProgress {
   double seconds = 0.0;  // since the farm began
 };
 
+// A server lost before its shared pre-passes were done (FarmOptions::sharedPrepass): the other
+// servers wait inside the pre-passes for its share and cannot be told to stop, so the caller
+// must end every rank (ProcessGroup::abortRun).
+class FarmSharedPrepassLost : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
 // A server's failure, reported to the master (status: the exit status, 2 for bad input).
 class FarmServerFailed : public std::runtime_error {
  public:
@@ -68,12 +76,13 @@ class FarmServerFailed : public std::runtime_error {
 // returns the farm's record. accept(job, server, result) gets each result that counts, once per
 // job; tick(progress) runs every refreshSeconds and at the end. contentHash: a hash of what every
 // server must hold alike (the scene); a server whose hash differs fails the run (InputError).
-// Throws FarmServerFailed when a server reports a failure, and std::runtime_error when every
-// server is lost with jobs left; either way every server has been told to stop.
+// lost(rank) is called as each server is declared lost. Throws FarmServerFailed when a server
+// reports a failure, and std::runtime_error when every server is lost with jobs left (either
+// way every server has been told to stop), FarmSharedPrepassLost as described there.
 FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::uint64_t contentHash,
                          const TaskSet& jobs, Scheduler& order, const ScheduleParams& params,
                          const std::function<void(int job, int server, std::span<const std::byte> result)>& accept,
-                         const std::function<void(const FarmProgress&)>& tick);
+                         const std::function<void(const FarmProgress&)>& tick, const std::function<void(int rank)>& lost);
 
 // On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes,
 // telling the master it is alive every quarter deadline meanwhile), then does the jobs it is

@@ -52,7 +52,8 @@ class Master {
   }
 
   FarmRecord run(const std::function<void(int, int, std::span<const std::byte>)>& accept,
-                 const std::function<void(const FarmProgress&)>& tick) {
+                 const std::function<void(const FarmProgress&)>& tick, const std::function<void(int)>& lost) {
+    lost_ = &lost;
     double nextTick = options_.refreshSeconds;
     // Idle servers hear from the master well within their deadline, whatever the refresh.
     const double keepAlive = std::min(options_.refreshSeconds, options_.deadlineSeconds / 4.0);
@@ -116,7 +117,13 @@ class Master {
           throw InputError("rank " + std::to_string(e.source) +
                            " loaded a different scene from rank 0's (its content hash differs): every rank must read the same scene");
         }
-        t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
+        // Shared pre-passes start together: every server is welcomed once all have been checked.
+        if (!options_.sharedPrepass) {
+          t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
+          return;
+        }
+        if (std::any_of(servers_.begin(), servers_.end(), [](const Server& x) { return !x.hello; })) return;
+        for (const Server& x : servers_) t_.send(x.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
         return;
       }
       case farm::ServerSays::Ready: {
@@ -176,8 +183,8 @@ class Master {
   }
 
   // The next job for a server: one handed on from a lost server first, then the schedule's,
-  // then (once a server has been lost) any job no one has been given, which may sit in a lost
-  // server's portion of a static schedule.
+  // then any job no one has been given yet (in a lost or slow server's static portion, say:
+  // the servers that are left do it rather than wait).
   int nextJob(int rank) {
     while (!requeued_.empty()) {
       const int j = requeued_.front();
@@ -199,7 +206,6 @@ class Master {
       s.granted.pop_front();
       if (state_[std::size_t(j)] == JobState::InPool) return j;  // else taken as an orphan already
     }
-    if (!anyLost_) return -1;
     for (; orphanScan_ < state_.size(); ++orphanScan_)
       if (state_[orphanScan_] == JobState::InPool) return int(orphanScan_++);
     return -1;
@@ -231,17 +237,11 @@ class Master {
       const bool preparing = s.hello && !s.ready;
       const bool neverHello = !s.hello && now > options_.readySeconds;
       if (!((holdsWork || preparing) && now - s.silentSince > options_.deadlineSeconds) && !neverHello) continue;
-      if (!s.ready && options_.sharedPrepass) {
+      if (!s.ready && options_.sharedPrepass)
         // The other servers wait in the shared pre-passes for its share: no job can be done.
-        std::fprintf(stderr,
-                     "parrender: failed (rank 0 of %d): farm server rank %d was lost before its shared pre-passes were done "
-                     "(the other servers need its share of them); ending every rank\n",
-                     t_.ranks(), s.record.rank);
-        std::fflush(stderr);
-        t_.abortAll(1);
-      }
+        throw FarmSharedPrepassLost("farm server rank " + std::to_string(s.record.rank) +
+                                    " was lost before its shared pre-passes were done (the other servers need its share of them)");
       s.record.lostAtSeconds = now;
-      anyLost_ = true;
       for (int j : s.holding) {
         state_[std::size_t(j)] = JobState::Requeued;
         holder_[std::size_t(j)] = -1;
@@ -250,6 +250,7 @@ class Master {
       }
       s.holding.clear();
       handedOn = true;
+      (*lost_)(s.record.rank);
       // Should it wake up, it finishes the job in hand, sends that (late) result and stops.
       t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Stop));
       std::fprintf(stderr, "parrender: farm: server rank %d declared lost after %.1f s of silence%s; %zu job(s) handed on\n",
@@ -281,6 +282,7 @@ class Master {
     for (Server& s : servers_) {
       if (s.record.lost() || s.goodbye) continue;
       s.record.lostAtSeconds = seconds();
+      (*lost_)(s.record.rank);
       std::fprintf(stderr,
                    "parrender: farm: server rank %d declared lost: it did not answer the stop within %.1f s (dead, stopped, or "
                    "still in its pre-passes)\n",
@@ -347,7 +349,8 @@ class Master {
   std::vector<Server> servers_;
   std::deque<int> requeued_;
   std::size_t done_ = 0, orphanScan_ = 0;
-  bool anyLost_ = false, warned_ = false;
+  bool warned_ = false;
+  const std::function<void(int)>* lost_ = nullptr;
   FarmFault fault_ = farmFaultFromEnvironment();
   FarmRecord record_;
 };
@@ -357,9 +360,9 @@ class Master {
 FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::uint64_t contentHash,
                          const TaskSet& jobs, Scheduler& order, const ScheduleParams& params,
                          const std::function<void(int, int, std::span<const std::byte>)>& accept,
-                         const std::function<void(const FarmProgress&)>& tick) {
+                         const std::function<void(const FarmProgress&)>& tick, const std::function<void(int)>& lost) {
   Master master(transport, options, contentHash, jobs, order, params);
-  return master.run(accept, tick);
+  return master.run(accept, tick, lost);
 }
 
 }  // namespace pr::par

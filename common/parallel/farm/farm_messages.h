@@ -19,9 +19,11 @@ enum class ServerSays : std::uint8_t { Hello = 1, Ready = 2, Result = 3, Failed 
 // Master to server.
 enum class MasterSays : std::uint8_t { Welcome = 1, Mismatch = 2, Job = 3, Wait = 4, Stop = 5, StopFailed = 6 };
 
+// Messages are their bytes (wire.h): no padding, so no byte of them is left unset.
 struct Hello {
   std::uint64_t contentHash = 0;
   std::int32_t pes = 1;
+  std::int32_t unused = 0;
 };
 struct Ready {
   double prepareSeconds = 0.0;
@@ -29,9 +31,10 @@ struct Ready {
 };
 // A result's header; the result's bytes follow.
 struct ResultHeader {
-  std::int32_t job = 0;
   double busySeconds = 0.0;  // on this job
   double idleSeconds = 0.0;  // waiting for jobs since ready, so far
+  std::int32_t job = 0;
+  std::int32_t unused = 0;
 };
 struct Failed {
   std::int32_t status = 1;  // the text follows

@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <deque>
 #include <fstream>
+#include <string>
 #include <thread>
 
 #include "common/parallel/farm/farm.h"
@@ -24,18 +25,23 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+std::string formatSeconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.1f s", s);
+  return text;
+}
+
 class Server {
  public:
-  Server(Transport& t, const FarmOptions& options) : t_(t), options_(options), lastHeard_(Clock::now()) {}
+  Server(Transport& t, const FarmOptions& options) : t_(t), options_(options) {}
 
-  // The next message from the master, waiting at most `seconds` since it last heard from it.
+  // The next message from the master, waiting at most `seconds` (the master writes to a
+  // server that waits at least every quarter deadline; a job in hand is not a wait).
   Envelope await(double seconds, const char* what) {
+    const Clock::time_point from = Clock::now();
     for (;;) {
-      if (std::optional<Envelope> e = t_.poll(farm::kToServerTag)) {
-        lastHeard_ = Clock::now();
-        return std::move(*e);
-      }
-      if (since(lastHeard_) > seconds) masterLost("sent nothing for " + std::to_string(int(seconds)) + " s while this server waited for " + what);
+      if (std::optional<Envelope> e = t_.poll(farm::kToServerTag)) return std::move(*e);
+      if (since(from) > seconds) masterLost("sent nothing for " + formatSeconds(seconds) + " while this server waited for " + what);
       std::this_thread::sleep_for(std::chrono::microseconds(100));
     }
   }
@@ -63,7 +69,7 @@ class Server {
   void send(const Bytes& b) { t_.send(0, farm::kToMasterTag, b); }
   void flush() {
     if (!t_.flush(options_.deadlineSeconds))
-      masterLost("took no result for " + std::to_string(int(options_.deadlineSeconds)) + " s");
+      masterLost("took no result for " + formatSeconds(options_.deadlineSeconds));
   }
 
   // The master is gone or hung: nothing this server does can reach the user, and the ending
@@ -77,7 +83,6 @@ class Server {
 
   Transport& t_;
   FarmOptions options_;
-  Clock::time_point lastHeard_;
   std::deque<int> jobs_;
 };
 
@@ -141,13 +146,18 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
                          std::as_bytes(std::span<const char>(text.data(), text.size()))));
     (void)transport.flush(options.deadlineSeconds);
   };
-  s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes}));
+  s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes, 0}));
   // Told to stop: it says so, so the master knows it is not waiting for a lost rank.
   const auto leave = [&] {
     s.send(farm::message(farm::ServerSays::Bye));
     (void)transport.flush(options.deadlineSeconds);
   };
-  if (!s.take(s.await(options.readySeconds, "its welcome"))) return leave();
+  for (;;) {  // the welcome (a master sharing the pre-passes welcomes every server at once)
+    const Envelope e = s.await(options.readySeconds, "its welcome");
+    if (!e.bytes.empty() && farm::MasterSays(e.bytes[0]) == farm::MasterSays::Wait) continue;
+    if (!s.take(e)) return leave();
+    break;
+  }
   double idle = 0.0;
   int sent = 0;
   try {
@@ -157,10 +167,8 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
     s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started), traffic.messages, traffic.bytes}));
     for (;;) {
       // Every message already here first: a stop, or the next jobs.
-      while (std::optional<Envelope> e = transport.poll(farm::kToServerTag)) {
-        s.lastHeard_ = Clock::now();
+      while (std::optional<Envelope> e = transport.poll(farm::kToServerTag))
         if (!s.take(*e)) return leave();
-      }
       if (s.jobs_.empty()) {
         const Clock::time_point waiting = Clock::now();
         const bool more = s.take(s.await(options.deadlineSeconds, "a job"));
@@ -173,7 +181,7 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
       injectFault(fault, transport.rank(), sent);
       const Clock::time_point begun = Clock::now();
       const Bytes result = work(job);
-      const farm::ResultHeader header{job, since(begun), idle};
+      const farm::ResultHeader header{since(begun), idle, job};
       s.send(farm::message(farm::ServerSays::Result, header, result));
       s.flush();
       ++sent;

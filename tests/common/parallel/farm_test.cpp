@@ -46,6 +46,7 @@ struct FarmRun {
   int ticks = 0;                          // progress reports
   int ticksNamingLost = 0;                // of them, those that name a lost server
   int lastDone = 0;                       // jobs done at the last report
+  std::vector<int> lostRanks;             // as the master declared them lost
 };
 
 FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vector<ServerPlan>& plans,
@@ -97,7 +98,8 @@ FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vec
                 ++run.ticks;
                 run.ticksNamingLost += p.lostRanks.empty() ? 0 : 1;
                 run.lastDone = p.jobsDone;
-              });
+              },
+              [&](int rank) { run.lostRanks.push_back(rank); });
         } catch (const std::exception& e) {
           run.masterError = e.what();
         }
@@ -154,6 +156,7 @@ TEST_CASE("Farm: a server that dies holding jobs is declared lost after the dead
     }
     CHECK_FALSE(run.record.servers[0].lost());
     CHECK_FALSE(run.record.servers[2].lost());
+    CHECK(run.lostRanks == std::vector<int>{2});
   }
 }
 
