@@ -6,6 +6,8 @@
 // same at any S); results funnel into the master one after another over its one link (latency
 // plus bytes over the bandwidth), and a job reaches its server a latency (plus its few bytes)
 // after the result that freed its place. A lost server's jobs are replayed as if done once.
+// Shared pre-passes (FarmRecord::prepass) are kept at their recorded time too, though each
+// server's share would shrink with more servers: the prediction is then an upper bound.
 #pragma once
 
 #include <vector>
