@@ -175,7 +175,7 @@ void addFarmOptions(CLI::App& command, FarmArgs& args) {
       ->check(CLI::Validator([](std::string& v) { return par::schedules().problem(v); }, "SCHEDULE"))
       ->capture_default_str();
   command.add_option("--farm-deadline", args.deadlineSeconds,
-                     "--farm: seconds a server holding jobs may send nothing before it is declared lost")
+                     "--farm: seconds a server holding jobs or running its pre-passes may send nothing before it is declared lost")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   command.add_option("--farm-refresh", args.refreshSeconds, "--farm: seconds between rewrites of the image (and --progress lines)")
