@@ -85,8 +85,9 @@ class Master {
     stopAll(farm::MasterSays::Stop);
     record_.wallSeconds = seconds();
     awaitGoodbyes();
+    const FarmProgress last = progress();
     for (Server& s : servers_) record_.servers.push_back(std::move(s.record));
-    tick(progressOfRecord());
+    tick(last);
     return std::move(record_);
   }
 
@@ -321,20 +322,6 @@ class Master {
         ++p.serversWorking;
       else
         ++p.serversPreparing;
-    }
-    return p;
-  }
-
-  FarmProgress progressOfRecord() const {
-    FarmProgress p;
-    p.jobsDone = int(done_);
-    p.jobs = int(state_.size());
-    p.seconds = record_.wallSeconds;
-    for (const FarmServerRecord& s : record_.servers) {
-      if (s.lost())
-        p.lostRanks.push_back(s.rank);
-      else
-        ++p.serversWorking;
     }
     return p;
   }
