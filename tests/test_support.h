@@ -43,6 +43,8 @@ inline std::string join(std::initializer_list<std::string> parts) {
 }
 // A path in double quotes, for a runParrender command line.
 inline std::string quoted(const std::filesystem::path& p) { return join({"\"", p.string(), "\""}); }
+// The bundled Cornell box (scenes/cornell.gltf), quoted for a command line.
+inline std::string cornell() { return quoted(sourceDir() / "scenes" / "cornell.gltf"); }
 
 struct CommandResult {
   int exitStatus = -1;

@@ -89,14 +89,14 @@ double broadcastSeconds(const par::RunRecord& predicted, const par::NetworkModel
 }
 
 // The run record in `file` when it is one of a farm (render --farm), else nothing.
-std::optional<par::RunRecord> farmRecordIn(const std::string& file) {
+// A run record (JSON) is read once: a farm's goes to simulateFarm, any other becomes the
+// workload, as readWorkload makes it of a record or a cost table.
+std::optional<par::RunRecord> runRecordIn(const std::string& file) {
   std::ifstream in(file);
   char first = 0;
   in >> first;
   if (first != '{') return std::nullopt;
-  par::RunRecord record = par::readRunRecord(file);
-  if (!record.farm) return std::nullopt;
-  return record;
+  return par::readRunRecord(file);
 }
 
 // A farm's record at other numbers of servers (common/parallel/farm/farm_replay.h): --pes
@@ -137,11 +137,12 @@ void simulateFarm(const par::RunRecord& record, const std::vector<int>& serversL
 void runSimulate(const SimulateArgs& args) {
   const par::NetworkModel& network = par::networkByName(args.network);
   const std::vector<int> pesList = parsePesList(args.pes);
-  if (const std::optional<par::RunRecord> farm = farmRecordIn(args.input)) {
-    simulateFarm(*farm, pesList, network, args);
+  const std::optional<par::RunRecord> record = runRecordIn(args.input);
+  if (record && record->farm) {
+    simulateFarm(*record, pesList, network, args);
     return;
   }
-  const par::Workload workload = par::readWorkload(args.input);
+  const par::Workload workload = record ? par::workloadFromRecord(*record, "'" + args.input + "'") : par::readWorkload(args.input);
   const bool fromRecord = workload.recordedPes > 0;
 
   // The stages that ran under the run's schedule keep it (and the recorded grain) unless the

@@ -37,18 +37,19 @@ JobSize parseJobSize(const std::string& text) {
   return s;
 }
 
-// The jobs: screen areas in image order, each task at its area's centre in job units.
-struct FarmJobs {
-  std::vector<rt::PixelRect> areas;
+// An area cut into w x h rectangles in row order, each a task at its centre in rectangle
+// units: the image into the master's jobs, and a job into a server's tiles.
+struct Areas {
+  std::vector<rt::PixelRect> rects;
   par::TaskSet tasks;
 };
 
-FarmJobs makeJobs(int width, int height, JobSize size) {
-  FarmJobs jobs;
-  jobs.areas = rt::tilesOf(rt::PixelRect{0, 0, width, height}, size.w, size.h);
-  const int cols = (width + size.w - 1) / size.w, rows = (height + size.h - 1) / size.h;
-  jobs.tasks = par::TaskSet::grid(cols, rows);
-  return jobs;
+Areas cut(const rt::PixelRect& area, int w, int h) {
+  Areas a;
+  a.rects = rt::tilesOf(area, w, h);
+  const int cols = (area.x1 - area.x0 + w - 1) / w, rows = (area.y1 - area.y0 + h - 1) / h;
+  a.tasks = par::TaskSet::grid(cols, rows);
+  return a;
 }
 
 par::FarmOptions farmOptions(const FarmArgs& farm) {
@@ -74,7 +75,7 @@ par::PrepareTraffic betweenServers(const par::RunRecord& record) {
 // A server: its own runtime of `threads` PEs, the world BVH and the integrator's pre-passes
 // (on that runtime, or shared: on a runtime across the servers, the master not among them),
 // then one stage per job over the job's tiles.
-void serve(const FarmArgs& farm, const FarmInput& in, const FarmJobs& jobs, std::uint64_t hash) {
+void serve(const FarmArgs& farm, const FarmInput& in, const Areas& jobs, std::uint64_t hash) {
   par::ProcessGroup& group = par::ProcessGroup::get();
   par::Runtime runtime(par::RuntimeOptions{in.threads, in.schedule.schedule, in.schedule.params, false, nullptr});
   const RenderRequest request{in.scene, in.camera, in.width, in.height, in.settings, in.plan, runtime, {}};
@@ -99,14 +100,13 @@ void serve(const FarmArgs& farm, const FarmInput& in, const FarmJobs& jobs, std:
   const auto work = [&](int id) {
     const rt::TraceJob& job = prepared->job;
     const rt::Integrator& integrator = *job.integrator;
-    const rt::PixelRect& area = jobs.areas[std::size_t(id)];
-    const std::vector<rt::PixelRect> tiles = rt::tilesOf(area, job.options.tileSizePx);
-    const int cols = (area.x1 - area.x0 + job.options.tileSizePx - 1) / job.options.tileSizePx;
+    const rt::PixelRect& area = jobs.rects[std::size_t(id)];
+    const Areas tiles = cut(area, job.options.tileSizePx, job.options.tileSizePx);
     rt::Film film(area, in.width, in.height, integrator.options().spp);
-    runtime.runStage("farm job", par::TaskSet::grid(cols, int(tiles.size()) / cols), [&](par::Pe& pe, par::TaskId t) {
+    runtime.runStage("farm job", tiles.tasks, [&](par::Pe& pe, par::TaskId t) {
       rt::TraceStats stats;
-      const rt::Film tile = rt::traceTile(integrator, *job.options.worldBvh, tiles[t], in.width, in.height, pe.id(), stats);
-      film.addBlock(tile.block(tiles[t]));
+      const rt::Film tile = rt::traceTile(integrator, *job.options.worldBvh, tiles.rects[t], in.width, in.height, pe.id(), stats);
+      film.addBlock(tile.block(tiles.rects[t]));
     });
     return par::encodeMessage(film.block(area));
   };
@@ -234,7 +234,7 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
   par::Transport& transport = group.transport();
   transport.tolerateLostRanks();
   const JobSize size = parseJobSize(farm.job);
-  const FarmJobs jobs = makeJobs(in.width, in.height, size);
+  const Areas jobs = cut(rt::PixelRect{0, 0, in.width, in.height}, size.w, size.h);
   const std::uint64_t hash = scene::contentHash(in.scene);
   if (group.rank() != 0) {
     serve(farm, in, jobs, hash);

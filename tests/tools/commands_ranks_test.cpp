@@ -16,6 +16,7 @@
 
 #include "mpirun_support.h"
 
+using pr::test::cornell;
 using pr::test::CommandResult;
 using pr::test::join;
 using pr::test::occurrences;
@@ -23,7 +24,6 @@ using pr::test::quoted;
 
 namespace {
 
-std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 std::string cornellGlass() { return quoted(pr::test::sourceDir() / "scenes" / "cornell-glass.gltf"); }
 
 nlohmann::json readJson(const std::filesystem::path& file) {

@@ -13,11 +13,11 @@
 #include "test_support.h"
 #include "tools/sweep/image_error.h"
 
+using pr::test::cornell;
 using pr::test::join;
 using pr::test::runParrender;
 
 namespace {
-std::string cornell() { return pr::test::quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 }  // namespace
 
 TEST_CASE("Compare: images agree only when every float of every pixel does") {

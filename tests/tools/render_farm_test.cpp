@@ -15,6 +15,7 @@
 #include "common/parallel/run_record.h"
 #include "mpirun_support.h"
 
+using pr::test::cornell;
 using pr::test::CommandResult;
 using pr::test::join;
 using pr::test::occurrences;
@@ -22,7 +23,6 @@ using pr::test::quoted;
 
 namespace {
 
-std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 
 CommandResult farmRun(int ranks, const std::string& args, const std::string& env = "", int limit = 180) {
   return pr::test::mpirun(ranks, "--enable-recovery " + quoted(PARRENDER_EXE), args, limit, env);

@@ -19,6 +19,7 @@
 #include "common/parallel/run_record.h"
 #include "mpirun_support.h"
 
+using pr::test::cornell;
 using pr::test::CommandResult;
 using pr::test::join;
 using pr::test::occurrences;
@@ -28,7 +29,6 @@ namespace {
 
 CommandResult mpiParrender(int ranks, const std::string& args) { return pr::test::mpirun(ranks, quoted(PARRENDER_EXE), args, 120); }
 
-std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 std::string cornellGlass() { return quoted(pr::test::sourceDir() / "scenes" / "cornell-glass.gltf"); }
 
 // Renders `args` in one process of one PE, then under mpirun at each R x T: the same image bit

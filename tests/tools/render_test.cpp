@@ -11,12 +11,12 @@
 #include "raytrace/integrators/integrator.h"
 #include "test_support.h"
 
+using pr::test::cornell;
 using pr::test::join;
 using pr::test::quoted;
 using pr::test::runParrender;
 
 namespace {
-std::string cornell() { return quoted(pr::test::sourceDir() / "scenes" / "cornell.gltf"); }
 }  // namespace
 
 TEST_CASE("Render: image-space render writes the image, run record and a summary") {

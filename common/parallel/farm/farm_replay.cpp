@@ -23,8 +23,6 @@ FarmPrediction predictFarm(const FarmRecord& farm, const TaskSet& tasks, std::si
   p.serverBusySeconds.assign(std::size_t(servers), 0.0);
 
   order.reset(tasks, servers, params);
-  const double bandwidth = network.bytesPerSecond;
-  const auto transfer = [&](std::size_t bytes) { return network.latencySeconds + (bandwidth > 0.0 ? double(bytes) / bandwidth : 0.0); };
   struct Server {
     std::deque<std::pair<int, double>> held;  // job, arrival
     std::deque<TaskId> granted;
@@ -71,7 +69,7 @@ FarmPrediction predictFarm(const FarmRecord& farm, const TaskSet& tasks, std::si
   const auto send = [&](int s, double at) {
     const int j = nextJob(s);
     if (j < 0) return;
-    state[std::size_t(s)].held.emplace_back(j, at + transfer(jobBytes));
+    state[std::size_t(s)].held.emplace_back(j, at + network.seconds(1, jobBytes));
   };
   for (int s = 0; s < servers; ++s) {
     state[std::size_t(s)].freeAt = start;
@@ -88,7 +86,7 @@ FarmPrediction predictFarm(const FarmRecord& farm, const TaskSet& tasks, std::si
       sv.working = false;
       const std::size_t bytes = farm.jobs[std::size_t(code)].resultBytes;
       const double begin = std::max(time, masterFree);
-      const double wire = bandwidth > 0.0 ? double(bytes) / bandwidth : 0.0;
+      const double wire = network.seconds(0, bytes);
       masterFree = begin + wire;
       p.masterLinkSeconds += wire;
       events.emplace(masterFree + network.latencySeconds, s, -1 - code);
