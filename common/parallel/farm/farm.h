@@ -4,7 +4,8 @@
 // own PEs and sends each result back. Unlike the runtime across processes (runtime.h), whose SPMD
 // stages end by collective termination that a dead rank would block, the farm is point to point
 // with deadlines, so it survives servers that die or stop answering:
-// - a server that holds jobs and has sent nothing for deadlineSeconds is declared lost, and the
+// - a server that holds jobs and has sent nothing for deadlineSeconds is declared lost (a working
+//   server says it is alive every quarter deadline, however long its job), and the
 //   jobs it held go to the others first; it is sent nothing more;
 // - a result counts only from the server that holds its job now: a lost server that wakes up
 //   and sends late results has them discarded by job, never added twice;
@@ -84,9 +85,9 @@ FarmRecord runFarmMaster(Transport& transport, const FarmOptions& options, std::
                          const std::function<void(int job, int server, std::span<const std::byte> result)>& accept,
                          const std::function<void(const FarmProgress&)>& tick, const std::function<void(int rank)>& lost);
 
-// On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes,
-// telling the master it is alive every quarter deadline meanwhile), then does the jobs it is
-// sent, work(job) making each one's result, until the master says stop. A server that says
+// On every other rank: says hello with contentHash and its PEs, runs prepare() (its pre-passes),
+// then does the jobs it is sent, work(job) making each one's result, until the master says stop;
+// during prepare and work it tells the master every quarter deadline that it is alive. A server that says
 // hello and then falls silent for deadlineSeconds before it is ready is lost like one holding jobs.
 // A failure of prepare or work is reported to the master and rethrown; a master that stops
 // answering for deadlineSeconds (readySeconds for the welcome) ends every rank

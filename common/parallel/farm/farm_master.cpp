@@ -136,8 +136,8 @@ class Master {
         topUp(e.source);
         return;
       }
-      case farm::ServerSays::Preparing:
-        return;  // alive: heard above
+      case farm::ServerSays::Alive:
+        return;  // heard above
       case farm::ServerSays::Bye:
         return;  // only after the stop (awaitGoodbyes)
       case farm::ServerSays::Result: {
@@ -160,7 +160,6 @@ class Master {
         s.record.jobs.push_back(h.job);
         s.record.busySeconds += h.busySeconds;
         s.record.idleSeconds = h.idleSeconds;
-        warnOfDeadline(h.busySeconds);
         accept(h.job, e.source, result);
         if (fault_.rank == 0 && fault_.afterJobs == int(done_)) raise(fault_.signal);
         topUp(e.source);
@@ -171,16 +170,6 @@ class Master {
         throw FarmServerFailed(f.status, "server rank " + std::to_string(e.source) + ": " + farm::textOf(r));
       }
     }
-  }
-
-  // One job's time near the deadline: a working server may then be taken for a lost one.
-  void warnOfDeadline(double busy) {
-    if (warned_ || busy < 0.5 * options_.deadlineSeconds) return;
-    warned_ = true;
-    std::fprintf(stderr,
-                 "parrender: warning: a farm job took %.1f s, over half the deadline of %.1f s: a server still working may be "
-                 "declared lost; raise --farm-deadline or make jobs smaller (--farm-job)\n",
-                 busy, options_.deadlineSeconds);
   }
 
   // The next job for a server: one handed on from a lost server first, then the schedule's,
@@ -336,7 +325,6 @@ class Master {
   std::vector<Server> servers_;
   std::deque<int> requeued_;
   std::size_t done_ = 0, orphanScan_ = 0;
-  bool warned_ = false;
   const std::function<void(int)>* lost_ = nullptr;
   FarmFault fault_ = farmFaultFromEnvironment();
   FarmRecord record_;

@@ -15,7 +15,7 @@ inline constexpr int kToMasterTag = ProcessGroup::kFirstUserTag + 100;
 inline constexpr int kToServerTag = ProcessGroup::kFirstUserTag + 101;
 
 // Server to master.
-enum class ServerSays : std::uint8_t { Hello = 1, Ready = 2, Result = 3, Failed = 4, Preparing = 5, Bye = 6 };
+enum class ServerSays : std::uint8_t { Hello = 1, Ready = 2, Result = 3, Failed = 4, Alive = 5, Bye = 6 };
 // Master to server.
 enum class MasterSays : std::uint8_t { Welcome = 1, Mismatch = 2, Job = 3, Wait = 4, Stop = 5, StopFailed = 6 };
 

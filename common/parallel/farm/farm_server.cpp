@@ -93,16 +93,18 @@ void injectFault(const FarmFault& fault, int rank, int sent) {
   raise(fault.signal);
 }
 
-// Runs prepare() while a thread tells the master every quarter deadline that this server is
-// alive (its pre-passes may take far longer than the deadline).
-PrepareTraffic preparing(Server& s, const std::function<PrepareTraffic()>& prepare) {
+// Runs work() while a thread tells the master every quarter deadline that this server is alive:
+// pre-passes and jobs may take far longer than the deadline, which is for servers that die or
+// stop (a stopped process stops this thread too), not for slow ones.
+template <class Work>
+auto alive(Server& s, const Work& work) -> decltype(work()) {
   std::mutex mutex;
   std::condition_variable finished;
   bool done = false;
   const auto every = std::chrono::duration<double>(s.options_.deadlineSeconds / 4.0);
   std::thread heartbeat([&] {
     std::unique_lock<std::mutex> lock(mutex);
-    while (!finished.wait_for(lock, every, [&] { return done; })) s.send(farm::message(farm::ServerSays::Preparing));
+    while (!finished.wait_for(lock, every, [&] { return done; })) s.send(farm::message(farm::ServerSays::Alive));
   });
   const auto stop = [&] {
     {
@@ -113,9 +115,9 @@ PrepareTraffic preparing(Server& s, const std::function<PrepareTraffic()>& prepa
     heartbeat.join();
   };
   try {
-    const PrepareTraffic traffic = prepare();
+    auto result = work();
     stop();
-    return traffic;
+    return result;
   } catch (...) {
     stop();
     throw;
@@ -163,7 +165,7 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
   try {
     const Clock::time_point started = Clock::now();
     injectFault(fault, transport.rank(), -1);
-    const PrepareTraffic traffic = preparing(s, prepare);
+    const PrepareTraffic traffic = alive(s, prepare);
     s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started), traffic.messages, traffic.bytes}));
     for (;;) {
       // Every message already here first: a stop, or the next jobs.
@@ -180,7 +182,7 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
       s.jobs_.pop_front();
       injectFault(fault, transport.rank(), sent);
       const Clock::time_point begun = Clock::now();
-      const Bytes result = work(job);
+      const Bytes result = alive(s, [&] { return work(job); });
       const farm::ResultHeader header{since(begun), idle, job};
       s.send(farm::message(farm::ServerSays::Result, header, result));
       s.flush();

@@ -26,11 +26,14 @@ using pr::par::Bytes;
 using pr::par::FarmRecord;
 
 // How a server behaves: its job's result is the job id; after `afterJobs` results it dies
-// (leaves without a word), or stalls for `stallSeconds` inside its next job and then goes on.
+// (leaves without a word), or is stopped for `stallSeconds` inside its next job (nothing it
+// sends leaves it meanwhile, its keep-alives included, as under SIGSTOP) and then goes on;
+// `slowSeconds`: every job of it takes that long.
 struct ServerPlan {
   int afterJobs = -1;
   bool dies = false;
   double stallSeconds = 0.0;
+  double slowSeconds = 0.0;
   std::uint64_t hash = 7;
   bool fails = false;  // its first job throws
 };
@@ -71,9 +74,11 @@ FarmRun runFarm(int ranks, int jobs, const std::string& schedule, const std::vec
                 if (plan.fails) throw std::runtime_error("no memory for job " + std::to_string(job));
                 if (done == plan.afterJobs) {
                   if (plan.dies) throw DeathOfServer{};
+                  net.hold(r, true);
                   std::this_thread::sleep_for(std::chrono::duration<double>(plan.stallSeconds));
+                  net.hold(r, false);
                 }
-                std::this_thread::sleep_for(std::chrono::duration<double>(jobSeconds));
+                std::this_thread::sleep_for(std::chrono::duration<double>(plan.slowSeconds > 0 ? plan.slowSeconds : jobSeconds));
                 ++done;
                 Bytes b(sizeof(int));
                 std::memcpy(b.data(), &job, sizeof job);
@@ -160,8 +165,16 @@ TEST_CASE("Farm: a server that dies holding jobs is declared lost after the dead
   }
 }
 
-TEST_CASE("Farm: a server that stalls past the deadline and wakes up has its late result discarded") {
-  // Server rank 2 stalls 0.6 s in its third job (deadline 0.2 s) while the others take 1.2 s for the rest.
+TEST_CASE("Farm: a server whose jobs take longer than the deadline says it is alive and is not lost") {
+  // Server rank 2 takes 0.5 s per job against a deadline of 0.2 s: slow, not lost.
+  const FarmRun run = runFarm(3, 12, "demand", {{}, {.slowSeconds = 0.5}}, 0.2);
+  checkEveryJobOnce(run);
+  CHECK(run.lostRanks.empty());
+  CHECK(run.record.servers[1].jobs.size() >= 1);
+}
+
+TEST_CASE("Farm: a server stopped past the deadline that wakes up has its late result discarded") {
+  // Server rank 2 stops for 0.6 s in its third job (deadline 0.2 s) while the others take 1.2 s for the rest.
   const FarmRun run = runFarm(3, 120, "demand", {{}, {2, false, 0.6}}, 0.2, 0.02);
   checkEveryJobOnce(run);
   const pr::par::FarmServerRecord& stalled = run.record.servers[1];

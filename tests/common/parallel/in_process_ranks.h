@@ -27,6 +27,9 @@ class InProcessNetwork {
     for (int r = 0; r < ranks; ++r) ends_.push_back(std::make_unique<End>(*this, r));
   }
   par::Transport& rank(int r) { return *ends_[static_cast<std::size_t>(r)]; }
+  // While a rank is held nothing it sends leaves it, as from a stopped process (SIGSTOP): its
+  // messages go out, in order, when it is released.
+  void hold(int r, bool held) { ends_[static_cast<std::size_t>(r)]->hold(held); }
 
  private:
   struct Box {
@@ -39,9 +42,18 @@ class InProcessNetwork {
     int rank() const override { return rank_; }
     int ranks() const override { return static_cast<int>(net_.boxes_.size()); }
     void send(int to, int tag, par::Bytes bytes) override {
-      Box& box = net_.boxes_[static_cast<std::size_t>(to)];
-      std::lock_guard lock(box.mutex);
-      box.byTag[tag].push_back({rank_, tag, std::move(bytes)});
+      std::lock_guard lock(heldMutex_);
+      if (held_)
+        heldBack_.push_back({to, tag, std::move(bytes)});
+      else
+        deliver(to, tag, std::move(bytes));
+    }
+    void hold(bool held) {
+      std::lock_guard lock(heldMutex_);
+      held_ = held;
+      if (held) return;
+      for (Unsent& m : heldBack_) deliver(m.to, m.tag, std::move(m.bytes));
+      heldBack_.clear();
     }
     std::optional<par::Envelope> poll(int tag) override {
       Box& box = net_.boxes_[static_cast<std::size_t>(rank_)];
@@ -57,8 +69,21 @@ class InProcessNetwork {
     [[noreturn]] void abortAll(int) override { std::abort(); }
 
    private:
+    void deliver(int to, int tag, par::Bytes bytes) {
+      Box& box = net_.boxes_[static_cast<std::size_t>(to)];
+      std::lock_guard lock(box.mutex);
+      box.byTag[tag].push_back({rank_, tag, std::move(bytes)});
+    }
+
     InProcessNetwork& net_;
     int rank_;
+    struct Unsent {
+      int to, tag;
+      par::Bytes bytes;
+    };
+    std::mutex heldMutex_;
+    bool held_ = false;
+    std::vector<Unsent> heldBack_;  // while held
   };
   std::vector<Box> boxes_;
   std::vector<std::unique_ptr<End>> ends_;
