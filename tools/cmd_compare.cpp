@@ -50,6 +50,7 @@ struct CompareArgs {
   RenderSettings settings;
   FamilyOptions family;
   LightingOptions lighting;
+  FarmArgs farm;
 };
 
 // A file name for a row's image: its label with spaces and '=' made safe.
@@ -57,6 +58,8 @@ std::string fileStem(const Combination& c) {
   std::string s = c.label();
   std::replace(s.begin(), s.end(), ' ', '_');
   std::replace(s.begin(), s.end(), '=', '-');
+  std::replace(s.begin(), s.end(), '(', '_');
+  s.erase(std::remove(s.begin(), s.end(), ')'), s.end());
   return s;
 }
 
@@ -66,6 +69,7 @@ void run(CompareArgs& a) {
   // Under mpirun, --threads is each rank's PEs and rank 0 prints and writes.
   const int ranks = par::ProcessGroup::get().ranks();
   const bool writes = holdsResults();
+  checkFarm(a.farm, findRenderMethod("image-space"), a.settings, ranks);
   if (a.threads.empty()) a.threads = defaultThreadCounts();
   ComparisonSpec spec;
   spec.methods = a.methods;
@@ -79,6 +83,7 @@ void run(CompareArgs& a) {
   spec.progress = !a.quiet;
   spec.keepImages = !a.images.empty();
   spec.reference = !a.noReference;
+  spec.farm = a.farm;
   spec.referenceSettings = ReferenceSettings{a.scene, a.camera, a.effects, a.lighting, a.referenceSpp, a.referenceDepth,
                                              a.settings.ray.seed, a.referenceDir, a.noCache, "image-space",
                                              everyRank(*std::max_element(a.threads.begin(), a.threads.end())), {}};
@@ -124,6 +129,10 @@ void run(CompareArgs& a) {
   if (ranks > 1)
     std::printf("across %d ranks launched by mpirun: P = %d x PEs per rank (--threads); P = 1 on rank 0 alone while "
                 "the others waited\n", ranks, ranks);
+  if (a.farm.enabled)
+    std::printf("image-space farm: rank 0 the master, the other %d ranks servers; P counts the servers' PEs, the schedule is "
+                "among each server's PEs, the master orders jobs of %s by %s\n",
+                ranks - 1, a.farm.job.c_str(), a.farm.schedule.c_str());
   std::printf("T1/Tn against the same combination at P=1, Ts/Tn against the family's sequential run (else its fastest "
               "at P=1)");
   if (!c.reference.image.empty())
@@ -215,6 +224,9 @@ void addCompareCommand(CLI::App& app) {
   cmd->add_option("--images", a->images, "folder for each row's image (PNG) and its x8 difference from the reference");
   cmd->add_flag("--quiet", a->quiet, "no progress lines");
   addLightingOptions(*cmd, a->lighting);
+  addFarmOptions(*cmd, a->farm,
+                 "under mpirun, image-space also as a farm (render --farm), after every other render: rank 0 the master, "
+                 "the other ranks servers of each --threads value; a server lost fails the comparison");
   cmd->callback([a] { run(*a); });
 }
 

@@ -128,8 +128,9 @@ void run(RenderArgs& a) {
   const scene::RenderPlan plan = scene::applyOverrides(scene::analyzeEffects(scene, &camera), overrides);
 
   if (a.farm.enabled) {
+    if (writes) warnWithoutRecovery();
     const par::RunRecord record =
-        renderOnFarm(a.farm, FarmInput{scene, camera, plan, a.width, a.height, a.settings, a.schedule, a.threads}, a.output);
+        renderOnFarm(a.farm, FarmInput{scene, camera, plan, a.width, a.height, a.settings, a.schedule, a.threads}, a.output).record;
     if (!writes) return;
     par::writeRunOutputs(record, a.outputs);
     std::printf("method %s (%s) as a farm: a master and %d servers x %d PE%s, schedule %s among each server's PEs, %dx%d -> %s\n",
@@ -138,7 +139,7 @@ void run(RenderArgs& a) {
     std::printf("%s\n", lighting.c_str());
     std::printf("effects:\n");
     for (scene::Effect e : scene::allEffects()) std::printf("  %s\n", plan.line(e).c_str());
-    printFarmSummary(record);
+    std::fputs(farmSummary(record).c_str(), stdout);
     return;
   }
 
@@ -228,7 +229,10 @@ void addRenderCommand(CLI::App& app) {
   addLightingOptions(*cmd, args->lighting);
   addRayOptions(*cmd, args->settings, args->family);
   addRasterOptions(*cmd, args->settings, args->family);
-  addFarmOptions(*cmd, args->farm);
+  addFarmOptions(*cmd, args->farm,
+                 "render as a farm under mpirun --enable-recovery: rank 0 hands out screen areas, the other ranks render "
+                 "them with --threads PEs each; a server that dies or stops answering loses no job (image-space only)");
+  addFarmRenderOptions(*cmd, args->farm);
   cmd->callback([args] { run(*args); });
 }
 

@@ -119,6 +119,7 @@ void run(ReportArgs& a) {
   // Under mpirun, --threads is each rank's PEs (default one); P = 1 runs on rank 0 alone, and
   // rank 0 alone reads and writes the report's folder while the other ranks wait.
   par::ProcessGroup& group = par::ProcessGroup::get();
+  checkFarm(a.spec.farm, findRenderMethod("image-space"), a.spec.settings, group.ranks());
   if (a.spec.threads.empty()) a.spec.threads = defaultThreadCounts();
   if (group.ranks() == 1 && std::find(a.spec.threads.begin(), a.spec.threads.end(), 1) == a.spec.threads.end())
     throw InputError("--threads must include 1: speed-up and efficiency are measured against P = 1");
@@ -255,6 +256,9 @@ void addReportCommand(CLI::App& app) {
       ->check(CLI::Range(1, 65536))
       ->capture_default_str();
   addLightingOptions(*cmd, s.lighting);
+  addFarmOptions(*cmd, s.farm,
+                 "under mpirun, image-space also as a farm (render --farm) in the comparison, with a section of its own: "
+                 "rank 0 the master, the other ranks servers of each --threads value; a server lost fails the report");
   cmd->callback([a] { run(*a); });
 }
 

@@ -22,6 +22,7 @@
 #include "common/parallel/simulator.h"
 #include "common/util/error.h"
 #include "tools/commands.h"
+#include "tools/farm_render.h"
 
 namespace pr::cli {
 namespace {
@@ -108,17 +109,12 @@ void simulateFarm(const par::RunRecord& record, const std::vector<int>& serversL
   const par::StageRecord& jobs = record.stages[1];
   const std::string schedule = args.scheduleGiven ? args.schedule.schedule : farm.schedule;
   const int pes = farm.servers.empty() ? 1 : farm.servers.front().pes;
-  par::TaskSet tasks;
-  tasks.tasks = jobs.tasks;
   std::printf("recorded farm: %zu servers of %d PE%s, %zu jobs (%s) in the order of %s; jobs stage %.6f s, farm %.6f s\n",
               farm.servers.size(), pes, pes == 1 ? "" : "s", farm.jobs.size(), farm.jobShape.c_str(), farm.schedule.c_str(),
               jobs.wallSeconds, farm.wallSeconds);
   std::printf("schedule %s; network %s (%s); results reach the master one after another over its link\n",
               schedule.c_str(), std::string(network.name).c_str(), std::string(network.description).c_str());
-  const auto predictAt = [&](int servers) {
-    std::unique_ptr<par::Scheduler> order = par::makeScheduler(schedule);
-    return par::predictFarm(farm, tasks, par::kFarmJobBytes, servers, network, *order, args.schedule.params);
-  };
+  const auto predictAt = [&](int servers) { return predictFarmRun(record, servers, network, schedule, args.schedule.params); };
   const par::FarmPrediction one = predictAt(1);
   const par::FarmPrediction recorded = predictAt(int(farm.servers.size()));
   std::printf("at the recorded %zu servers: jobs stage predicted %.6f s, measured %.6f s (%+.1f%%)\n\n", farm.servers.size(),

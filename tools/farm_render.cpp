@@ -2,6 +2,7 @@
 #include "tools/farm_render.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <string_view>
@@ -52,13 +53,18 @@ Areas cut(const rt::PixelRect& area, int w, int h) {
   return a;
 }
 
-par::FarmOptions farmOptions(const FarmArgs& farm) {
+// The farm runs of this process so far: every rank runs the same ones (compare and report run
+// a farm per combination and repeat), so each counts them alike.
+int farmRuns = 0;
+
+par::FarmOptions farmOptions(const FarmArgs& farm, int run) {
   par::FarmOptions o;
   o.deadlineSeconds = farm.deadlineSeconds;
   o.jobsAhead = farm.jobsAhead;
   o.refreshSeconds = farm.refreshSeconds;
   o.readySeconds = par::ProcessGroup::get().timeoutSeconds();
   o.sharedPrepass = farm.prepass == "shared";
+  o.run = run;
   return o;
 }
 
@@ -75,7 +81,7 @@ par::PrepareTraffic betweenServers(const par::RunRecord& record) {
 // A server: its own runtime of `threads` PEs, the world BVH and the integrator's pre-passes
 // (on that runtime, or shared: on a runtime across the servers, the master not among them),
 // then one stage per job over the job's tiles.
-void serve(const FarmArgs& farm, const FarmInput& in, const Areas& jobs, std::uint64_t hash) {
+void serve(const FarmArgs& farm, const FarmInput& in, const Areas& jobs, std::uint64_t hash, int run) {
   par::ProcessGroup& group = par::ProcessGroup::get();
   par::Runtime runtime(par::RuntimeOptions{in.threads, in.schedule.schedule, in.schedule.params, false, nullptr});
   const RenderRequest request{in.scene, in.camera, in.width, in.height, in.settings, in.plan, runtime, {}};
@@ -110,7 +116,7 @@ void serve(const FarmArgs& farm, const FarmInput& in, const Areas& jobs, std::ui
     });
     return par::encodeMessage(film.block(area));
   };
-  par::runFarmServer(group.transport(), farmOptions(farm), hash, in.threads, prepare, work);
+  par::runFarmServer(group.transport(), farmOptions(farm, run), hash, in.threads, prepare, work);
 }
 
 // The master's run record: its PEs are the servers (one per rank), its stages the servers'
@@ -165,10 +171,8 @@ par::RunRecord farmRunRecord(par::FarmRecord farm, const par::TaskSet& tasks, st
 
 }  // namespace
 
-void addFarmOptions(CLI::App& command, FarmArgs& args) {
-  command.add_flag("--farm", args.enabled,
-                   "render as a farm under mpirun --enable-recovery: rank 0 hands out screen areas, the other ranks render "
-                   "them with --threads PEs each; a server that dies or stops answering loses no job (image-space only)");
+void addFarmOptions(CLI::App& command, FarmArgs& args, const std::string& what) {
+  command.add_flag("--farm", args.enabled, what);
   command.add_option("--farm-job", args.job, "--farm: a job's screen area, WIDTHxHEIGHT pixels")->capture_default_str();
   command.add_option("--farm-schedule", args.schedule,
                      "--farm: the master's order of jobs, a demand-driven schedule (demand, spiral, random, preferred-bias, ...)")
@@ -176,9 +180,6 @@ void addFarmOptions(CLI::App& command, FarmArgs& args) {
       ->capture_default_str();
   command.add_option("--farm-deadline", args.deadlineSeconds,
                      "--farm: seconds a server holding jobs or running its pre-passes may send nothing before it is declared lost")
-      ->check(CLI::Range(0.1, 86400.0))
-      ->capture_default_str();
-  command.add_option("--farm-refresh", args.refreshSeconds, "--farm: seconds between rewrites of the image (and --progress lines)")
       ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   command.add_option("--farm-prepass", args.prepass,
@@ -189,6 +190,12 @@ void addFarmOptions(CLI::App& command, FarmArgs& args) {
       ->capture_default_str();
   command.add_option("--farm-ahead", args.jobsAhead, "--farm: jobs a server holds at once (the next ones wait there while it works)")
       ->check(CLI::Range(1, 64))
+      ->capture_default_str();
+}
+
+void addFarmRenderOptions(CLI::App& command, FarmArgs& args) {
+  command.add_option("--farm-refresh", args.refreshSeconds, "--farm: seconds between rewrites of the image (and --progress lines)")
+      ->check(CLI::Range(0.1, 86400.0))
       ->capture_default_str();
   command.add_option("--farm-status", args.statusFile,
                      "--farm: write the run's exit status (0: complete) to this file at the end; under mpirun --enable-recovery, "
@@ -221,30 +228,34 @@ void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSet
                      (method.properties.family == MethodFamily::Raster ? " is a rasterizer"
                                                                         : "'s data is partitioned among PEs and would be lost with a server"));
   if (ranks < 2)
-    throw InputError("--farm needs a master and at least one server: launch it as mpirun --enable-recovery -np N parrender "
-                     "render ... --farm, with N >= 2");
+    throw InputError("--farm needs a master and at least one server: launch parrender under mpirun --enable-recovery -np N, "
+                     "with N >= 2");
   if (par::scheduleNeedsCostEstimates(farm.schedule))
     throw InputError("--farm-schedule " + farm.schedule + " orders jobs by cost estimates, which the farm's master (which traces nothing) does not have");
   if (settings.ray.adaptive) throw InputError("--adaptive splits tiles by a cost pre-pass, which the farm does not run");
   (void)parseJobSize(farm.job);
 }
 
-par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std::string& output) {
+void warnWithoutRecovery() {
+  // Open MPI's mpirun passes --enable-recovery to its ranks as this variable.
+  const char* recovery = std::getenv("OMPI_MCA_orte_enable_recovery");
+  if (!recovery || std::string_view(recovery) != "1")
+    std::fprintf(stderr, "parrender: warning: --farm without mpirun --enable-recovery: a server that dies ends every rank "
+                         "(Open MPI's default); launch it as mpirun --enable-recovery ...\n");
+}
+
+FarmRender renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std::string& output) {
   par::ProcessGroup& group = par::ProcessGroup::get();
   par::Transport& transport = group.transport();
   transport.tolerateLostRanks();
   const JobSize size = parseJobSize(farm.job);
   const Areas jobs = cut(rt::PixelRect{0, 0, in.width, in.height}, size.w, size.h);
   const std::uint64_t hash = scene::contentHash(in.scene);
+  const int run = farmRuns++;
   if (group.rank() != 0) {
-    serve(farm, in, jobs, hash);
+    serve(farm, in, jobs, hash, run);
     return {};
   }
-  // Open MPI's mpirun passes --enable-recovery to its ranks as this variable.
-  const char* recovery = std::getenv("OMPI_MCA_orte_enable_recovery");
-  if (!recovery || std::string_view(recovery) != "1")
-    std::fprintf(stderr, "parrender: warning: --farm without mpirun --enable-recovery: a server that dies ends every rank "
-                         "(Open MPI's default); launch it as mpirun --enable-recovery ...\n");
   rt::Film film(in.width, in.height, samplesPerPixel(in.settings.ray));
   std::unique_ptr<par::Scheduler> order = par::makeScheduler(farm.schedule);
   int written = 0;
@@ -252,7 +263,7 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
     film.addBlock(par::decodeMessage<rt::FilmBlock>(result));
   };
   const auto tick = [&](const par::FarmProgress& p) {
-    if (p.jobsDone != written) {
+    if (!output.empty() && p.jobsDone != written) {
       image::writeImage(output, film.toImage());
       written = p.jobsDone;
     }
@@ -266,7 +277,7 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
   const auto lost = [&group](int rank) { group.markLost(rank); };
   par::FarmRecord record;
   try {
-    record = par::runFarmMaster(transport, farmOptions(farm), hash, jobs.tasks, *order, in.schedule.params, accept, tick, lost);
+    record = par::runFarmMaster(transport, farmOptions(farm, run), hash, jobs.tasks, *order, in.schedule.params, accept, tick, lost);
   } catch (const par::FarmSharedPrepassLost& e) {
     group.abortRun(1, e.what());
   } catch (const par::FarmServerFailed& e) {
@@ -274,33 +285,71 @@ par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& in, const std
     throw;
   }
   record.jobShape = "screen area " + std::to_string(size.w) + "x" + std::to_string(size.h);
-  return farmRunRecord(std::move(record), jobs.tasks, par::kFarmJobBytes);
+  return FarmRender{farmRunRecord(std::move(record), jobs.tasks, par::kFarmJobBytes), film.toImage()};
 }
 
-void printFarmSummary(const par::RunRecord& record) {
-  if (!record.farm) return;
+TimedRender timedFarmRender(const FarmArgs& farm, const RenderInput& input, const RenderSettings& settings, int threads,
+                            const par::ScheduleOptions& schedule) {
+  par::ProcessGroup& group = par::ProcessGroup::get();
+  const double cpu0 = processCpuSeconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  FarmRender done = renderOnFarm(
+      farm, FarmInput{input.scene, input.camera, input.plan, input.width, input.height, settings, schedule, threads}, "");
+  TimedRender t;
+  if (group.rank() != 0) return t;
+  t.wallSeconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  t.cpuSeconds = processCpuSeconds() - cpu0;
+  for (const par::FarmServerRecord& s : done.record.farm->servers) {
+    t.cpuSeconds += s.cpuSeconds;
+    if (s.lost())
+      group.abortRun(1, "farm server rank " + std::to_string(s.rank) +
+                            " was lost; compare and report measure the farm and need every rank for the renders after it "
+                            "(render --farm is the farm that goes on without a lost server)");
+  }
+  t.outcome.image = std::move(done.image);
+  t.record = std::move(done.record);
+  return t;
+}
+
+par::FarmPrediction predictFarmRun(const par::RunRecord& record, int servers, const par::NetworkModel& network,
+                                   const std::string& schedule, const par::ScheduleParams& params) {
+  if (!record.farm || record.stages.size() < 2) throw InputError("a farm's run record has its jobs as its second stage");
+  par::TaskSet tasks;
+  tasks.tasks = record.stages[1].tasks;
+  std::unique_ptr<par::Scheduler> order = par::makeScheduler(schedule);
+  return par::predictFarm(*record.farm, tasks, par::kFarmJobBytes, servers, network, *order, params);
+}
+
+std::string farmSummary(const par::RunRecord& record) {
+  if (!record.farm) return {};
   const par::FarmRecord& f = *record.farm;
-  std::printf("farm: %zu jobs (%s) in the order of %s, %zu servers, pre-passes %s, deadline %.1f s, wall %.3f s\n",
-              f.jobs.size(), f.jobShape.c_str(), f.schedule.c_str(), f.servers.size(), f.prepass.c_str(), f.deadlineSeconds,
-              f.wallSeconds);
+  std::string out;
+  const auto line = [&out](const char* format, auto... values) {
+    char text[512];
+    std::snprintf(text, sizeof text, format, values...);
+    out += text;
+  };
+  line("farm: %zu jobs (%s) in the order of %s, %zu servers, pre-passes %s, deadline %.1f s, wall %.3f s\n", f.jobs.size(),
+       f.jobShape.c_str(), f.schedule.c_str(), f.servers.size(), f.prepass.c_str(), f.deadlineSeconds, f.wallSeconds);
   int handedOn = 0, late = 0;
   for (const par::FarmServerRecord& s : f.servers) {
-    std::printf("  server rank %d (%d PE%s): %zu jobs, pre-passes %.3f s", s.rank, s.pes, s.pes == 1 ? "" : "s", s.jobs.size(),
-                s.prepareSeconds);
+    line("  server rank %d (%d PE%s): %zu jobs, pre-passes %.3f s", s.rank, s.pes, s.pes == 1 ? "" : "s", s.jobs.size(),
+         s.prepareSeconds);
     if (f.prepass == "shared")
-      std::printf(" (shared: %llu messages, %llu bytes between servers)", (unsigned long long)s.prepareMessages,
-                  (unsigned long long)s.prepareBytes);
-    std::printf(", busy %.3f s, idle %.3f s", s.busySeconds, s.idleSeconds);
-    if (s.lost()) std::printf("; lost at %.2f s (last heard %.2f s), %zu job(s) handed on", s.lostAtSeconds, s.lastHeardSeconds, s.handedOn.size());
-    if (s.lateResults > 0) std::printf("; %d late result(s) discarded", s.lateResults);
-    std::printf("\n");
+      line(" (shared: %llu messages, %llu bytes between servers)", (unsigned long long)s.prepareMessages,
+           (unsigned long long)s.prepareBytes);
+    line(", busy %.3f s, idle %.3f s, CPU %.3f s", s.busySeconds, s.idleSeconds, s.cpuSeconds);
+    if (s.lost()) line("; lost at %.2f s (last heard %.2f s), %zu job(s) handed on", s.lostAtSeconds, s.lastHeardSeconds, s.handedOn.size());
+    if (s.lateResults > 0) line("; %d late result(s) discarded", s.lateResults);
+    out += "\n";
     handedOn += int(s.handedOn.size());
     late += s.lateResults;
   }
   std::uint64_t bytes = 0;
   for (const par::FarmJobRecord& j : f.jobs) bytes += j.resultBytes;
-  std::printf("results: %zu messages (%llu bytes) to the master; jobs handed on %d, late results discarded %d\n", f.jobs.size(),
-              (unsigned long long)bytes, handedOn, late);
+  line("results: %zu messages (%llu bytes) to the master; jobs handed on %d, late results discarded %d\n", f.jobs.size(),
+       (unsigned long long)bytes, handedOn, late);
+  return out;
 }
 
 }  // namespace pr::cli

@@ -14,8 +14,11 @@
 
 #include <CLI/CLI.hpp>
 
+#include "common/image/image.h"
+#include "common/parallel/farm/farm_replay.h"
 #include "common/parallel/run_options.h"
 #include "tools/render_methods.h"
+#include "tools/timed_render.h"
 
 namespace pr::cli {
 
@@ -30,7 +33,11 @@ struct FarmArgs {
   std::string statusFile;  // --farm-status: the run's exit status, written by rank 0 at the end
   std::string prepass = "replicated";  // --farm-prepass: replicated | shared
 };
-void addFarmOptions(CLI::App& command, FarmArgs& args);
+// What a farm is: --farm (described as `what`), --farm-job, --farm-schedule, --farm-prepass,
+// --farm-deadline, --farm-ahead (render, compare, report).
+void addFarmOptions(CLI::App& command, FarmArgs& args, const std::string& what);
+// What only `render --farm` watches: --farm-refresh, --farm-status, --progress.
+void addFarmRenderOptions(CLI::App& command, FarmArgs& args);
 
 // Bad use, refused before the scene is loaded (pr::InputError naming the reason): one rank only
 // (no mpirun), a method other than image-space (a server must hold all a job needs), a
@@ -41,10 +48,10 @@ void reportFarmStatus(const FarmArgs& farm);
 
 void checkFarm(const FarmArgs& farm, const RenderMethod& method, const RenderSettings& settings, int ranks);
 
-// The render as a farm, on every rank (the master's image and record are written to `output`
-// and outputs.metricsFile, the image also every --farm-refresh seconds). On rank 0 returns the
-// farm's run record, whose PEs are the servers; elsewhere an empty record. Marks lost servers
-// in the ProcessGroup, so the run's ending does not wait for them.
+// The render as a farm, on every rank: the master's image is written to `output` every
+// --farm-refresh seconds and at the end (none when `output` is empty). On rank 0 returns the
+// image and the farm's run record, whose PEs are the servers; elsewhere nothing. Marks lost
+// servers in the ProcessGroup, so the run's ending does not wait for them.
 struct FarmInput {
   const scene::Scene& scene;
   const scene::Camera& camera;
@@ -54,9 +61,32 @@ struct FarmInput {
   par::ScheduleOptions schedule;  // among each server's PEs
   int threads = 1;                // each server's PEs
 };
-par::RunRecord renderOnFarm(const FarmArgs& farm, const FarmInput& input, const std::string& output);
+struct FarmRender {
+  par::RunRecord record;
+  image::Image image;
+};
+FarmRender renderOnFarm(const FarmArgs& farm, const FarmInput& input, const std::string& output);
 
-// The summary's farm lines: servers, their jobs, busy and idle time, the lost ones.
-void printFarmSummary(const par::RunRecord& record);
+// On rank 0: a warning on stderr when mpirun was not given --enable-recovery, without which a
+// server that dies ends every rank.
+void warnWithoutRecovery();
+
+// The farm as one of the timed renders of compare and report (every rank takes part): the
+// master's wall clock around the farm, the CPU time of the master and of every server (each
+// reports its own as it says goodbye). Those commands measure the farm and need every rank for
+// the renders after it, so a server lost during it ends the run (status 1) with one message;
+// `render --farm` is the farm that goes on without it.
+TimedRender timedFarmRender(const FarmArgs& farm, const RenderInput& input, const RenderSettings& settings, int threads,
+                            const par::ScheduleOptions& schedule);
+
+// A farm's run record (renderOnFarm) replayed at `servers` servers on `network`, its jobs
+// ordered by `schedule` (common/parallel/farm/farm_replay.h). Throws pr::InputError for a
+// record without its jobs stage.
+par::FarmPrediction predictFarmRun(const par::RunRecord& record, int servers, const par::NetworkModel& network,
+                                   const std::string& schedule, const par::ScheduleParams& params);
+
+// The farm's lines of a summary: jobs, servers, their jobs, CPU, busy and idle time, the lost
+// ones, results sent ("" for a record that is not a farm's).
+std::string farmSummary(const par::RunRecord& record);
 
 }  // namespace pr::cli

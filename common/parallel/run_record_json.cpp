@@ -90,7 +90,8 @@ json farmJson(const FarmRecord& f) {
                {"idleSeconds", s.idleSeconds},
                {"jobs", s.jobs},
                {"lastHeardSeconds", s.lastHeardSeconds},
-               {"lateResults", s.lateResults}};
+               {"lateResults", s.lateResults},
+               {"cpuSeconds", s.cpuSeconds}};
     if (s.lost()) {
       js["lostAtSeconds"] = s.lostAtSeconds;
       js["handedOn"] = s.handedOn;
@@ -277,6 +278,7 @@ FarmRecord parseFarm(const json& jf, const std::string& origin) {
     s.jobs = intList(js, "jobs", origin, server);
     s.lastHeardSeconds = optionalField(js, "lastHeardSeconds", 0.0, origin, server);
     s.lateResults = optionalField(js, "lateResults", 0, origin, server);
+    s.cpuSeconds = optionalField(js, "cpuSeconds", 0.0, origin, server);
     s.lostAtSeconds = optionalField(js, "lostAtSeconds", -1.0, origin, server);
     s.handedOn = intList(js, "handedOn", origin, server);
     f.servers.push_back(std::move(s));

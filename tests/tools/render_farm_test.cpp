@@ -3,13 +3,16 @@
 // ranks, with the path tracer and the photon map; a server killed (SIGKILL) or stopped (SIGSTOP,
 // continued after the master declared it lost) while it holds a job leaves the image complete
 // and identical, the run exits 0 and the record names the lost server, the jobs handed on and
-// the late result discarded; bad use is refused with one message. The protocol's guarantees
+// the late result discarded; bad use is refused with one message; compare and report measure
+// the farm beside the SPMD runs and show its servers. The protocol's guarantees
 // in one process: tests/common/parallel/farm_test.cpp.
 #include <doctest/doctest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <string>
+
+#include <nlohmann/json.hpp>
 
 #include "common/image/image_io.h"
 #include "common/parallel/run_record.h"
@@ -260,4 +263,79 @@ TEST_CASE("render --farm: bad use is refused with one message") {
   INFO(r.output);
   CHECK(statusIn(status) == "2");
   CHECK(occurrences(r.output, "rank 1 loaded a different scene from rank 0's") == 1);
+}
+
+TEST_CASE("compare --farm: image-space as a farm beside its SPMD runs, bit-identical, every server in the notes and the JSON") {
+  const std::filesystem::path dir = pr::test::scratchDir("compare_farm");
+  const std::string args = join({"compare ", cornell(), " --methods image-space --integrators path,photonmap --photons 2000 --threads 1,2",
+                                 " --width 64 --height 48 --spp 2 --repeat 2 --no-reference --quiet --farm --farm-job 16x12 --json ",
+                                 quoted(dir / "c.json")});
+  const CommandResult r = farmRun(3, args);
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  CHECK(occurrences(r.output, "image-space farm: rank 0 the master, the other 2 ranks servers") == 1);
+  CHECK(occurrences(r.output, "images: every render is bit-identical to the first of its family and integrator") == 1);
+  std::ifstream in(dir / "c.json");
+  const nlohmann::json j = nlohmann::json::parse(in);
+  int farms = 0;
+  for (const nlohmann::json& row : j["rows"]) {
+    if (!row.contains("farm")) continue;
+    ++farms;
+    CAPTURE(row["agreement"]);
+    CHECK(row["imageAgrees"] == true);
+    CHECK(row["method"] == "image-space");
+    CHECK(row["ranks"] == 3);
+    const int threads = row["pes"].get<int>() / 2;  // 2 servers
+    CHECK((threads == 1 || threads == 2));
+    REQUIRE(row["farm"]["servers"].size() == 2);
+    std::size_t jobs = 0;
+    for (const nlohmann::json& server : row["farm"]["servers"]) {
+      CHECK(server["pes"] == threads);
+      CHECK(server["cpuSeconds"].get<double>() > 0.0);  // told at its goodbye
+      jobs += server["jobs"].size();
+    }
+    CHECK(jobs == 16);  // 64x48 in jobs of 16x12
+    CHECK(row["speedupSerial"].get<double>() > 0.0);
+  }
+  CHECK(farms == 4);  // 2 integrators x 2 values of --threads
+  // Every farm's servers in the notes, the median run's.
+  CHECK(occurrences(r.output, "server rank 1 (1 PE): ") == 2);
+  CHECK(occurrences(r.output, "server rank 2 (2 PEs): ") == 2);
+  // Without a server: one message.
+  const CommandResult alone = pr::test::runParrender(join({"compare ", cornell(), " --methods image-space --farm --quiet"}));
+  CHECK(alone.exitStatus == 2);
+  CHECK(occurrences(alone.output, "--farm needs a master and at least one server") == 1);
+}
+
+TEST_CASE("compare --farm: a server lost during a farm ends the comparison with one message, never a hang") {
+  const CommandResult r =
+      farmRun(3, join({"compare ", cornell(), " --methods image-space --threads 1 --width 64 --height 48 --spp 2 --repeat 1 --no-reference --quiet",
+                       " --farm --farm-job 16x12 --farm-deadline ", kLossDeadline}),
+              "PARRENDER_FARM_FAULT=2:2:9", 90);
+  INFO(r.output);
+  CHECK(r.exitStatus != 124);
+  CHECK(occurrences(r.output, "farm server rank 2 was lost; compare and report measure the farm") == 1);
+}
+
+TEST_CASE("report --farm: a section with the farm beside image-space on the same ranks, every server, and the simulator's replay") {
+  const std::filesystem::path dir = pr::test::scratchDir("report_farm");
+  const CommandResult r = farmRun(
+      3, join({"report ", cornell(), " -o ", quoted(dir / "report"), " --methods image-space --schedules demand --width 64 --height 48",
+               " --spp 2 --repeat 1 --reference-spp 4 --photon-spp 1 --path-spp 1 --photons 1000 --reference-dir ", quoted(dir / "refs"),
+               " --farm --farm-job 16x12"}),
+      "", 300);
+  INFO(r.output);
+  REQUIRE(r.exitStatus == 0);
+  std::ifstream in(dir / "report" / "index.html");
+  const std::string html((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  REQUIRE(occurrences(html, "<h3>The render farm</h3>") == 1);
+  const std::size_t from = html.find("<h3>The render farm</h3>");
+  const std::string farm = html.substr(from, html.find("<h3>", from + 1) - from);
+  CHECK(occurrences(farm, "image-space farm(demand) demand path P=2 R=3") == 2);  // the farm's table and its servers'
+  CHECK(occurrences(farm, "image-space demand path P=3 R=3: ") == 1);             // SPMD on the same ranks beside it
+  CHECK(occurrences(farm, "<tr><td>1</td><td>1</td>") == 1);                      // server ranks 1 and 2, one PE each
+  CHECK(occurrences(farm, "<tr><td>2</td><td>1</td>") == 1);
+  CHECK(occurrences(farm, "<td>2 (measured: jobs ") == 1);  // the replay's residual at 2 servers
+  CHECK(occurrences(farm, "<tr><td>16</td>") == 1);         // and out to one server per job, no further
+  CHECK(farm.find("<tr><td>32</td>") == std::string::npos);
 }

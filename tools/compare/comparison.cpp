@@ -19,8 +19,10 @@
 
 namespace pr::cli {
 
+std::string Combination::methodName() const { return farm.empty() ? method : method + " farm"; }
+
 std::string Combination::label() const {
-  std::string out = method + " " + schedule;
+  std::string out = method + (farm.empty() ? "" : " farm(" + farm + ")") + " " + schedule;
   if (integrator != kNotApplicable) out += " " + integrator;
   if (compositor != kNotApplicable) out += " " + compositor;
   out += " P=" + std::to_string(pes);
@@ -80,6 +82,14 @@ RenderSettings settingsFor(const Combination& c, const ComparisonSpec& spec) {
   if (c.integrator != kNotApplicable) settings.ray.integrator = c.integrator;
   if (c.compositor != kNotApplicable) settings.raster.compositor = c.compositor;
   return settings;
+}
+
+// One timed render of the combination, on every rank that takes part.
+TimedRender timed(const Combination& c, const ComparisonSpec& spec, const RenderInput& input) {
+  const RenderSettings settings = settingsFor(c, spec);
+  const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
+  if (!c.farm.empty()) return timedFarmRender(spec.farm, input, settings, c.pes / (c.ranks - 1), schedule);
+  return timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks}, schedule);
 }
 
 bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
@@ -153,7 +163,7 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
       for (const std::string& compositor : compositorList)
         for (const std::string& schedule : spec.schedules)
           for (const Placement where : placements) {
-            Combination c{name, method.properties.family, schedule, integrator, compositor, where.pes, where.ranks};
+            Combination c{name, method.properties.family, schedule, integrator, compositor, where.pes, where.ranks, {}};
             std::string reason = whyInvalid(c, spec);
             if (reason.empty()) {
               try {
@@ -168,6 +178,25 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
             else out.skipped.push_back({c.label(), reason});
           }
   }
+  // The farm's combinations last: a lost server would leave the renders after it without a rank.
+  if (spec.farm.enabled) {
+    const RenderMethod& imageSpace = findRenderMethod("image-space");
+    checkFarm(spec.farm, imageSpace, spec.settings, ranks);
+    for (const std::string& integrator : spec.integrators)
+      for (const std::string& schedule : spec.schedules)
+        for (int t : threads) {
+          const Combination c{imageSpace.name, MethodFamily::Ray, schedule, integrator, kNotApplicable, (ranks - 1) * t, ranks,
+                              spec.farm.schedule};
+          RayOptions rayOptions = spec.settings.ray;
+          rayOptions.integrator = integrator;
+          try {
+            checkRenderMemory(imageSpace, input.width, input.height, t, samplesPerPixel(rayOptions));
+            combinations.push_back(c);
+          } catch (const InputError& e) {
+            out.skipped.push_back({c.label(), e.what()});
+          }
+        }
+  }
   for (const std::string& note : spec.notes) out.skipped.push_back({"option", note});
 
   if (spec.reference) out.reference = pathReference(spec.referenceSettings, input);
@@ -178,13 +207,11 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   // Under mpirun, once on rank 0 alone and once across ranks.
   const bool holds = holdsResults();
   const bool progress = spec.progress && holds;
-  std::set<std::pair<MethodFamily, int>> warmed;
+  std::set<std::tuple<MethodFamily, int, bool>> warmed;
   for (const Combination& c : combinations) {
-    if (!warmed.insert({c.family, c.ranks}).second) continue;
+    if (!warmed.insert({c.family, c.ranks, !c.farm.empty()}).second) continue;
     if (progress) std::fprintf(stderr, "warm-up (untimed): %s\n", c.label().c_str());
-    const RenderSettings settings = settingsFor(c, spec);
-    timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks},
-                par::ScheduleOptions{c.schedule, spec.scheduleParams});
+    (void)timed(c, spec, input);
   }
 
   const int total = int(combinations.size()) * spec.repeat;
@@ -192,14 +219,11 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   // The first image of each family and integrator: every other must equal it bit for bit.
   std::map<std::pair<MethodFamily, std::string>, std::size_t> familyFirst;
   for (const Combination& c : combinations) {
-    const RenderSettings settings = settingsFor(c, spec);
-    const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
-    const RenderMethod& method = findRenderMethod(c.method);
     ComparisonRow row;
     row.what = c;
     std::vector<TimedRender> runs;
     for (int r = 0; r < spec.repeat; ++r) {
-      TimedRender t = timedRender(method, input, settings, Placement{c.pes, c.ranks}, schedule);
+      TimedRender t = timed(c, spec, input);
       ++done;
       if (!holds) continue;  // rank 0 holds the figures and images
       if (progress)
@@ -250,14 +274,16 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
     out.rows.push_back(std::move(row));
   }
 
-  // Speed-ups: T1 is the same combination at P = 1; Ts the family's serial reference for the
+  // Speed-ups: T1 is the same combination at P = 1 (a farm's: image-space's with the schedule
+  // of its servers' PEs); Ts the family's serial reference for the
   // integrator, the sequential tracer when it ran, else the family's fastest run at P = 1.
   for (ComparisonRow& row : out.rows) {
     const ComparisonRow* one = nullptr;
     const ComparisonRow* serial = nullptr;
     for (const ComparisonRow& other : out.rows) {
       const Combination& o = other.what;
-      if (o.pes != 1 || o.family != row.what.family || o.integrator != row.what.integrator) continue;
+      // A farm at P = 1 (one server) is no one-PE baseline: a master runs beside it.
+      if (o.pes != 1 || !o.farm.empty() || o.family != row.what.family || o.integrator != row.what.integrator) continue;
       if (o.method == row.what.method && o.schedule == row.what.schedule && o.compositor == row.what.compositor) one = &other;
       const bool sequential = o.method == "sequential";
       if (!serial || (sequential && serial->what.method != "sequential") ||

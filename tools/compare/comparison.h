@@ -16,6 +16,7 @@
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_options.h"
 #include "common/parallel/run_record.h"
+#include "tools/farm_render.h"
 #include "tools/render_methods.h"
 #include "tools/sweep/path_reference.h"
 #include "tools/timed_render.h"
@@ -32,7 +33,12 @@ struct Combination {
   std::string schedule, integrator, compositor;
   int pes = 1;
   int ranks = 1;  // under mpirun: every rank (P = ranks x PEs per rank), or 1 for rank 0 alone
-  std::string label() const;  // "object-space demand path P=2", "... P=4 R=2" across ranks
+  // A farm (farm_render.h): the master's order of jobs; empty for every other render. A farm's
+  // P counts its servers' PEs, (ranks - 1) x PEs per server; `schedule` is among each server's.
+  std::string farm;
+  std::string label() const;  // "object-space demand path P=2", "... P=4 R=2" across ranks,
+                              // "image-space farm(demand) demand path P=2 R=3"
+  std::string methodName() const;  // "image-space", or "image-space farm" for a farm
 };
 
 struct ComparisonSpec {
@@ -47,6 +53,10 @@ struct ComparisonSpec {
   bool keepImages = true;        // keep each row's image (report); else only the figures
   bool progress = true;          // a line on stderr per render
   std::vector<std::string> notes;  // options given that some methods do not take (shown as skipped)
+  // With farm.enabled, under mpirun: image-space also as a farm, a master and ranks - 1 servers
+  // of each --threads value, for every schedule (among a server's PEs) and integrator, after
+  // every other render.
+  FarmArgs farm;
 };
 
 struct ComparisonRow {
@@ -79,7 +89,8 @@ struct Comparison {
   int mismatches = 0;   // rows whose image differs from their family's
 };
 
-// Throws pr::InputError for an empty dimension or an unknown name; a combination that cannot
+// Throws pr::InputError for an empty dimension or an unknown name, and for a farm without a
+// server or the farm's bad use (checkFarm); a combination that cannot
 // run (sequential at P > 1, binary-swap at P not a power of two, a request over the memory
 // limit) is skipped with the reason. Under mpirun with R ranks, each value T of spec.threads
 // gives a row at P = R x T across every rank, and every combination also runs at P = 1 on

@@ -60,6 +60,14 @@ std::string layout(const std::vector<std::vector<std::string>>& cells, std::size
   return out;
 }
 
+// P, and where its PEs ran: "4 (2x2)" on 2 ranks, "4 (2x2+master)" for a farm of 2 servers.
+std::string placementText(const Combination& c) {
+  if (!c.farm.empty())
+    return std::to_string(c.pes) + " (" + std::to_string(c.ranks - 1) + "x" + std::to_string(c.pes / (c.ranks - 1)) + "+master)";
+  if (c.ranks > 1) return std::to_string(c.pes) + " (" + std::to_string(c.ranks) + "x" + std::to_string(c.pes / c.ranks) + ")";
+  return std::to_string(c.pes);
+}
+
 }  // namespace
 
 std::string comparisonTable(const Comparison& c) {
@@ -82,14 +90,12 @@ std::string comparisonTable(const Comparison& c) {
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     const par::KindTraffic all = allTraffic(r);
-    std::vector<std::string> line = {r.what.method,
+    std::vector<std::string> line = {r.what.methodName(),
                                      std::string(toString(r.what.family)),
                                      r.what.schedule,
                                      r.what.integrator,
                                      r.what.compositor,
-                                     r.what.ranks > 1 ? std::to_string(r.what.pes) + " (" + std::to_string(r.what.ranks) +
-                                                            "x" + std::to_string(r.what.pes / r.what.ranks) + ")"
-                                                      : std::to_string(r.what.pes),
+                                     placementText(r.what),
                                      number(r.wall, "%.4g"),
                                      r.wall > 0.0 ? "±" + number(50.0 * (r.wallMax - r.wallMin) / r.wall, "%.0f") + "%" : "-",
                                      number(r.cpu, "%.4g"),
@@ -121,6 +127,8 @@ std::string comparisonNotes(const Comparison& c) {
     if (!r.agrees) out += "IMAGE MISMATCH " + r.what.label() + ": " + r.agreement + "\n";
   if (c.mismatches == 0 && !c.rows.empty())
     out += "images: every render is bit-identical to the first of its family and integrator\n";
+  for (const ComparisonRow& r : c.rows)
+    if (r.record.farm) out += "\n" + r.what.label() + " (the median run):\n" + farmSummary(r.record);
   return out;
 }
 
@@ -129,7 +137,8 @@ std::string comparisonCsv(const Comparison& c) {
   out << "method,family,schedule,integrator,compositor,pes,repeats,wall_seconds,wall_min,wall_max,cpu_seconds,speedup,"
          "speedup_serial,efficiency,load_imbalance,messages,bytes";
   for (const std::string& k : comparisonKinds()) out << "," << k << "_messages," << k << "_bytes";
-  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks,between_ranks_messages,between_ranks_bytes\n";
+  out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks,between_ranks_messages,between_ranks_bytes,"
+         "farm_schedule\n";
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     out << r.what.method << "," << toString(r.what.family) << "," << r.what.schedule << "," << r.what.integrator << ","
@@ -143,7 +152,7 @@ std::string comparisonCsv(const Comparison& c) {
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
         << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "," << r.what.ranks << ","
-        << allTraffic(r).betweenRankMessages << "," << allTraffic(r).betweenRankBytes << "\n";
+        << allTraffic(r).betweenRankMessages << "," << allTraffic(r).betweenRankBytes << "," << r.what.farm << "\n";
   }
   return out.str();
 }
@@ -185,6 +194,8 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"rmse", optional(r.rmse, r.rmse >= 0.0)},
                     {"imageAgrees", r.agrees},
                     {"agreement", r.agreement}});
+    // A farm's servers and jobs, as its run record holds them.
+    if (r.record.farm) rows.back()["farm"] = nlohmann::json::parse(par::toJsonText(r.record))["farm"];
   }
   nlohmann::json skipped = nlohmann::json::array();
   for (const SkippedCombination& s : c.skipped) skipped.push_back({{"what", s.what}, {"reason", s.reason}});

@@ -21,6 +21,7 @@
 #include "tools/compare/comparison_output.h"
 #include "tools/report/cache_sweep.h"
 #include "tools/report/classification.h"
+#include "tools/report/farm_section.h"
 #include "tools/report/html.h"
 #include "tools/report/scaling_model.h"
 #include "tools/sweep/image_error.h"
@@ -91,9 +92,10 @@ struct MethodScaling {
   const ComparisonRow* largest = nullptr;  // the run at the largest P
 };
 
-// The rows that trace each method's curve: its first schedule and compositor.
+// The rows that trace each method's curve: its first schedule and compositor (a farm's has its
+// own section).
 bool onCurve(const ComparisonRow& r, const ReportSpec& spec) {
-  return r.what.schedule == spec.schedules.front() &&
+  return r.what.farm.empty() && r.what.schedule == spec.schedules.front() &&
          (r.what.compositor == kNotApplicable || r.what.compositor == raster::compositors().begin()->name);
 }
 
@@ -203,7 +205,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
     std::string kinds;
     for (const par::KindTraffic& k : t.byKind)
       if (k.messages) kinds += (kinds.empty() ? "" : ", ") + k.kind + " " + std::to_string(k.messages);
-    rows.push_back({r.what.method, r.what.schedule, r.what.integrator, std::to_string(r.what.pes), fmt(r.wall, "%.4f"),
+    rows.push_back({r.what.methodName(), r.what.schedule, r.what.integrator, std::to_string(r.what.pes), fmt(r.wall, "%.4f"),
                     fmt(r.cpu, "%.4f"), r.speedup > 0 ? fmt(r.speedup, "%.2f") : "-",
                     r.speedupSerial > 0 ? fmt(r.speedupSerial, "%.2f") : "-", r.efficiency > 0 ? fmt(r.efficiency, "%.2f") : "-",
                     fmt(t.imbalance, "%.3f"), std::to_string(all.messages), formatBytes(all.bytes), kinds,
@@ -218,6 +220,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
                  "messages", "bytes", "messages by kind", "comp/comm", "cache hits", "RMSE", "image"},
                 rows) +
           (skipped.empty() ? "" : "<p>Skipped:</p>" + table({"combination", "reason"}, skipped, "text"));
+  html += farmSection(c, par::networkByName(spec.network), spec.maxPredictedPes);
 
   // Speed-up and efficiency against P: measured, predicted, Amdahl.
   std::fprintf(stderr, "report: %s: predicting to %d PEs on %s\n", stem.c_str(), spec.maxPredictedPes, spec.network.c_str());
@@ -425,7 +428,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
       for (const ComparisonRow& r : c.rows)
         if (r.what.pes == p && r.what.family == family && (!best || r.wall < best->wall)) best = &r;
       if (best && best != fastest)
-        html += " Fastest " + escape(std::string(toString(family))) + ": " + escape(best->what.method) + ", " +
+        html += " Fastest " + escape(std::string(toString(family))) + ": " + escape(best->what.methodName()) + ", " +
                 fmt(best->wall, "%.4f") + " s.";
     }
     html += "</li>";
@@ -501,6 +504,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
   cs.threads = spec.threads;
   cs.repeat = spec.repeat;
   cs.settings = spec.settings;
+  cs.farm = spec.farm;
   cs.referenceSettings = ReferenceSettings{sceneFile, spec.camera, "", spec.lighting, spec.referenceSpp, 16,
                                            spec.settings.ray.seed, spec.referenceDir, false, "image-space",
                                            everyRank(maxThreads), {}};

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "tools/farm_render.h"
 #include "tools/lighting.h"
 #include "tools/render_methods.h"
 
@@ -33,6 +34,7 @@ struct ReportSpec {
   // among the methods.
   std::vector<double> cacheMb = {0.0, 0.25, 1.0, 4.0, 16.0, 64.0};
   LightingOptions lighting;
+  FarmArgs farm;  // with farm.enabled, under mpirun: image-space also as a farm (farm_section.h)
 };
 
 // Writes the scene's files under dir (created) and returns its HTML section; `relDir` is dir

@@ -41,6 +41,9 @@ struct FarmOptions {
   // results all-gathered): a server lost before it is ready then ends every rank at once,
   // since the others wait for its share. Otherwise each server's pre-passes are its own.
   bool sharedPrepass = false;
+  // Which farm run of the command this is, counted alike on every rank (compare runs several):
+  // each run's messages go on tags of their own (farm_messages.h).
+  int run = 0;
 };
 
 // What a server's pre-passes sent to other servers (shared pre-passes; zero otherwise).

@@ -35,7 +35,13 @@ class Master {
  public:
   Master(Transport& transport, const FarmOptions& options, std::uint64_t hash, const TaskSet& jobs, Scheduler& order,
          const ScheduleParams& params)
-      : t_(transport), options_(options), hash_(hash), order_(order), start_(Clock::now()) {
+      : t_(transport),
+        options_(options),
+        toMaster_(farm::toMasterTag(options.run)),
+        toServer_(farm::toServerTag(options.run)),
+        hash_(hash),
+        order_(order),
+        start_(Clock::now()) {
     const int servers = t_.ranks() - 1;
     PR_CHECK(servers >= 1, "a farm needs a server besides the master");
     order_.reset(jobs, servers, params);
@@ -61,7 +67,7 @@ class Master {
     try {
       while (done_ < state_.size()) {
         bool heard = false;
-        while (std::optional<Envelope> e = t_.poll(farm::kToMasterTag)) {
+        while (std::optional<Envelope> e = t_.poll(toMaster_)) {
           heard = true;
           handle(*e, accept);
         }
@@ -114,17 +120,17 @@ class Master {
         s.hello = true;
         s.record.pes = hello.pes;
         if (hello.contentHash != hash_) {
-          t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Mismatch));
+          t_.send(e.source, toServer_, farm::message(farm::MasterSays::Mismatch));
           throw InputError("rank " + std::to_string(e.source) +
                            " loaded a different scene from rank 0's (its content hash differs): every rank must read the same scene");
         }
         // Shared pre-passes start together: every server is welcomed once all have been checked.
         if (!options_.sharedPrepass) {
-          t_.send(e.source, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
+          t_.send(e.source, toServer_, farm::message(farm::MasterSays::Welcome));
           return;
         }
         if (std::any_of(servers_.begin(), servers_.end(), [](const Server& x) { return !x.hello; })) return;
-        for (const Server& x : servers_) t_.send(x.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Welcome));
+        for (const Server& x : servers_) t_.send(x.record.rank, toServer_, farm::message(farm::MasterSays::Welcome));
         return;
       }
       case farm::ServerSays::Ready: {
@@ -214,7 +220,7 @@ class Master {
       jr.sentSeconds = seconds();
       ++jr.attempts;
       s.holding.push_back(j);
-      t_.send(rank, farm::kToServerTag, farm::message(farm::MasterSays::Job, std::int32_t(j)));
+      t_.send(rank, toServer_, farm::message(farm::MasterSays::Job, std::int32_t(j)));
     }
   }
 
@@ -242,7 +248,7 @@ class Master {
       handedOn = true;
       (*lost_)(s.record.rank);
       // Should it wake up, it finishes the job in hand, sends that (late) result and stops.
-      t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Stop));
+      t_.send(s.record.rank, toServer_, farm::message(farm::MasterSays::Stop));
       std::fprintf(stderr, "parrender: farm: server rank %d declared lost after %.1f s of silence%s; %zu job(s) handed on\n",
                    s.record.rank, now - s.silentSince, s.ready ? "" : " (before it was ready)", s.record.handedOn.size());
     }
@@ -256,11 +262,16 @@ class Master {
   void awaitGoodbyes() {
     const double until = seconds() + options_.deadlineSeconds;
     for (;;) {
-      while (std::optional<Envelope> e = t_.poll(farm::kToMasterTag)) {
+      while (std::optional<Envelope> e = t_.poll(toMaster_)) {
         if (e->source < 1 || e->source >= t_.ranks() || e->bytes.empty()) continue;
         Server& s = server(e->source);
         const auto kind = farm::ServerSays(e->bytes[0]);
-        if (kind == farm::ServerSays::Bye) s.goodbye = true;
+        if (kind == farm::ServerSays::Bye && !s.record.lost()) {
+          s.goodbye = true;
+          WireReader r(e->bytes);
+          (void)r.value<farm::ServerSays>();
+          s.record.cpuSeconds = r.value<farm::Bye>().cpuSeconds;
+        }
         if (kind == farm::ServerSays::Result) ++s.record.lateResults;
       }
       bool waiting = false;
@@ -292,11 +303,11 @@ class Master {
   void keepIdleServersWaiting() {
     for (Server& s : servers_)
       if (s.hello && !s.record.lost() && s.holding.empty())
-        t_.send(s.record.rank, farm::kToServerTag, farm::message(farm::MasterSays::Wait));
+        t_.send(s.record.rank, toServer_, farm::message(farm::MasterSays::Wait));
   }
 
   void stopAll(farm::MasterSays how) {
-    for (const Server& s : servers_) t_.send(s.record.rank, farm::kToServerTag, farm::message(how));
+    for (const Server& s : servers_) t_.send(s.record.rank, toServer_, farm::message(how));
   }
 
   FarmProgress progress() const {
@@ -317,6 +328,7 @@ class Master {
 
   Transport& t_;
   FarmOptions options_;
+  int toMaster_, toServer_;
   std::uint64_t hash_;
   Scheduler& order_;
   Clock::time_point start_;

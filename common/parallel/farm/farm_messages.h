@@ -11,8 +11,11 @@
 
 namespace pr::par::farm {
 
-inline constexpr int kToMasterTag = ProcessGroup::kFirstUserTag + 100;
-inline constexpr int kToServerTag = ProcessGroup::kFirstUserTag + 101;
+// Each farm run of a command (FarmOptions::run) has tags of its own, so that a message of one
+// run (a server's hello for the next run sent while the master still waits for another
+// server's goodbye, a lost server's late result) never reaches another run's protocol.
+inline int toMasterTag(int run) { return ProcessGroup::kFirstUserTag + 100 + 2 * (run % 1000); }
+inline int toServerTag(int run) { return toMasterTag(run) + 1; }
 
 // Server to master.
 enum class ServerSays : std::uint8_t { Hello = 1, Ready = 2, Result = 3, Failed = 4, Alive = 5, Bye = 6 };
@@ -38,6 +41,9 @@ struct ResultHeader {
 };
 struct Failed {
   std::int32_t status = 1;  // the text follows
+};
+struct Bye {
+  double cpuSeconds = 0.0;  // the server process's CPU time (user and system) since its hello
 };
 
 template <class Kind, class T>

@@ -22,6 +22,7 @@ struct FarmServerRecord {
   double lastHeardSeconds = 0.0;  // its last message before that
   std::vector<int> handedOn;    // the jobs it held when lost, handed to the others
   int lateResults = 0;          // results it sent for jobs it no longer held (discarded)
+  double cpuSeconds = 0.0;      // its process's CPU time from hello to goodbye (0: it said no goodbye)
   bool lost() const { return lostAtSeconds >= 0.0; }
 };
 

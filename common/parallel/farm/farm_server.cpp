@@ -1,6 +1,7 @@
 // A farm server (farm.h): hello, pre-passes, then jobs as they come, each result sent back and
 // flushed before the next job starts (a large result moves only while this rank is inside MPI).
 #include <signal.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -25,6 +26,13 @@ using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
+// User plus system CPU seconds of this process so far (every thread).
+double cpuSeconds() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
+}
+
 std::string formatSeconds(double s) {
   char text[32];
   std::snprintf(text, sizeof text, "%.1f s", s);
@@ -33,14 +41,15 @@ std::string formatSeconds(double s) {
 
 class Server {
  public:
-  Server(Transport& t, const FarmOptions& options) : t_(t), options_(options) {}
+  Server(Transport& t, const FarmOptions& options)
+      : t_(t), options_(options), toMaster_(farm::toMasterTag(options.run)), toServer_(farm::toServerTag(options.run)) {}
 
   // The next message from the master, waiting at most `seconds` (the master writes to a
   // server that waits at least every quarter deadline; a job in hand is not a wait).
   Envelope await(double seconds, const char* what) {
     const Clock::time_point from = Clock::now();
     for (;;) {
-      if (std::optional<Envelope> e = t_.poll(farm::kToServerTag)) return std::move(*e);
+      if (std::optional<Envelope> e = t_.poll(toServer_)) return std::move(*e);
       if (since(from) > seconds) masterLost("sent nothing for " + formatSeconds(seconds) + " while this server waited for " + what);
       std::this_thread::sleep_for(std::chrono::microseconds(100));
     }
@@ -66,7 +75,7 @@ class Server {
     return true;
   }
 
-  void send(const Bytes& b) { t_.send(0, farm::kToMasterTag, b); }
+  void send(const Bytes& b) { t_.send(0, toMaster_, b); }
   void flush() {
     if (!t_.flush(options_.deadlineSeconds))
       masterLost("took no result for " + formatSeconds(options_.deadlineSeconds));
@@ -83,6 +92,7 @@ class Server {
 
   Transport& t_;
   FarmOptions options_;
+  int toMaster_, toServer_;
   std::deque<int> jobs_;
 };
 
@@ -148,10 +158,11 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
                          std::as_bytes(std::span<const char>(text.data(), text.size()))));
     (void)transport.flush(options.deadlineSeconds);
   };
+  const double cpuAtHello = cpuSeconds();
   s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes, 0}));
   // Told to stop: it says so, so the master knows it is not waiting for a lost rank.
   const auto leave = [&] {
-    s.send(farm::message(farm::ServerSays::Bye));
+    s.send(farm::message(farm::ServerSays::Bye, farm::Bye{cpuSeconds() - cpuAtHello}));
     (void)transport.flush(options.deadlineSeconds);
   };
   for (;;) {  // the welcome (a master sharing the pre-passes welcomes every server at once)
@@ -169,7 +180,7 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
     s.send(farm::message(farm::ServerSays::Ready, farm::Ready{since(started), traffic.messages, traffic.bytes}));
     for (;;) {
       // Every message already here first: a stop, or the next jobs.
-      while (std::optional<Envelope> e = transport.poll(farm::kToServerTag))
+      while (std::optional<Envelope> e = transport.poll(s.toServer_))
         if (!s.take(*e)) return leave();
       if (s.jobs_.empty()) {
         const Clock::time_point waiting = Clock::now();
