@@ -163,7 +163,8 @@ par::RunRecord farmRunRecord(par::FarmRecord farm, const par::TaskSet& tasks, st
   }
   jobs.channels.push_back({"farm results", "results", results, resultBytes, results, resultBytes});
   for (const par::FarmJobRecord& j : farm.jobs)
-    if (j.server > 0) r.timeline.push_back({j.server - 1, 1, par::TaskId(j.job), j.doneSeconds - j.busySeconds, j.doneSeconds});
+    if (j.server > 0)
+      r.timeline.push_back({j.server - 1, 1, par::TaskId(j.job), j.doneSeconds - j.busySeconds, j.doneSeconds, 0u, 0u, 0.0});
   r.stages = {std::move(prepare), std::move(jobs)};
   r.farm = std::move(farm);
   return r;

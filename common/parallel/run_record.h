@@ -75,7 +75,15 @@ struct StageRecord {
   std::vector<ChannelTraffic> channels;  // the same messages, by channel (only non-zero ones)
   std::vector<TaskInfo> tasks;  // the stage's TaskSet (cost estimates, positions)
   std::vector<int> owners;      // owner-pinned stages: the PE of each task; empty otherwise
+  // What the owners alone cannot say (at P = 1 every owner-pinned stage has owners {0}): one
+  // of the kinds below, or empty for a stage run under a schedule or pinned by a method's split.
+  std::string kind;
 };
+
+// Runtime::runOnEachPe: one task per PE, owner-local work that divides among the owners.
+inline constexpr const char* kEachPeStage = "each PE";
+// Runtime::runOnOnePe and runOncePerRank: work done once (on each rank), whatever P.
+inline constexpr const char* kOnePeStage = "one PE";
 
 // One task on one PE, or with task = kMessageSpan one message handler, with task = kSetupSpan
 // the PE's set-up at the start of a stage (Runtime::runStage with a SetupFn).
@@ -88,6 +96,9 @@ struct TaskSpan {
   double start = 0.0, end = 0.0;  // seconds since the runtime started
   std::uint32_t messagesSent = 0;  // data messages the task sent, for the simulator
   std::uint64_t bytesSent = 0;
+  // The part of [start, end) spent waiting for a reply or a message (a data item, a tile's bins),
+  // not computing: the simulator replays end - start - waitSeconds and models the wait itself.
+  double waitSeconds = 0.0;
 };
 
 // An algorithm counter or figure reported per PE (geometry bytes held, primitives duplicated,

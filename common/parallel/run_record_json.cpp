@@ -153,12 +153,13 @@ json toJson(const RunRecord& record) {
       js["preferred"] = preferred;
     }
     if (!s.owners.empty()) js["owners"] = s.owners;  // owner-pinned stages: the PE of each task
+    if (!s.kind.empty()) js["kind"] = s.kind;
     stages.push_back(js);
   }
   j["stages"] = stages;
   json timeline = json::array();
   for (const TaskSpan& t : record.timeline)
-    timeline.push_back({t.pe, t.stage, t.task, t.start, t.end, t.messagesSent, t.bytesSent});
+    timeline.push_back({t.pe, t.stage, t.task, t.start, t.end, t.messagesSent, t.bytesSent, t.waitSeconds});
   j["timeline"] = timeline;
   json counters = json::array();
   for (const CounterRecord& c : record.counters) counters.push_back({{"name", c.name}, {"perPe", c.perPe}});
@@ -397,17 +398,26 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
       s.owners.push_back(numberAs<int>(owner, origin + ": " + where + " owner"));
     if (!s.owners.empty() && s.owners.size() != s.tasks.size())
       throw InputError(origin + ": " + where + " \"owners\" must name one PE per task");
+    s.kind = js.value("kind", std::string());  // optional: records written before stages had kinds
+    if (!s.kind.empty() && s.kind != kEachPeStage && s.kind != kOnePeStage)
+      throw InputError(origin + ": " + where + " \"kind\" must be \"" + kEachPeStage + "\" or \"" + kOnePeStage + "\", not \"" +
+                       s.kind + "\"");
     record.stages.push_back(std::move(s));
   }
   const json timeline = field<json>(j, "timeline", origin, top);
   for (const json& jt : timeline) {
-    if (!jt.is_array() || jt.size() != 7)
-      throw InputError(origin + ": \"timeline\" entries must be [pe, stage, task, start, end, messagesSent, bytesSent]");
+    // Records written before spans carried their waiting have seven fields.
+    if (!jt.is_array() || (jt.size() != 7 && jt.size() != 8))
+      throw InputError(origin +
+                       ": \"timeline\" entries must be [pe, stage, task, start, end, messagesSent, bytesSent, waitSeconds]");
     const std::string spanWhat = origin + ": timeline span";
     TaskSpan span{numberAs<int>(jt[0], spanWhat + " pe"),           numberAs<int>(jt[1], spanWhat + " stage"),
                   numberAs<TaskId>(jt[2], spanWhat + " task"),      numberAs<double>(jt[3], spanWhat + " start"),
                   numberAs<double>(jt[4], spanWhat + " end"),       numberAs<std::uint32_t>(jt[5], spanWhat + " messagesSent"),
-                  numberAs<std::uint64_t>(jt[6], spanWhat + " bytesSent")};
+                  numberAs<std::uint64_t>(jt[6], spanWhat + " bytesSent"),
+                  jt.size() == 8 ? numberAs<double>(jt[7], spanWhat + " waitSeconds") : 0.0};
+    if (!(span.waitSeconds >= 0.0) || span.waitSeconds > span.end - span.start + 1e-9)
+      throw InputError(origin + ": a \"timeline\" span waits longer than it lasts");
     if (span.stage < 0 || span.stage >= static_cast<int>(record.stages.size()) || span.pe < 0 ||
         span.pe >= record.pes || span.task < kSetupSpan ||
         span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
@@ -453,7 +463,12 @@ std::string toChromeTraceText(const RunRecord& record) {
                       {"tid", t.pe},
                       {"ts", t.start * 1e6},  // microseconds, as the format requires
                       {"dur", (t.end - t.start) * 1e6},
-                      {"args", {{"stage", stage}, {"task", t.task}, {"messagesSent", t.messagesSent}, {"bytesSent", t.bytesSent}}}});
+                      {"args",
+                       {{"stage", stage},
+                        {"task", t.task},
+                        {"messagesSent", t.messagesSent},
+                        {"bytesSent", t.bytesSent},
+                        {"waitSeconds", t.waitSeconds}}}});
   }
   json j = {{"traceEvents", events}, {"displayTimeUnit", "ms"}};
   return j.dump() + "\n";

@@ -115,6 +115,7 @@ void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>&
                                std::to_string(pe.id()));
     work(pe);
   });
+  record_.stages.back().kind = kEachPeStage;
 }
 
 void Runtime::runOncePerRank(std::string_view name, const std::function<void(Pe&)>& work) {
@@ -122,10 +123,12 @@ void Runtime::runOncePerRank(std::string_view name, const std::function<void(Pe&
   for (int r = 0; r < ranks_; ++r) owner.push_back(r * localPes_);
   const TaskSet tasks = TaskSet::uniform(owner.size());
   runPinned(name, tasks, std::move(owner), [&](Pe& p, TaskId) { work(p); });
+  record_.stages.back().kind = kOnePeStage;
 }
 
 void Runtime::runOnOnePe(std::string_view name, int pe, const std::function<void(Pe&)>& work) {
   runPinned(name, TaskSet::uniform(1), {pe}, [&](Pe& p, TaskId) { work(p); });
+  record_.stages.back().kind = kOnePeStage;
 }
 
 void Runtime::recordBroadcast(std::size_t bytes, int root) {
@@ -271,12 +274,13 @@ std::optional<double> Runtime::timed(Pe& pe, TaskId task, std::vector<TaskSpan>&
   const double w0 = c.inTaskWaitSeconds;
   if (!work()) return std::nullopt;
   const double t1 = now();
-  c.busySeconds += (t1 - t0) - (c.inTaskWaitSeconds - w0);
+  const double waited = c.inTaskWaitSeconds - w0;
+  c.busySeconds += (t1 - t0) - waited;
   c.lastWorkEnd = t1;
   if (options_.recordTimeline)
     spans.push_back({pe.id(), pe.stage(), task, t0, t1,
                      static_cast<std::uint32_t>(c.messagesSent.load(std::memory_order_relaxed) - m0),
-                     c.bytesSent.load(std::memory_order_relaxed) - b0});
+                     c.bytesSent.load(std::memory_order_relaxed) - b0, waited});
   return t1 - t0;
 }
 

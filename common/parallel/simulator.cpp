@@ -70,6 +70,13 @@ std::string describeNetworks() {
   return text;
 }
 
+// What a recorded span computed: its length less its waiting for replies and messages, which
+// depends on the network and on other PEs, and which the replay models (the messages' costs)
+// instead of repeating the recorded wait as work.
+namespace {
+double computed(const TaskSpan& span) { return std::max(0.0, span.end - span.start - span.waitSeconds); }
+}  // namespace
+
 Workload workloadFromRecord(const RunRecord& record, const std::string& origin) {
   Workload w;
   w.schedule = record.schedule;
@@ -84,6 +91,7 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     stage.schedule = sr.schedule;
     stage.runtimeSchedule = sr.schedule == record.schedule;
     stage.owners = sr.owners;
+    stage.kind = sr.kind;
     // The stage's own figures; a record written before it had them: what any PE received.
     stage.broadcasts = sr.broadcasts;
     stage.broadcastBytes = sr.broadcastBytes;
@@ -111,7 +119,7 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
         std::vector<PeLoad>& loads = setup ? stage.setups : stage.handlers;
         if (loads.empty()) loads.resize(static_cast<std::size_t>(record.pes));
         PeLoad& load = loads[static_cast<std::size_t>(span.pe)];
-        load.seconds += span.end - span.start;
+        load.seconds += computed(span);
         load.spans += 1;
         load.messagesSent += span.messagesSent;
         load.bytesSent += span.bytesSent;
@@ -120,7 +128,7 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
       if (span.task < 0 || static_cast<std::size_t>(span.task) >= n)
         throw InputError(origin + ": stage '" + sr.name + "' has a span for task " + std::to_string(span.task) +
                          " of " + std::to_string(n));
-      stage.costs[span.task] += span.end - span.start;
+      stage.costs[span.task] += computed(span);
       stage.messages[span.task] += span.messagesSent;
       stage.bytes[span.task] += span.bytesSent;
       if (!seen[span.task]) seen[span.task] = 1, ++seenCount;
@@ -272,7 +280,7 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
     auto handle = [&](int p, double& t, double upTo) {
       const double due = upTo - handlerDone[p];
       if (due <= 0.0) return;
-      if (options.recordTimeline) record.timeline.push_back({p, stageIndex, kMessageSpan, t, t + due, 0u, 0u});
+      if (options.recordTimeline) record.timeline.push_back({p, stageIndex, kMessageSpan, t, t + due, 0u, 0u, 0.0});
       handlerDone[p] = upTo;
       sr.pes[p].busySeconds += due;
       t += due;
@@ -296,7 +304,7 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
         const double d = setup.seconds + send;
         if (options.recordTimeline)
           record.timeline.push_back({p, stageIndex, kSetupSpan, t, t + d, static_cast<std::uint32_t>(setup.messagesSent),
-                                     setup.bytesSent});
+                                     setup.bytesSent, 0.0});
         r.busySeconds += d;
         r.sendReceiveSeconds += send;
         r.messagesSent += setup.messagesSent;
@@ -341,7 +349,7 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
         }
         if (options.recordTimeline)
           record.timeline.push_back({p, stageIndex, id, t, t + d, traffic ? stage.messages[id] : 0u,
-                                     traffic ? stage.bytes[id] : 0u});
+                                     traffic ? stage.bytes[id] : 0u, 0.0});
         t += d;
         r.busySeconds += d;
         r.tasks += 1;

@@ -60,7 +60,7 @@ std::string describeNetworks();
 
 // Work of one PE in one stage besides its tasks, as recorded: its message handlers (the spans
 // with task == kMessageSpan) or its set-up (task == kSetupSpan, Runtime::runStage with a
-// SetupFn): their summed seconds, how many spans (messages handled; one set-up), and the data
+// SetupFn): their summed seconds (less waiting, as a task's cost), how many spans (messages handled; one set-up), and the data
 // messages they sent.
 struct PeLoad {
   double seconds = 0.0;
@@ -71,7 +71,8 @@ using HandlerLoad = PeLoad;
 using SetupLoad = PeLoad;
 
 // One stage's work. tasks is what the scheduler sees (estimates, positions); costs are the
-// seconds each task really takes; messages/bytes the data messages each task sends (empty:
+// seconds each task really computes (a recorded span less its waiting for replies: the replay
+// charges the network for the messages instead); messages/bytes the data messages each task sends (empty:
 // none). A sender pays latency + bytes/bandwidth for its messages inside the task. The fields
 // after them come from a run record and are empty or zero for a cost table; stage_replay.h
 // says how each is replayed at another P.
@@ -84,6 +85,7 @@ struct SimStage {
   std::string schedule;         // the strategy the stage ran with; empty: the one simulate() is given
   bool runtimeSchedule = true;  // it ran under the run's own schedule, which --schedule replaces
   std::vector<int> owners;      // owner-pinned stages: the PE of each task in the recorded run
+  std::string kind;             // StageRecord::kind: each PE, one PE, or empty
   std::vector<HandlerLoad> handlers;  // one per recorded PE; empty: no message handled
   std::vector<SetupLoad> setups;      // one per recorded PE; empty: the stage has no set-up
   // Replicated read-only data each PE received before the stage (messages and bytes per PE).

@@ -119,6 +119,21 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
     r.note = "owners as recorded";
     return r;
   }
+  if (stage.kind == kOnePeStage && n > 0) {
+    // Work done once whatever P (on each rank side by side, for a stage run once per rank):
+    // one task, the longest copy, on the recorded PE when the new P has it, else on PE 0.
+    r.rule = ReplayRule::SingleOwner;
+    const std::size_t longest = std::size_t(std::max_element(stage.costs.begin(), stage.costs.end()) - stage.costs.begin());
+    const int owner = owners[longest] < pes ? owners[longest] : 0;
+    r.stage.tasks.tasks = {stage.tasks.tasks[longest]};
+    r.stage.costs = {stage.costs[longest]};
+    r.stage.messages = stage.messages.empty() ? std::vector<std::uint32_t>{} : std::vector<std::uint32_t>{stage.messages[longest]};
+    r.stage.bytes = stage.bytes.empty() ? std::vector<std::uint64_t>{} : std::vector<std::uint64_t>{stage.bytes[longest]};
+    r.stage.owners = {owner};
+    r.note = "work done once (recorded as one-PE work): " + seconds(stage.costs[longest]) + " on PE " + std::to_string(owner) +
+             " at any P";
+    return r;
+  }
   if (isEachPe(owners, recordedPes)) {
     // P' tasks of total/P' each: the method's split of its data at P' is assumed even.
     r.rule = ReplayRule::EachPe;

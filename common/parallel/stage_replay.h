@@ -13,7 +13,10 @@
 //   round-robin   owners[t] = t mod P with more tasks than PEs (screen regions dealt out):
 //                 re-dealt t mod P'. Assumes the set of regions does not depend on P.
 //   single owner  every task on one PE q < P' (work done once by a designated PE, e.g. the
-//                 world BVH built on the assembler's PE): kept on q at any P'.
+//                 world BVH built on the assembler's PE): kept on q at any P'. A stage the
+//                 record names "one PE" (runOnOnePe, runOncePerRank) is this, whatever its
+//                 owners look like: at P = 1 it cannot be told from each-PE work otherwise, and
+//                 once per rank it is one copy's work (the longest) done side by side.
 //   one PE        P' = 1: every task on the one PE (a single owner holds all the data).
 //   excluded      any other owner list follows a data distribution the record does not
 //                 describe (e.g. voxels assigned by cost): no prediction at P' for that stage.

@@ -180,3 +180,22 @@ TEST_CASE("RunRecord: JSON round trip keeps the tasks' preferred PEs, and a reco
   CHECK_THROWS_AS(runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"preferred":[-2]}],"timeline":[]})", "bad"),
                   pr::InputError);
 }
+
+TEST_CASE("RunRecord: a span's waiting survives JSON, a record without it reads as none, and a wait longer than its span is refused") {
+  RunRecord a;
+  a.pes = 1;
+  StageRecord s;
+  s.name = "s";
+  s.tasks = TaskSet::uniform(1).tasks;
+  s.pes.resize(1);
+  a.stages.push_back(s);
+  a.timeline.push_back({0, 0, 0, 0.0, 0.5, 0u, 0u, 0.25});
+  CHECK(runRecordFromJsonText(toJsonText(a), "test").timeline[0].waitSeconds == 0.25);
+  const std::string head = R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]]}],"timeline":)";
+  CHECK(runRecordFromJsonText(head + "[[0,0,0,0,0.5,0,0]]}", "old").timeline[0].waitSeconds == 0.0);
+  CHECK_THROWS_AS(runRecordFromJsonText(head + "[[0,0,0,0,0.5,0,0,0.75]]}", "bad"), pr::InputError);
+  // A stage's kind is one the runtime writes, or none.
+  CHECK_THROWS_AS(
+      runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"kind":"sideways"}],"timeline":[]})", "bad"),
+      pr::InputError);
+}

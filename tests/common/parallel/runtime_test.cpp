@@ -2,6 +2,7 @@
 // error reported, metric invariants (busy <= wall, task counts sum to the pool), broadcasts.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <mutex>
@@ -9,8 +10,10 @@
 #include <stdexcept>
 #include <thread>
 
+#include "common/parallel/await_reply.h"
 #include "common/parallel/channel.h"
 #include "common/parallel/runtime.h"
+#include "common/parallel/simulator.h"
 #include "common/parallel/spin_work.h"
 #include "common/util/error.h"
 #include "tests/common/parallel/parallel_test_support.h"
@@ -244,4 +247,33 @@ TEST_CASE("Runtime: an exception in a set-up ends the stage and names the set-up
   // The failed PE ran no task and its set-up left no span.
   CHECK(r.stages[0].pes[1].tasks == 0);
   for (const TaskSpan& span : r.timeline) CHECK(!(span.pe == 1 && span.task == kSetupSpan));
+}
+
+TEST_CASE("Runtime: a task's span carries the time it waited inside, which its busy time leaves out and a replay does not repeat") {
+  // PE 0's task waits until PE 1's task, after 40 ms of work, raises a flag.
+  Runtime rt(2, "demand");
+  Channel<int> serving(rt, "serving", MessageKind::Requests, [](Pe&, int&&) {});
+  std::atomic<bool> raised{false};
+  rt.runPinned("wait inside", TaskSet::uniform(2), {0, 1}, [&](Pe& pe, TaskId t) {
+    if (t == 0) {
+      waitUntil(pe, serving, "the flag", [&] { return raised.load(); });
+    } else {
+      std::this_thread::sleep_for(std::chrono::milliseconds(40));
+      raised = true;
+    }
+  });
+  const RunRecord& r = rt.record();
+  const auto span = [&](TaskId t) {
+    return *std::find_if(r.timeline.begin(), r.timeline.end(), [&](const TaskSpan& s) { return s.task == t; });
+  };
+  const TaskSpan waiter = span(0), worker = span(1);
+  CHECK(waiter.waitSeconds > 0.03);
+  CHECK(waiter.waitSeconds <= waiter.end - waiter.start);
+  CHECK(worker.waitSeconds == 0.0);
+  // Busy is the span less its wait, on the waiting PE.
+  CHECK(r.stages[0].pes[0].busySeconds == doctest::Approx(waiter.end - waiter.start - waiter.waitSeconds).epsilon(1e-6));
+  // The simulator replays what each task computed: the waiter's few microseconds, the worker's 40 ms.
+  const pr::par::Workload w = pr::par::workloadFromRecord(r, "test");
+  CHECK(w.stages[0].costs[0] < 0.01);
+  CHECK(w.stages[0].costs[1] >= 0.04);
 }

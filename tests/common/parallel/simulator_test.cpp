@@ -310,3 +310,38 @@ TEST_CASE("Simulator: parrender simulate prints a table from a run record and a 
   CHECK(result.exitStatus == 2);
   CHECK(result.output.find("\"stages\" must be an array") != std::string::npos);
 }
+
+TEST_CASE("Simulator: a task that waited 2 ms inside costs its computation only") {
+  // Task 0 lasted 3 ms, 2 ms of it waiting for a reply; task 1 computed for 1 ms.
+  const RunRecord rec = handMadeRecord("balanced", 2, {{0, 0, 0, 0.0, 0.003, 0, 0, 0.002}, {1, 0, 1, 0.0, 0.001}}, 0.003);
+  const Workload w = workloadFromRecord(rec, "hand-made");
+  CHECK(w.stages[0].costs[0] == doctest::Approx(0.001));
+  CHECK(w.stages[0].costs[1] == doctest::Approx(0.001));
+  SimOptions options;
+  options.pes = 2;
+  options.network = NetworkModel{"free", 0.0, 1e30, ""};
+  CHECK(simulate(w, "", options).wallSeconds == doctest::Approx(0.001));
+  options.pes = 1;
+  CHECK(simulate(w, "", options).wallSeconds == doctest::Approx(0.002));
+}
+
+TEST_CASE("Simulator: work recorded on one PE at P = 1 stays serial at P = 2, work recorded on each PE divides") {
+  Runtime rt(1, "demand");
+  rt.runOnOnePe("build", 0, [](Pe&) { pr::par::spinFor(0.02); });
+  rt.runOnEachPe("clear", [](Pe&) { pr::par::spinFor(0.02); });
+  const RunRecord& rec = rt.record();
+  CHECK(rec.stages[0].kind == kOnePeStage);
+  CHECK(rec.stages[1].kind == kEachPeStage);
+  const Workload w = workloadFromRecord(runRecordFromJsonText(toJsonText(rec), "round trip"), "test");
+  SimOptions options;
+  options.pes = 2;
+  options.network = NetworkModel{"free", 0.0, 1e30, ""};
+  const RunRecord two = simulate(w, "", options);
+  // The build: one task of its whole cost on PE 0; the clear: half its cost on each PE.
+  CHECK(two.stages[0].pes[0].tasks == 1);
+  CHECK(two.stages[0].pes[1].tasks == 0);
+  CHECK(two.stages[0].wallSeconds == doctest::Approx(w.stages[0].costs[0]));
+  CHECK(two.stages[1].pes[0].tasks == 1);
+  CHECK(two.stages[1].pes[1].tasks == 1);
+  CHECK(two.stages[1].wallSeconds == doctest::Approx(w.stages[1].costs[0] / 2));
+}
