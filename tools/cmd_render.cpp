@@ -167,8 +167,9 @@ void run(RenderArgs& a) {
   std::printf("wall %.3f s", wall);
   if (outcome.rays > 0)
     std::printf(", rays %llu, %.2f Mrays/s", (unsigned long long)outcome.rays, wall > 0.0 ? double(outcome.rays) / wall * 1e-6 : 0.0);
-  std::printf(", load imbalance %.3f, efficiency %.3f, messages %llu (%llu bytes), broadcast %.0f bytes to each other PE\n",
-              summary.total.imbalance, summary.total.efficiency, (unsigned long long)summary.total.messages,
+  std::printf(", load imbalance %.3f, serial fraction %.3f, utilisation %.3f, messages %llu (%llu bytes), broadcast %.0f bytes "
+              "to each other PE\n",
+              summary.total.imbalance, summary.total.serialFraction, summary.total.utilisation, (unsigned long long)summary.total.messages,
               (unsigned long long)summary.total.bytes, summary.total.figure("broadcastBytesReceived").max);
   if (!summary.total.byKind.empty()) {
     std::printf("traffic by kind:");

@@ -93,7 +93,7 @@ StageSummary summarizePes(const std::string& name, const std::string& schedule, 
     s.schedulingBytes += r.schedulingBytes;
   }
   s.imbalance = loadImbalance(busy);
-  s.efficiency = wall > 0.0 && !pes.empty() ? busySum / (wall * pes.size()) : 0.0;
+  s.utilisation = wall > 0.0 && !pes.empty() ? busySum / (wall * pes.size()) : 0.0;
   // Computation is busy time outside Channel calls; communication is those calls plus waiting
   // for messages (seed 3.1.3's ratio, from measured times only).
   s.computeToComm = commSum > 0.0 ? std::max(0.0, busySum - sendReceiveSum) / commSum : -1.0;
@@ -176,17 +176,28 @@ RunSummary summarize(const RunRecord& record) {
   summary.pes = record.pes;
   summary.ranks = record.ranks;
   summary.wallSeconds = record.wallSeconds;
-  double stageWall = 0.0;
+  double stageWall = 0.0, serialWall = 0.0, parallelWall = 0.0, weightedImbalance = 0.0;
   std::vector<KindTraffic> byKind;
   for (const StageRecord& stage : record.stages) {
-    summary.stages.push_back(summarizePes(stage.name, stage.schedule, stage.wallSeconds, stage.pes));
-    summary.stages.back().byKind = trafficByKind(stage, record.ranks);
-    for (const KindTraffic& k : summary.stages.back().byKind) addTraffic(byKind, k);
+    StageSummary& s = summary.stages.emplace_back(summarizePes(stage.name, stage.schedule, stage.wallSeconds, stage.pes));
+    s.byKind = trafficByKind(stage, record.ranks);
+    for (const KindTraffic& k : s.byKind) addTraffic(byKind, k);
     stageWall += stage.wallSeconds;
+    s.serial = stage.kind == kOnePeStage;
+    if (s.serial) {
+      s.imbalance = 0.0;  // by design, not by imbalance: the serial fraction below
+      serialWall += stage.wallSeconds;
+    } else {
+      parallelWall += stage.wallSeconds;
+      weightedImbalance += stage.wallSeconds * s.imbalance;
+    }
   }
-  // Efficiency of the whole run over the time spent in stages; the controller's serial code
+  // Utilisation of the whole run over the time spent in stages; the controller's serial code
   // between stages is not PE time.
   summary.total = summarizePes("total", record.schedule, stageWall, peTotals(record));
+  summary.total.imbalance = parallelWall > 0.0 ? weightedImbalance / parallelWall : 0.0;
+  const double between = std::max(0.0, record.wallSeconds - stageWall);
+  summary.total.serialFraction = record.wallSeconds > 0.0 ? std::min(1.0, (serialWall + between) / record.wallSeconds) : 0.0;
   // Channel kinds first, then the runtime's own kinds, whatever order the stages saw them in.
   std::stable_partition(byKind.begin(), byKind.end(),
                         [](const KindTraffic& k) { return k.kind != "tasks" && k.kind != "broadcasts"; });
@@ -221,16 +232,23 @@ std::string formatSummary(const RunSummary& summary) {
   std::snprintf(line, sizeof line, "P = %d, wall %.6f s\n", summary.pes, summary.wallSeconds);
   out += line;
   std::snprintf(line, sizeof line, "%-14s %-14s %10s %9s %8s %11s %9s %10s %12s\n", "stage", "schedule", "wall s",
-                "imbalance", "effic.", "sync wait s", "tasks", "messages", "bytes");
+                "imbalance", "utilis.", "sync wait s", "tasks", "messages", "bytes");
   out += line;
   auto row = [&](const StageSummary& s) {
-    std::snprintf(line, sizeof line, "%-14s %-14s %10.6f %9.4f %8.4f %11.6f %9llu %10llu %12llu\n", s.name.c_str(),
-                  s.schedule.c_str(), s.wallSeconds, s.imbalance, s.efficiency, s.syncWaitSeconds,
+    char imbalance[16];
+    std::snprintf(imbalance, sizeof imbalance, s.serial ? "serial" : "%.4f", s.imbalance);
+    std::snprintf(line, sizeof line, "%-14s %-14s %10.6f %9s %8.4f %11.6f %9llu %10llu %12llu\n", s.name.c_str(),
+                  s.schedule.c_str(), s.wallSeconds, imbalance, s.utilisation, s.syncWaitSeconds,
                   (unsigned long long)s.tasks, (unsigned long long)s.messages, (unsigned long long)s.bytes);
     out += line;
   };
   for (const StageSummary& s : summary.stages) row(s);
   row(summary.total);
+  std::snprintf(line, sizeof line,
+                "total imbalance: the parallel stages' imbalances weighted by their wall time; serial fraction %.4f (stages run on "
+                "one PE by design and the time between stages)\n",
+                summary.total.serialFraction);
+  out += line;
   out += "per-PE figures over the run (min / mean / max):\n";
   const auto& figures = peFigures();
   for (std::size_t i = 0; i < figures.size(); ++i) {

@@ -16,7 +16,7 @@ struct Spread {
 };
 Spread spreadOf(const std::vector<double>& values);
 
-// max(busy) / mean(busy) - 1 (shared/DESIGN.md); 0 for no work at all.
+// max(busy) / mean(busy) - 1 over one stage's PEs (shared/DESIGN.md); 0 for no work at all.
 double loadImbalance(const std::vector<double>& busySeconds);
 
 // The per-PE figures, by their JSON/C++ name, in a fixed order, each with where it comes from:
@@ -46,8 +46,16 @@ struct StageSummary {
   std::string schedule;
   double wallSeconds = 0.0;
   std::vector<Spread> figures;  // one per peFigures() entry
+  // A stage's load imbalance: max(busy) / mean(busy) - 1 over its PEs, 0 for a stage run on one
+  // PE by design (serial). The whole run's: the parallel stages' imbalances weighted by their
+  // wall time (shared/DESIGN.md), so that a serial stage is no imbalance and opposite
+  // imbalances in two stages do not cancel.
   double imbalance = 0.0;
-  double efficiency = 0.0;       // sum(busy) / (P * wall)
+  bool serial = false;  // a stage run on one PE by design (StageRecord::kind "one PE")
+  // The whole run only: the share of its wall time in serial stages and in the controlling
+  // thread between stages (Amdahl's serial term, as measured); 0 on a stage.
+  double serialFraction = 0.0;
+  double utilisation = 0.0;      // sum(busy) / (P * wall): the share of the PEs' time spent working
   double syncWaitSeconds = 0.0;  // summed over PEs
   // sum(busy - comm) / sum(comm), the seed's computation-to-communication ratio; < 0 when no
   // time was spent communicating (no messages).

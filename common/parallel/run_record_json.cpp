@@ -35,7 +35,7 @@ json spreadJson(const Spread& s) { return {{"min", s.min}, {"mean", s.mean}, {"m
 
 json summaryJson(const StageSummary& s) {
   json j = {{"wallSeconds", s.wallSeconds},     {"imbalance", s.imbalance},
-            {"efficiency", s.efficiency},       {"syncWaitSeconds", s.syncWaitSeconds},
+            {"utilisation", s.utilisation},     {"syncWaitSeconds", s.syncWaitSeconds},
             {"tasks", s.tasks},                 {"messages", s.messages},
             {"bytes", s.bytes},                 {"schedulingMessages", s.schedulingMessages},
             {"schedulingBytes", s.schedulingBytes}};
@@ -116,6 +116,7 @@ json toJson(const RunRecord& record) {
   j["error"] = record.error;
   const RunSummary summary = summarize(record);
   j["summary"] = summaryJson(summary.total);
+  j["summary"]["serialFraction"] = summary.total.serialFraction;
   json provenance = json::object();
   for (const PeFigure& f : peFigures()) provenance[f.name] = f.provenance;
   j["figureProvenance"] = provenance;  // per figure: "measured" or "modelled: how"
@@ -131,6 +132,7 @@ json toJson(const RunRecord& record) {
                {"broadcasts", s.broadcasts},
                {"broadcastBytes", s.broadcastBytes},
                {"summary", summaryJson(summary.stages[i])}};
+    if (summary.stages[i].serial) js["summary"]["serial"] = true;
     json pes = json::array();
     for (const PeStageRecord& r : s.pes) pes.push_back(peJson(r));
     js["pes"] = pes;

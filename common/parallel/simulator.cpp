@@ -261,6 +261,8 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
     sr.startSeconds = stageStart;
     sr.tasks = stage.tasks.tasks;
     sr.owners = plan.rule == ReplayRule::Scheduled ? std::vector<int>{} : stage.owners;
+    // Work done once stays serial at any P: its record says so, as the measured one did.
+    sr.kind = plan.rule == ReplayRule::SingleOwner ? std::string(kOnePeStage) : stage.kind;
     sr.pes.resize(pes);
 
     // Handler work per PE (its own seconds plus its sends), and how much of it is done.

@@ -95,12 +95,12 @@ void granularity() {
   std::vector<double> costs(4000);
   for (std::size_t i = 0; i < costs.size(); ++i) costs[i] = 20e-6 * (1 + i % 5);
   std::printf("\n2b. granularity, demand-driven, P = 2, 4000 tasks of 20..100 us\n");
-  std::printf("%6s %10s %8s %10s %12s\n", "grain", "wall s", "effic.", "imbalance", "sched. msgs");
+  std::printf("%6s %10s %8s %10s %12s\n", "grain", "wall s", "utilis.", "imbalance", "sched. msgs");
   for (int grain : {1, 4, 16, 64, 256, 1000}) {
     ScheduleParams params;
     params.grain = grain;
     const RunSummary s = summarize(runSpin(2, "demand", costs, params));
-    std::printf("%6d %10.5f %8.4f %10.4f %12llu\n", grain, s.wallSeconds, s.total.efficiency, s.total.imbalance,
+    std::printf("%6d %10.5f %8.4f %10.4f %12llu\n", grain, s.wallSeconds, s.total.utilisation, s.total.imbalance,
                 (unsigned long long)s.total.schedulingMessages);
   }
 }
@@ -115,7 +115,7 @@ void efficiency() {
     const RunSummary s = summarize(r);
     points.push_back({pes, r.wallSeconds});
     std::printf("P = %d: wall %.4f s, busy/(P*wall) %.2f%%, imbalance %.4f\n", pes, r.wallSeconds,
-                100 * s.total.efficiency, s.total.imbalance);
+                100 * s.total.utilisation, s.total.imbalance);
   }
   const double serial = 400 * 1e-3;  // Ts: the same spinning without the runtime
   const ScalingTable table = scalingTable(points, serial);

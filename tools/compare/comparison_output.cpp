@@ -80,7 +80,7 @@ std::string comparisonTable(const Comparison& c) {
       }
   std::vector<std::vector<std::string>> cells;
   std::vector<std::string> header = {"method", "family", "schedule", "integrator", "compositor", "P", "wall_s", "spread",
-                                     "cpu_s", "T1/Tn", "Ts/Tn", "eff", "imbal", "messages", "bytes"};
+                                     "cpu_s", "T1/Tn", "Ts/Tn", "eff", "imbal", "serial", "messages", "bytes"};
   for (const std::string& k : kinds) header.push_back(k + " msg/B");
   // Under mpirun: what of every row's traffic crossed between ranks.
   const bool acrossRanks = std::any_of(c.rows.begin(), c.rows.end(), [](const ComparisonRow& r) { return r.what.ranks > 1; });
@@ -103,6 +103,7 @@ std::string comparisonTable(const Comparison& c) {
                                      orDash(r.speedupSerial, r.speedupSerial > 0.0),
                                      orDash(r.efficiency, r.efficiency > 0.0),
                                      number(t.imbalance),
+                                     number(t.serialFraction),
                                      compact(all.messages),
                                      compact(all.bytes)};
     for (const std::string& k : kinds) {
@@ -138,7 +139,7 @@ std::string comparisonCsv(const Comparison& c) {
          "speedup_serial,efficiency,load_imbalance,messages,bytes";
   for (const std::string& k : comparisonKinds()) out << "," << k << "_messages," << k << "_bytes";
   out << ",compute_to_comm,cache_hit_ratio,rays,rmse,image_agrees,agreement,ranks,between_ranks_messages,between_ranks_bytes,"
-         "farm_schedule\n";
+         "farm_schedule,serial_fraction\n";
   for (const ComparisonRow& r : c.rows) {
     const par::StageSummary& t = r.summary.total;
     out << r.what.method << "," << toString(r.what.family) << "," << r.what.schedule << "," << r.what.integrator << ","
@@ -152,7 +153,7 @@ std::string comparisonCsv(const Comparison& c) {
     }
     out << "," << exact(t.computeToComm) << "," << exact(r.cacheHitRatio) << "," << r.rays << "," << exact(r.rmse) << ","
         << (r.agrees ? "true" : "false") << "," << csvText(r.agreement) << "," << r.what.ranks << ","
-        << allTraffic(r).betweenRankMessages << "," << allTraffic(r).betweenRankBytes << "," << r.what.farm << "\n";
+        << allTraffic(r).betweenRankMessages << "," << allTraffic(r).betweenRankBytes << "," << r.what.farm << "," << exact(t.serialFraction) << "\n";
   }
   return out.str();
 }
@@ -181,8 +182,9 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"speedupSerial", optional(r.speedupSerial, r.speedupSerial > 0.0)},
                     {"serialReference", r.serialReference},
                     {"efficiency", optional(r.efficiency, r.efficiency > 0.0)},
-                    {"recordEfficiency", t.efficiency},
+                    {"utilisation", t.utilisation},
                     {"loadImbalance", t.imbalance},
+                    {"serialFraction", t.serialFraction},
                     {"messages", allTraffic(r).messages},
                     {"bytes", allTraffic(r).bytes},
                     {"betweenRankMessages", allTraffic(r).betweenRankMessages},

@@ -208,7 +208,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
     rows.push_back({r.what.methodName(), r.what.schedule, r.what.integrator, std::to_string(r.what.pes), fmt(r.wall, "%.4f"),
                     fmt(r.cpu, "%.4f"), r.speedup > 0 ? fmt(r.speedup, "%.2f") : "-",
                     r.speedupSerial > 0 ? fmt(r.speedupSerial, "%.2f") : "-", r.efficiency > 0 ? fmt(r.efficiency, "%.2f") : "-",
-                    fmt(t.imbalance, "%.3f"), std::to_string(all.messages), formatBytes(all.bytes), kinds,
+                    fmt(t.imbalance, "%.3f"), fmt(t.serialFraction, "%.3f"), std::to_string(all.messages), formatBytes(all.bytes), kinds,
                     t.computeToComm >= 0 ? fmt(t.computeToComm, "%.1f") : "-",
                     r.cacheHitRatio >= 0 ? fmt(r.cacheHitRatio, "%.3f") : "-", fmt(r.rmse, "%.4f"),
                     r.agrees ? r.agreement : "DIFFERS: " + r.agreement});
@@ -217,7 +217,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   for (const SkippedCombination& s : c.skipped) skipped.push_back({s.what, s.reason});
   html += "<h3>Comparison</h3>" +
           table({"method", "schedule", "integrator", "P", "wall s", "CPU s", "T1/Tn", "Ts/Tn", "efficiency", "imbalance",
-                 "messages", "bytes", "messages by kind", "comp/comm", "cache hits", "RMSE", "image"},
+                 "serial fraction", "messages", "bytes", "messages by kind", "comp/comm", "cache hits", "RMSE", "image"},
                 rows) +
           (skipped.empty() ? "" : "<p>Skipped:</p>" + table({"combination", "reason"}, skipped, "text"));
   html += farmSection(c, par::networkByName(spec.network), spec.maxPredictedPes);

@@ -17,7 +17,7 @@ TEST_CASE("Metrics: imbalance of the seed's balanced split is 21 / 14 - 1") {
   const RunSummary s = summarize(simulate(pr::test::seedExample(), "balanced", options));
   // busy 21, 13, 8: mean 14, max 21.
   CHECK(s.total.imbalance == doctest::Approx(0.5));
-  CHECK(s.total.efficiency == doctest::Approx(42.0 / (3 * 21.0)));
+  CHECK(s.total.utilisation == doctest::Approx(42.0 / (3 * 21.0)));
   // PEs 1 and 2 wait 8 and 13 units at the end of the stage.
   CHECK(s.total.syncWaitSeconds == doctest::Approx(21.0));
   CHECK(s.total.figure("busySeconds").min == 8.0);
@@ -57,4 +57,32 @@ TEST_CASE("Metrics: saturation is where adding PEs stops helping") {
   const ScalingTable t = scalingTable({{1, 10.0}, {2, 5.0}, {4, 4.0}, {8, 3.9}, {16, 4.2}});
   CHECK(t.bestPes == 8);
   CHECK(t.saturationPes == 4);  // 4.0 <= 1.05 * 3.9
+}
+
+TEST_CASE("Metrics: a serial stage is serial fraction, not imbalance, and opposite imbalances of two stages do not cancel") {
+  // P = 2: a serial build (1 s on PE 0 by design), then two stages of 2 s whose busy times are
+  // 2 and 1, then 1 and 2; 0.5 s between stages in the controlling thread.
+  RunRecord r;
+  r.pes = 2;
+  r.wallSeconds = 5.5;
+  const auto stage = [](const char* name, double wall, double busy0, double busy1, const char* kind) {
+    StageRecord s;
+    s.name = name;
+    s.wallSeconds = wall;
+    s.kind = kind;
+    s.pes.resize(2);
+    s.pes[0].busySeconds = busy0;
+    s.pes[1].busySeconds = busy1;
+    return s;
+  };
+  r.stages = {stage("build", 1.0, 1.0, 0.0, kOnePeStage), stage("a", 2.0, 2.0, 1.0, ""), stage("b", 2.0, 1.0, 2.0, "")};
+  const RunSummary s = summarize(r);
+  CHECK(s.stages[0].serial);
+  CHECK(s.stages[0].imbalance == 0.0);
+  CHECK(s.stages[1].imbalance == doctest::Approx(2.0 / 1.5 - 1.0));
+  // Weighted by wall time over the parallel stages: each stage's 1/3, where the busy time summed
+  // over the run (4 and 3 s) would say 1/7.
+  CHECK(s.total.imbalance == doctest::Approx(1.0 / 3.0));
+  CHECK(s.total.serialFraction == doctest::Approx((1.0 + 0.5) / 5.5));
+  CHECK(formatSummary(s).find("serial fraction 0.2727") != std::string::npos);
 }
