@@ -94,7 +94,9 @@ void prepare(const std::filesystem::path& dir) {
 }
 
 // Every scene's renders (every rank takes part) and section; index.html written by rank 0.
-void build(const ReportArgs& a, const std::filesystem::path& dir) {
+// Returns the renders whose image differs from their family's (rank 0's count).
+int build(const ReportArgs& a, const std::filesystem::path& dir) {
+  int mismatches = 0;
   std::string body = "<h1>parrender: parallel rendering methods compared</h1>\n" + methodsIntro(a.spec);
   body += "<p>Scenes:";
   for (const std::string& s : a.scenes) {
@@ -104,12 +106,15 @@ void build(const ReportArgs& a, const std::filesystem::path& dir) {
   body += "</p>\n";
   for (const std::string& s : a.scenes) {
     const std::string stem = std::filesystem::path(s).stem().string();
-    body += "<a id=\"" + report::escape(stem) + "\"></a>" + report::sceneReport(s, a.spec, dir / stem, stem);
+    const report::SceneSection section = report::sceneReport(s, a.spec, dir / stem, stem);
+    body += "<a id=\"" + report::escape(stem) + "\"></a>" + section.html;
+    mismatches += section.mismatches;
   }
   par::ProcessGroup::get().onRank0Alone("rank 0 writing the report's page", [&] {
     writeFileAtomically(dir / "index.html", report::page("parrender report", body), "report page");
     return par::Bytes();
   });
+  return mismatches;
 }
 
 void run(ReportArgs& a) {
@@ -171,8 +176,9 @@ void run(ReportArgs& a) {
     return par::Bytes();
   });
   const bool writes = holdsResults();
+  int mismatches = 0;  // rank 0's count
   try {
-    build(a, fresh);
+    mismatches = build(a, fresh);
     // The earlier report steps aside only once the new one is whole, and comes back if the
     // new one cannot take its place.
     group.onRank0Alone("rank 0 putting the report in place", [&] {
@@ -195,6 +201,10 @@ void run(ReportArgs& a) {
   std::error_code ignored;
   std::filesystem::remove_all(old, ignored);
   std::printf("report: %s\n", (out / "index.html").string().c_str());
+  // As compare does: the report is written (its verdict leaves them out), and the run fails.
+  if (mismatches > 0)
+    throw std::runtime_error(std::to_string(mismatches) +
+                             " render(s) differ from their family's image (IMAGE MISMATCH above; the report marks them)");
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <numeric>
 #include <set>
@@ -84,12 +85,22 @@ RenderSettings settingsFor(const Combination& c, const ComparisonSpec& spec) {
   return settings;
 }
 
+// A fault for tests (PARRENDER_IMAGE_FAULT=METHOD): every image of METHOD the comparison renders
+// has its first pixel changed, so that the path of an image that differs from its family's can
+// be tested (compare and report exit 1, the report's verdict leaves the row out).
+void injectImageFault(const Combination& c, TimedRender& t) {
+  const char* method = std::getenv("PARRENDER_IMAGE_FAULT");
+  if (method && c.method == method && !t.outcome.image.empty()) t.outcome.image.pixels[0] += glm::vec3(1.0f);
+}
+
 // One timed render of the combination, on every rank that takes part.
 TimedRender timed(const Combination& c, const ComparisonSpec& spec, const RenderInput& input) {
   const RenderSettings settings = settingsFor(c, spec);
   const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
-  if (!c.farm.empty()) return timedFarmRender(spec.farm, input, settings, c.pes / (c.ranks - 1), schedule);
-  return timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks}, schedule);
+  TimedRender t = !c.farm.empty() ? timedFarmRender(spec.farm, input, settings, c.pes / (c.ranks - 1), schedule)
+                                  : timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks}, schedule);
+  injectImageFault(c, t);
+  return t;
 }
 
 bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }

@@ -10,7 +10,7 @@
 namespace pr::cli::report {
 
 std::vector<PredictedPoint> predictScaling(const par::RunRecord& record, const par::NetworkModel& network,
-                                           const std::vector<int>& pes) {
+                                           const std::vector<int>& pes, double measuredOneSeconds) {
   const par::Workload workload = par::workloadFromRecord(record, "the report's run");
   std::vector<PredictedPoint> out;
   double one = 0.0;
@@ -25,7 +25,8 @@ std::vector<PredictedPoint> predictScaling(const par::RunRecord& record, const p
     point.pes = p;
     point.seconds = prediction.record.wallSeconds;
     point.imbalance = summary.total.imbalance;
-    if (p == 1) one = point.seconds;
+    point.notes = prediction.stages;
+    if (p == 1) one = measuredOneSeconds > 0.0 ? measuredOneSeconds : point.seconds;
     out.push_back(point);
   }
   for (PredictedPoint& point : out) {

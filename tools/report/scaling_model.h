@@ -14,15 +14,18 @@ namespace pr::cli::report {
 struct PredictedPoint {
   int pes = 1;
   double seconds = 0.0;     // predicted makespan
-  double speedup = 0.0;     // against the prediction at P = 1
+  double speedup = 0.0;     // against the baseline predictScaling was given
   double efficiency = 0.0;
   double imbalance = 0.0;
+  std::vector<par::StageNote> notes;  // how each stage was replayed at this P, the excluded ones with why
 };
 
 // The record replayed at every P of `pes` (which must hold 1), each stage under its own
-// recorded schedule.
+// recorded schedule. Speed-ups are against `measuredOneSeconds` when it is given (> 0: the
+// measured T1, the baseline of the measured points beside them), else against the prediction
+// at P = 1.
 std::vector<PredictedPoint> predictScaling(const par::RunRecord& record, const par::NetworkModel& network,
-                                           const std::vector<int>& pes);
+                                           const std::vector<int>& pes, double measuredOneSeconds = 0.0);
 
 // The mean Karp-Flatt serial fraction over the measured points at P > 1 (speed-ups T1/Tn),
 // clamped to [0, 1]; NaN without such a point.

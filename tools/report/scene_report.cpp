@@ -86,11 +86,39 @@ std::string measuredFigure(const ComparisonRow& r, int width, int height) {
 struct MethodScaling {
   std::string method;
   std::vector<std::pair<int, double>> measured;  // (P, T1/Tn)
+  std::vector<std::pair<int, double>> measuredSeconds;  // (P, wall s) of every run on the curve
+  double measuredOne = 0.0;  // T1: the wall time at P = 1 in this process, 0 when not run
   std::vector<PredictedPoint> predicted;
+  // The same record replayed at the measured P on this machine's network (shared-memory): the
+  // simulator checked against the measurements, apart from the chosen network's cost.
+  std::vector<PredictedPoint> here;
   double serialFraction = std::numeric_limits<double>::quiet_NaN();
   int bestPredictedPes = 1;
   const ComparisonRow* largest = nullptr;  // the run at the largest P
 };
+
+// The prediction on this machine's network beside each measurement of the method:
+// "P=2: 0.123 s for 0.121 s measured (+2%)".
+std::string residuals(const MethodScaling& s) {
+  std::string out;
+  for (const auto& [p, wall] : s.measuredSeconds)
+    for (const PredictedPoint& q : s.here)
+      if (q.pes == p && wall > 0.0)
+        out += (out.empty() ? "" : "; ") + std::string("P=") + std::to_string(p) + ": " + fmt(q.seconds, "%.4f") + " s for " +
+               fmt(wall, "%.4f") + " s measured (" + fmt(100.0 * (q.seconds / wall - 1.0), "%+.0f") + "%)";
+  return out.empty() ? "-" : out;
+}
+
+// How each stage was replayed at a predicted P: the rule, the strategy and the assumption (or
+// why the stage was left out), as `parrender simulate` prints them.
+std::string replayNotes(const PredictedPoint& point) {
+  std::string items;
+  for (const par::StageNote& n : point.notes)
+    items += "<li>" + escape(n.stage + ": " + n.rule + (n.schedule.empty() ? "" : " (" + n.schedule + ")") + ": " + n.note) +
+             (n.excluded ? " <b>excluded from the prediction</b>" : "") + "</li>";
+  return "<details><summary>how each stage was replayed at P = " + std::to_string(point.pes) + "</summary><ul>" + items +
+         "</ul></details>";
+}
 
 // The rows that trace each method's curve: its first schedule and compositor (a farm's has its
 // own section).
@@ -148,6 +176,8 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
     MethodScaling& s = scaling[r.what.method];
     s.method = r.what.method;
     if (r.speedup > 0.0) s.measured.emplace_back(r.what.pes, r.speedup);
+    s.measuredSeconds.emplace_back(r.what.pes, r.wall);
+    if (r.what.pes == 1 && r.what.ranks == 1) s.measuredOne = r.wall;
     if (!s.largest || r.what.pes > s.largest->what.pes) s.largest = &r;
   }
 
@@ -229,7 +259,17 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   nlohmann::json scalingData = nlohmann::json::array();
   for (auto& [method, s] : scaling) {
     if (method == "sequential" || !s.largest) continue;
-    s.predicted = predictScaling(s.largest->record, network, predictedPes);
+    // The powers of two and every measured P, so that each measurement has its prediction.
+    std::vector<int> measuredPes = {1};
+    for (const auto& [p, wall] : s.measuredSeconds) measuredPes.push_back(p);
+    std::vector<int> pes = predictedPes;
+    pes.insert(pes.end(), measuredPes.begin(), measuredPes.end());
+    for (std::vector<int>* list : {&pes, &measuredPes}) {
+      std::sort(list->begin(), list->end());
+      list->erase(std::unique(list->begin(), list->end()), list->end());
+    }
+    s.predicted = predictScaling(s.largest->record, network, pes, s.measuredOne);
+    s.here = predictScaling(s.largest->record, par::networkByName("shared-memory"), measuredPes, s.measuredOne);
     s.serialFraction = fittedSerialFraction(s.measured);
     double best = 0.0;
     for (const PredictedPoint& p : s.predicted) {
@@ -268,19 +308,21 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   html += "<h3>Speed-up and efficiency against P</h3><p>Dots: measured (T1/Tn). Solid and dashed lines: the "
           "simulator replaying each method's largest-P run at P = 1 &hellip; " + std::to_string(predictedPes.back()) +
           " on the " + escape(spec.network) + " network (" + escape(std::string(network.description)) +
-          "), and Amdahl's law with the Karp&ndash;Flatt serial fraction fitted to the measured points. Diamonds: the "
-          "best predicted P.</p>\n";
+          "), its speed-ups against the measured T1 like the dots', and Amdahl's law with the Karp&ndash;Flatt serial "
+          "fraction fitted to the measured points. Diamonds: the best predicted P. The table checks the simulator against "
+          "the measurements: the same record replayed at each measured P on this machine's network (shared-memory), "
+          "beside the measured time (predicted / measured &minus; 1).</p>\n";
   html += chart(dir, relDir, "speedup", scalingSpec("speedup", true), scalingData, "Speed-up against P");
   html += chart(dir, relDir, "efficiency", scalingSpec("efficiency", false), scalingData, "Efficiency against P");
   std::vector<std::vector<std::string>> fitRows;
   for (const auto& [method, s] : scaling) {
     if (method == "sequential" || s.predicted.empty()) continue;
-    fitRows.push_back({method, std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.4f") : "-",
+    fitRows.push_back({method, residuals(s), std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.4f") : "-",
                        std::isfinite(s.serialFraction) && s.serialFraction > 0 ? fmt(1.0 / s.serialFraction, "%.1f") : "-",
                        std::to_string(s.bestPredictedPes), fmt(s.predicted.back().speedup, "%.3g"),
                        fmt(s.predicted.back().efficiency, "%.3f"), fmt(s.predicted.back().seconds, "%.4f")});
   }
-  html += table({"method", "Karp-Flatt serial fraction", "Amdahl bound 1/f", "best predicted P",
+  html += table({"method", "replayed at the measured P (shared-memory)", "Karp-Flatt serial fraction", "Amdahl bound 1/f", "best predicted P",
                  "predicted speed-up at " + std::to_string(predictedPes.back()),
                  "predicted efficiency", "predicted seconds"},
                 fitRows);
@@ -413,11 +455,17 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
                 accuracy, "RMSE against CPU time");
 
   // The verdict.
-  html += "<h3>Verdict</h3><div class=\"verdict\"><ul>";
+  // Only among rows whose image agrees with their family's: a faster wrong image wins nothing.
+  html += "<h3>Verdict</h3><div class=\"verdict\">" +
+          (c.mismatches > 0 ? "<p><b>" + std::to_string(c.mismatches) +
+                                  " renders differ from their family's image: they are left out of the verdict, and the "
+                                  "report command fails.</b></p>"
+                            : std::string()) +
+          "<ul>";
   for (int p : measuredPes) {
     const ComparisonRow* fastest = nullptr;
     for (const ComparisonRow& r : c.rows)
-      if (r.what.pes == p && (!fastest || r.wall < fastest->wall)) fastest = &r;
+      if (r.agrees && r.what.pes == p && (!fastest || r.wall < fastest->wall)) fastest = &r;
     if (!fastest) continue;
     html += "<li>At P = " + std::to_string(p) + " the fastest is <b>" + escape(fastest->what.label()) + "</b>, " +
             fmt(fastest->wall, "%.4f") + " s (efficiency " +
@@ -426,7 +474,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
     for (MethodFamily family : {MethodFamily::Ray, MethodFamily::Raster}) {
       const ComparisonRow* best = nullptr;
       for (const ComparisonRow& r : c.rows)
-        if (r.what.pes == p && r.what.family == family && (!best || r.wall < best->wall)) best = &r;
+        if (r.agrees && r.what.pes == p && r.what.family == family && (!best || r.wall < best->wall)) best = &r;
       if (best && best != fastest)
         html += " Fastest " + escape(std::string(toString(family))) + ": " + escape(best->what.methodName()) + ", " +
                 fmt(best->wall, "%.4f") + " s.";
@@ -438,7 +486,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   auto predictedFastest = [&](std::optional<MethodFamily> family) {
     const MethodScaling* best = nullptr;
     for (const auto& [method, s] : scaling)
-      if (!s.predicted.empty() && (!family || s.largest->what.family == *family) &&
+      if (!s.predicted.empty() && s.largest->agrees && (!family || s.largest->what.family == *family) &&
           (!best || s.predicted.back().seconds < best->predicted.back().seconds))
         best = &s;
     return best;
@@ -470,8 +518,10 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
               " s until the last of " + std::to_string(topP) + " PEs has it; measured at P = " + std::to_string(r.what.pes) + ", " +
               formatBytes(dataBytes) + " of other data between PEs, computation/communication " +
               (r.summary.total.computeToComm >= 0 ? fmt(r.summary.total.computeToComm, "%.1f") : std::string("- (no messages)")) +
-              ", Karp&ndash;Flatt serial fraction " +
-              (std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.3f") : std::string("-")) + ".</li>";
+              ", serial fraction " + fmt(r.summary.total.serialFraction, "%.3f") + " (stages on one PE by design), "
+              "Karp&ndash;Flatt serial fraction " +
+              (std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.3f") : std::string("-")) +
+              "; replayed at the measured P on shared memory: " + escape(residuals(s)) + "." + replayNotes(last) + "</li>";
     }
     html += "</ul></li>";
   }
@@ -482,8 +532,8 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
 
 }  // namespace
 
-std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
-                        const std::string& relDir) {
+SceneSection sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
+                         const std::string& relDir) {
   const bool holds = holdsResults();  // under mpirun, rank 0 prints and writes
   const std::string stem = std::filesystem::path(sceneFile).stem().string();
   if (holds) std::fprintf(stderr, "report: %s: loading\n", stem.c_str());
@@ -542,7 +592,7 @@ std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, co
     html = sceneSection(runs, spec, dir, relDir);
     return par::Bytes();
   });
-  return html;
+  return {html, runs.c.mismatches};
 }
 
 }  // namespace pr::cli::report

@@ -39,7 +39,11 @@ struct ReportSpec {
 
 // Writes the scene's files under dir (created) and returns its HTML section; `relDir` is dir
 // as index.html links it.
-std::string sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
-                        const std::string& relDir);
+struct SceneSection {
+  std::string html;
+  int mismatches = 0;  // renders whose image differs from their family's (on rank 0; 0 elsewhere)
+};
+SceneSection sceneReport(const std::string& sceneFile, const ReportSpec& spec, const std::filesystem::path& dir,
+                         const std::string& relDir);
 
 }  // namespace pr::cli::report
