@@ -1,8 +1,6 @@
 // One fresh, timed render (see timed_render.h).
 #include "tools/timed_render.h"
 
-#include <sys/resource.h>
-
 #include <chrono>
 #include <string>
 #include <utility>
@@ -11,12 +9,6 @@
 #include "common/util/error.h"
 
 namespace pr::cli {
-
-double processCpuSeconds() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return double(usage.ru_utime.tv_sec + usage.ru_stime.tv_sec) + 1e-6 * double(usage.ru_utime.tv_usec + usage.ru_stime.tv_usec);
-}
 
 std::string Placement::acrossRanks() const {
   if (ranks == 1) return {};

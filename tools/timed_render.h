@@ -14,6 +14,7 @@
 #include "common/scene/camera.h"
 #include "common/scene/effect_analysis.h"
 #include "common/scene/scene.h"
+#include "common/util/cpu_time.h"
 #include "tools/render_methods.h"
 
 namespace pr::cli {
@@ -32,8 +33,6 @@ struct TimedRender {
   double wallSeconds = 0.0, cpuSeconds = 0.0;
 };
 
-// User plus system CPU seconds of this process so far.
-double processCpuSeconds();
 
 // Where a render runs: `pes` PEs in all, on `ranks` ranks - 1 (this process; under mpirun,
 // rank 0 alone) or every rank of the run (ProcessGroup::ranks(), which must divide pes).

@@ -1,7 +1,7 @@
 // Metrics: the only code that turns RunRecords (measured or simulated) into figures — min/mean/
-// max over PEs of every per-PE figure, load imbalance, efficiency, time at synchronisation
-// points, computation-to-communication ratio — and runs at several P into speed-up, efficiency
-// and the Karp-Flatt serial fraction. Reports, JSON, the CLI and tests all read these.
+// max over PEs of every per-PE figure, load imbalance, serial fraction, utilisation, time at
+// synchronisation points, computation-to-communication ratio — and runs at several P into
+// speed-up, efficiency and the Karp-Flatt serial fraction. Reports, JSON, the CLI and tests all read these.
 #pragma once
 
 #include <string>

@@ -25,7 +25,7 @@ std::vector<double> taskCostProfile(const RunRecord& record, int stage) {
   std::vector<double> costs(record.stages[stage].tasks.size(), 0.0);
   for (const TaskSpan& span : record.timeline)
     if (span.stage == stage && span.task >= 0 && span.task < static_cast<TaskId>(costs.size()))
-      costs[span.task] += span.end - span.start;
+      costs[span.task] += std::max(0.0, span.end - span.start - span.waitSeconds);  // what it computed
   return costs;
 }
 

@@ -70,10 +70,10 @@ std::string describeNetworks() {
   return text;
 }
 
-// What a recorded span computed: its length less its waiting for replies and messages, which
-// depends on the network and on other PEs, and which the replay models (the messages' costs)
-// instead of repeating the recorded wait as work.
 namespace {
+// What a recorded span computed: its wait for replies and messages depends on the network and
+// on other PEs, which the replay models (the messages' costs) instead of repeating it as work.
+// (taskCostProfile, run_record_json.cpp, takes the same.)
 double computed(const TaskSpan& span) { return std::max(0.0, span.end - span.start - span.waitSeconds); }
 }  // namespace
 

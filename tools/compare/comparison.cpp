@@ -218,18 +218,22 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   // Under mpirun, once on rank 0 alone and once across ranks.
   const bool holds = holdsResults();
   const bool progress = spec.progress && holds;
+  // The farm's warm-up waits for its first row, after every other render.
   std::set<std::tuple<MethodFamily, int, bool>> warmed;
-  for (const Combination& c : combinations) {
-    if (!warmed.insert({c.family, c.ranks, !c.farm.empty()}).second) continue;
+  const auto warmUp = [&](const Combination& c) {
+    if (!warmed.insert({c.family, c.ranks, !c.farm.empty()}).second) return;
     if (progress) std::fprintf(stderr, "warm-up (untimed): %s\n", c.label().c_str());
     (void)timed(c, spec, input);
-  }
+  };
+  for (const Combination& c : combinations)
+    if (c.farm.empty()) warmUp(c);
 
   const int total = int(combinations.size()) * spec.repeat;
   int done = 0;
   // The first image of each family and integrator: every other must equal it bit for bit.
   std::map<std::pair<MethodFamily, std::string>, std::size_t> familyFirst;
   for (const Combination& c : combinations) {
+    if (!c.farm.empty()) warmUp(c);
     ComparisonRow row;
     row.what = c;
     std::vector<TimedRender> runs;

@@ -259,17 +259,13 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   nlohmann::json scalingData = nlohmann::json::array();
   for (auto& [method, s] : scaling) {
     if (method == "sequential" || !s.largest) continue;
-    // The powers of two and every measured P, so that each measurement has its prediction.
-    std::vector<int> measuredPes = {1};
-    for (const auto& [p, wall] : s.measuredSeconds) measuredPes.push_back(p);
-    std::vector<int> pes = predictedPes;
-    pes.insert(pes.end(), measuredPes.begin(), measuredPes.end());
-    for (std::vector<int>* list : {&pes, &measuredPes}) {
-      std::sort(list->begin(), list->end());
-      list->erase(std::unique(list->begin(), list->end()), list->end());
-    }
-    s.predicted = predictScaling(s.largest->record, network, pes, s.measuredOne);
-    s.here = predictScaling(s.largest->record, par::networkByName("shared-memory"), measuredPes, s.measuredOne);
+    s.predicted = predictScaling(s.largest->record, network, predictedPes, s.measuredOne);
+    // Every measured P (and 1, the baseline) on this machine's network, beside the measurements.
+    std::vector<int> atMeasured = {1};
+    for (const auto& [p, wall] : s.measuredSeconds) atMeasured.push_back(p);
+    std::sort(atMeasured.begin(), atMeasured.end());
+    atMeasured.erase(std::unique(atMeasured.begin(), atMeasured.end()), atMeasured.end());
+    s.here = predictScaling(s.largest->record, par::networkByName("shared-memory"), atMeasured, s.measuredOne);
     s.serialFraction = fittedSerialFraction(s.measured);
     double best = 0.0;
     for (const PredictedPoint& p : s.predicted) {
@@ -458,8 +454,8 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   // Only among rows whose image agrees with their family's: a faster wrong image wins nothing.
   html += "<h3>Verdict</h3><div class=\"verdict\">" +
           (c.mismatches > 0 ? "<p><b>" + std::to_string(c.mismatches) +
-                                  " renders differ from their family's image: they are left out of the verdict, and the "
-                                  "report command fails.</b></p>"
+                                  " renders differ from their family's image: none of them is chosen as the fastest below, "
+                                  "and the report command fails.</b></p>"
                             : std::string()) +
           "<ul>";
   for (int p : measuredPes) {

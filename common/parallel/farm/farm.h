@@ -9,8 +9,10 @@
 //   jobs it held go to the others first; it is sent nothing more;
 // - a result counts only from the server that holds its job now: a lost server that wakes up
 //   and sends late results has them discarded by job, never added twice;
-// - the master never waits without a deadline, and a server that hears nothing from the master
-//   for deadlineSeconds (the master keeps idle servers told to wait) ends the run.
+// - the master never waits for a silent server without a deadline, and a server that hears
+//   nothing from the master for deadlineSeconds (the master keeps idle servers told to wait)
+//   ends the run. The deadline tells dead and stopped processes from working ones; a job that
+//   never ends inside a live process (its PEs hung) keeps its server alive and is not caught.
 // The transport must tolerate lost ranks (Transport::tolerateLostRanks) and the run must be
 // launched with `mpirun --enable-recovery`, or a dead server takes every rank with it.
 #pragma once

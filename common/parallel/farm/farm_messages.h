@@ -14,6 +14,7 @@ namespace pr::par::farm {
 // Each farm run of a command (FarmOptions::run) has tags of its own, so that a message of one
 // run (a server's hello for the next run sent while the master still waits for another
 // server's goodbye, a lost server's late result) never reaches another run's protocol.
+// run >= 0 (a count); tags 1100 .. 3099, below ServerGroupTransport's offset.
 inline int toMasterTag(int run) { return ProcessGroup::kFirstUserTag + 100 + 2 * (run % 1000); }
 inline int toServerTag(int run) { return toMasterTag(run) + 1; }
 

@@ -1,7 +1,6 @@
 // A farm server (farm.h): hello, pre-passes, then jobs as they come, each result sent back and
 // flushed before the next job starts (a large result moves only while this rank is inside MPI).
 #include <signal.h>
-#include <sys/resource.h>
 #include <unistd.h>
 
 #include <chrono>
@@ -17,6 +16,7 @@
 #include "common/parallel/farm/farm.h"
 #include "common/parallel/farm/farm_messages.h"
 #include "common/parallel/runtime.h"
+#include "common/util/cpu_time.h"
 #include "common/util/error.h"
 
 namespace pr::par {
@@ -25,13 +25,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
-
-// User plus system CPU seconds of this process so far (every thread).
-double cpuSeconds() {
-  rusage u{};
-  getrusage(RUSAGE_SELF, &u);
-  return double(u.ru_utime.tv_sec + u.ru_stime.tv_sec) + 1e-6 * double(u.ru_utime.tv_usec + u.ru_stime.tv_usec);
-}
 
 std::string formatSeconds(double s) {
   char text[32];
@@ -158,11 +151,11 @@ void runFarmServer(Transport& transport, const FarmOptions& options, std::uint64
                          std::as_bytes(std::span<const char>(text.data(), text.size()))));
     (void)transport.flush(options.deadlineSeconds);
   };
-  const double cpuAtHello = cpuSeconds();
+  const double cpuAtHello = processCpuSeconds();
   s.send(farm::message(farm::ServerSays::Hello, farm::Hello{contentHash, pes, 0}));
   // Told to stop: it says so, so the master knows it is not waiting for a lost rank.
   const auto leave = [&] {
-    s.send(farm::message(farm::ServerSays::Bye, farm::Bye{cpuSeconds() - cpuAtHello}));
+    s.send(farm::message(farm::ServerSays::Bye, farm::Bye{processCpuSeconds() - cpuAtHello}));
     (void)transport.flush(options.deadlineSeconds);
   };
   for (;;) {  // the welcome (a master sharing the pre-passes welcomes every server at once)

@@ -14,7 +14,7 @@ namespace pr::par {
 class ServerGroupTransport final : public Transport {
  public:
   // Tags of the group: the runtime's own tags moved up by this much (MPI guarantees tags up
-  // to 32767; the runtime's and the farm's are below 2000).
+  // to 32767; the runtime's and the farm's are below 3100, farm_messages.h).
   static constexpr int kTagOffset = 10000;
 
   explicit ServerGroupTransport(Transport& run) : run_(run) {}

@@ -1,4 +1,4 @@
-// Metrics: imbalance, efficiency, synchronisation wait, computation-to-communication ratio and
+// Metrics: imbalance, serial fraction, utilisation, synchronisation wait, computation-to-communication ratio and
 // the scaling figures (speed-up, efficiency, Karp-Flatt), with analytic expectations.
 #include <doctest/doctest.h>
 

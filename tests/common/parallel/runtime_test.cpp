@@ -250,14 +250,16 @@ TEST_CASE("Runtime: an exception in a set-up ends the stage and names the set-up
 }
 
 TEST_CASE("Runtime: a task's span carries the time it waited inside, which its busy time leaves out and a replay does not repeat") {
-  // PE 0's task waits until PE 1's task, after 40 ms of work, raises a flag.
+  // PE 0's task waits until PE 1's task, after 40 ms of work begun once PE 0 waits, raises a flag.
   Runtime rt(2, "demand");
   Channel<int> serving(rt, "serving", MessageKind::Requests, [](Pe&, int&&) {});
-  std::atomic<bool> raised{false};
+  std::atomic<bool> waiting{false}, raised{false};
   rt.runPinned("wait inside", TaskSet::uniform(2), {0, 1}, [&](Pe& pe, TaskId t) {
     if (t == 0) {
+      waiting = true;
       waitUntil(pe, serving, "the flag", [&] { return raised.load(); });
     } else {
+      while (!waiting) std::this_thread::yield();
       std::this_thread::sleep_for(std::chrono::milliseconds(40));
       raised = true;
     }
