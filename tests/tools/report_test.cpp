@@ -106,6 +106,10 @@ TEST_CASE("Report: a small report opens offline in headless Chromium with every 
   CHECK(html.find("src=\"http") == std::string::npos);  // nothing fetched from the network
   CHECK(html.find("Classification") != std::string::npos);
   CHECK(html.find("Verdict") != std::string::npos);
+  // No class's claim about traffic is contradicted by the measured runs at P = 2.
+  CHECK(html.find("CONTRADICTED") == std::string::npos);
+  CHECK(html.find("holds: 0 ray messages") != std::string::npos);  // image-space
+  CHECK(html.find(" bytes composited</td>") != std::string::npos);  // sort-last
   // The data beside every chart.
   int charts = 0;
   for (const char* name : {"speedup", "efficiency", "per_pe", "gantt", "communication", "composite_analytic", "cache", "accuracy"}) {
@@ -297,4 +301,19 @@ TEST_CASE("Report: an image that differs from its family's fails the report and 
   CHECK(page.find("s measured (") != std::string::npos);
   CHECK(page.find("how each stage was replayed at P = 4") != std::string::npos);
   CHECK(page.find("build: single owner") != std::string::npos);  // image-space's BVH, serial at any P
+}
+
+TEST_CASE("Report: a class's claim about traffic is checked against the measured run, and a contradiction is flagged") {
+  using pr::cli::report::checkClaim;
+  using pr::cli::report::MeasuredTraffic;
+  CHECK(checkClaim("image-space", MeasuredTraffic{2, 0, 0, 0.0}) == "holds: 0 ray messages");
+  CHECK(checkClaim("image-space", MeasuredTraffic{2, 3, 0, 0.0}) == "CONTRADICTED: 3 ray messages");
+  CHECK(checkClaim("object-space", MeasuredTraffic{2, 3, 0, 0.0}) == "holds: 3 ray messages");
+  CHECK(checkClaim("object", MeasuredTraffic{2, 0, 0, 0.0}) == "not shown here: 0 ray messages");
+  CHECK(checkClaim("sort-middle", MeasuredTraffic{4, 0, 7, 0.0}) == "holds: 7 primitive messages");
+  CHECK(checkClaim("sort-first", MeasuredTraffic{4, 0, 0, 0.0}) == "not shown here: 0 primitive messages");
+  CHECK(checkClaim("sort-last", MeasuredTraffic{2, 0, 0, 4096.0}) == "holds: 4096 bytes composited");
+  CHECK(checkClaim("sort-last", MeasuredTraffic{2, 0, 0, 0.0}) == "not shown here: 0 bytes composited");
+  CHECK(checkClaim("object-space", MeasuredTraffic{1, 0, 0, 0.0}) == "-");  // one PE cannot say
+  CHECK(checkClaim("image-space-cached", MeasuredTraffic{2, 0, 0, 0.0}) == "-");
 }

@@ -66,4 +66,22 @@ ScheduleClass classifySchedule(std::string_view schedule) {
   return it->second;
 }
 
+std::string checkClaim(std::string_view method, const MeasuredTraffic& run) {
+  if (run.pes < 2) return "-";
+  // A class that forbids some traffic is contradicted by any of it; one that implies traffic is
+  // only not shown by none (a small image can leave one PE with all the work, or one region).
+  const auto none = [](std::uint64_t n, const std::string& measured) {
+    return (n == 0 ? "holds: " : "CONTRADICTED: ") + measured;
+  };
+  const auto some = [](bool any, const std::string& measured) { return (any ? "holds: " : "not shown here: ") + measured; };
+  const std::string rays = std::to_string(run.rayMessages) + " ray messages";
+  if (method == "image-space") return none(run.rayMessages, rays);
+  if (method == "object-space" || method == "object") return some(run.rayMessages > 0, rays);
+  if (method == "sort-first" || method == "sort-middle")
+    return some(run.primitiveMessages > 0, std::to_string(run.primitiveMessages) + " primitive messages");
+  if (method == "sort-last")
+    return some(run.compositedBytes > 0.0, std::to_string(std::uint64_t(run.compositedBytes)) + " bytes composited");
+  return "-";
+}
+
 }  // namespace pr::cli::report

@@ -6,6 +6,7 @@
 // report prints these classes beside the figures measured on the scene that define them.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -27,5 +28,19 @@ struct ScheduleClass {
 // Throws pr::InputError for a name the registries do not know.
 MethodClass classifyMethod(std::string_view method);
 ScheduleClass classifySchedule(std::string_view schedule);
+
+// What a measured run of a method sent, as the class's claims speak of it.
+struct MeasuredTraffic {
+  int pes = 1;
+  std::uint64_t rayMessages = 0, primitiveMessages = 0;
+  double compositedBytes = 0.0;  // the Sort/composite_bytes counter
+};
+
+// The class's claim about traffic checked against a measured run of the method at P > 1, with
+// what the measurement shows: "holds: ", "CONTRADICTED: " (image-space, whose rays never leave
+// their PE, sent some), or "not shown here: " (object-space and object send rays, sort-first
+// and sort-middle primitives, sort-last composites pixels, but this run sent none: one PE may
+// have had all the work); "-" when the run cannot say (P = 1, or a claim the record cannot check).
+std::string checkClaim(std::string_view method, const MeasuredTraffic& run);
 
 }  // namespace pr::cli::report

@@ -199,15 +199,22 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   for (const std::string& m : spec.methods) {
     const MethodClass k = classifyMethod(m);
     const auto s = scaling.find(m);
+    const ComparisonRow* largest = s != scaling.end() ? s->second.largest : nullptr;
     classRows.push_back({m, std::string(toString(findRenderMethod(m).properties.family)), k.subdivision, k.sortPoint,
-                         k.dataManagement, k.definingFigure,
-                         s != scaling.end() && s->second.largest ? measuredFigure(*s->second.largest, spec.width, spec.height) : "-",
+                         k.dataManagement, k.definingFigure, largest ? measuredFigure(*largest, spec.width, spec.height) : "-",
+                         largest ? checkClaim(m, MeasuredTraffic{largest->what.pes, kindBytes(*largest, "rays", true),
+                                                                 kindBytes(*largest, "primitives", true),
+                                                                 counterTotal(*largest, "Sort/composite_bytes")})
+                                 : "-",
                          k.seedSection});
   }
   html += "<h3>Classification</h3><p>After the seed course, chapters 2&ndash;5. Computational model and task "
-          "management of the schedules compared: " + escape(models) + ".</p>\n" +
+          "management of the schedules compared: " + escape(models) + ". Each class's claim about traffic is checked "
+          "against the method's run at its largest P: a claim the measurement contradicts says so, and traffic a class "
+          "implies that this run did not send (one PE may have had all the work of a small image) is marked not "
+          "shown.</p>\n" +
           table({"method", "family", "task subdivision", "sort point", "data management", "defining figure",
-                 "measured on this scene", "seed"},
+                 "measured on this scene", "the class's claim, checked", "seed"},
                 classRows, "text");
 
   // Images and their x8 error against the reference.
