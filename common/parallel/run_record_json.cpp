@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/parallel/farm/farm_record_json.h"
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
 #include "common/util/atomic_file.h"
@@ -78,33 +79,6 @@ json peJson(const PeStageRecord& r) {
           {"prefetches", r.prefetches}};
 }
 
-json farmJson(const FarmRecord& f) {
-  json servers = json::array();
-  for (const FarmServerRecord& s : f.servers) {
-    json js = {{"rank", s.rank},
-               {"pes", s.pes},
-               {"prepareSeconds", s.prepareSeconds},
-               {"prepareMessages", s.prepareMessages},
-               {"prepareBytes", s.prepareBytes},
-               {"busySeconds", s.busySeconds},
-               {"idleSeconds", s.idleSeconds},
-               {"jobs", s.jobs},
-               {"lastHeardSeconds", s.lastHeardSeconds},
-               {"lateResults", s.lateResults},
-               {"cpuSeconds", s.cpuSeconds}};
-    if (s.lost()) {
-      js["lostAtSeconds"] = s.lostAtSeconds;
-      js["handedOn"] = s.handedOn;
-    }
-    servers.push_back(js);
-  }
-  json jobs = json::array();
-  for (const FarmJobRecord& j : f.jobs)
-    jobs.push_back({j.job, j.server, j.sentSeconds, j.doneSeconds, j.busySeconds, j.attempts, j.resultBytes});
-  return {{"schedule", f.schedule},     {"prepass", f.prepass}, {"deadlineSeconds", f.deadlineSeconds}, {"jobsAhead", f.jobsAhead},
-          {"jobShape", f.jobShape},     {"wallSeconds", f.wallSeconds},         {"servers", servers},
-          {"jobs", jobs}};  // jobs: [job, server, sentSeconds, doneSeconds, busySeconds, attempts, resultBytes]
-}
 
 json toJson(const RunRecord& record) {
   json j;
@@ -233,6 +207,34 @@ T optionalField(const json& j, const char* key, T fallback, const std::string& o
 RunRecord parseRunRecord(const std::string& text, const std::string& origin);
 
 }  // namespace
+
+json farmJson(const FarmRecord& f) {
+  json servers = json::array();
+  for (const FarmServerRecord& s : f.servers) {
+    json js = {{"rank", s.rank},
+               {"pes", s.pes},
+               {"prepareSeconds", s.prepareSeconds},
+               {"prepareMessages", s.prepareMessages},
+               {"prepareBytes", s.prepareBytes},
+               {"busySeconds", s.busySeconds},
+               {"idleSeconds", s.idleSeconds},
+               {"jobs", s.jobs},
+               {"lastHeardSeconds", s.lastHeardSeconds},
+               {"lateResults", s.lateResults},
+               {"cpuSeconds", s.cpuSeconds}};
+    if (s.lost()) {
+      js["lostAtSeconds"] = s.lostAtSeconds;
+      js["handedOn"] = s.handedOn;
+    }
+    servers.push_back(js);
+  }
+  json jobs = json::array();
+  for (const FarmJobRecord& j : f.jobs)
+    jobs.push_back({j.job, j.server, j.sentSeconds, j.doneSeconds, j.busySeconds, j.attempts, j.resultBytes});
+  return {{"schedule", f.schedule},     {"prepass", f.prepass}, {"deadlineSeconds", f.deadlineSeconds}, {"jobsAhead", f.jobsAhead},
+          {"jobShape", f.jobShape},     {"wallSeconds", f.wallSeconds},         {"servers", servers},
+          {"jobs", jobs}};  // jobs: [job, server, sentSeconds, doneSeconds, busySeconds, attempts, resultBytes]
+}
 
 std::string toJsonText(const RunRecord& record) { return toJson(record).dump(1) + "\n"; }
 

@@ -97,7 +97,7 @@ void injectImageFault(const Combination& c, TimedRender& t) {
 TimedRender timed(const Combination& c, const ComparisonSpec& spec, const RenderInput& input) {
   const RenderSettings settings = settingsFor(c, spec);
   const par::ScheduleOptions schedule{c.schedule, spec.scheduleParams};
-  TimedRender t = !c.farm.empty() ? timedFarmRender(spec.farm, input, settings, c.pes / (c.ranks - 1), schedule)
+  TimedRender t = !c.farm.empty() ? timedFarmRender(spec.farm, input, settings, c.pesPerProcess(), schedule)
                                   : timedRender(findRenderMethod(c.method), input, settings, Placement{c.pes, c.ranks}, schedule);
   injectImageFault(c, t);
   return t;

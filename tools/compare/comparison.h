@@ -39,6 +39,8 @@ struct Combination {
   std::string label() const;  // "object-space demand path P=2", "... P=4 R=2" across ranks,
                               // "image-space farm(demand) demand path P=2 R=3"
   std::string methodName() const;  // "image-space", or "image-space farm" for a farm
+  // The PEs each process that renders has: P / ranks, or for a farm P / its servers.
+  int pesPerProcess() const { return farm.empty() ? pes / ranks : pes / (ranks - 1); }
 };
 
 struct ComparisonSpec {

@@ -1,6 +1,8 @@
 // The comparison's table, CSV and JSON (see comparison_output.h).
 #include "tools/compare/comparison_output.h"
 
+#include "common/parallel/farm/farm_record_json.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <sstream>
@@ -63,8 +65,8 @@ std::string layout(const std::vector<std::vector<std::string>>& cells, std::size
 // P, and where its PEs ran: "4 (2x2)" on 2 ranks, "4 (2x2+master)" for a farm of 2 servers.
 std::string placementText(const Combination& c) {
   if (!c.farm.empty())
-    return std::to_string(c.pes) + " (" + std::to_string(c.ranks - 1) + "x" + std::to_string(c.pes / (c.ranks - 1)) + "+master)";
-  if (c.ranks > 1) return std::to_string(c.pes) + " (" + std::to_string(c.ranks) + "x" + std::to_string(c.pes / c.ranks) + ")";
+    return std::to_string(c.pes) + " (" + std::to_string(c.ranks - 1) + "x" + std::to_string(c.pesPerProcess()) + "+master)";
+  if (c.ranks > 1) return std::to_string(c.pes) + " (" + std::to_string(c.ranks) + "x" + std::to_string(c.pesPerProcess()) + ")";
   return std::to_string(c.pes);
 }
 
@@ -197,7 +199,7 @@ nlohmann::json comparisonJson(const Comparison& c) {
                     {"imageAgrees", r.agrees},
                     {"agreement", r.agreement}});
     // A farm's servers and jobs, as its run record holds them.
-    if (r.record.farm) rows.back()["farm"] = nlohmann::json::parse(par::toJsonText(r.record))["farm"];
+    if (r.record.farm) rows.back()["farm"] = par::farmJson(*r.record.farm);
   }
   nlohmann::json skipped = nlohmann::json::array();
   for (const SkippedCombination& s : c.skipped) skipped.push_back({{"what", s.what}, {"reason", s.reason}});

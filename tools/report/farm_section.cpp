@@ -22,7 +22,7 @@ const ComparisonRow* spmdBeside(const Comparison& c, const ComparisonRow& farm) 
   for (const ComparisonRow& r : c.rows) {
     const Combination& o = r.what;
     if (o.farm.empty() && o.method == f.method && o.schedule == f.schedule && o.integrator == f.integrator &&
-        o.ranks == f.ranks && o.pes / o.ranks == f.pes / (f.ranks - 1))
+        o.ranks == f.ranks && o.pesPerProcess() == f.pesPerProcess())
       return &r;
   }
   return nullptr;
