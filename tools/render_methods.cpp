@@ -208,9 +208,10 @@ bool runsAcrossRanksByName(std::string_view name) {
 
 RenderMethodRegistry makeMethods() {
   RenderMethodRegistry methods("method");
-  for (const rt::PartitionInfo& p : rt::partitions()) methods.add({p.name, p.description, renderRay, {MethodFamily::Ray}});
+  for (const rt::PartitionInfo& p : rt::partitions())
+    methods.add({p.name, p.description, renderRay, {MethodFamily::Ray, p.name == "sequential"}});
   for (const raster::SortPointInfo& s : raster::sortPoints())
-    methods.add({s.name, s.description, renderRaster, {MethodFamily::Raster}});
+    methods.add({s.name, s.description, renderRaster, {MethodFamily::Raster, s.name == "sequential-raster"}});
   return methods;
 }
 

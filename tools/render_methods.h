@@ -99,6 +99,9 @@ rt::TraceJob rayJobFor(const RenderRequest& request);
 // Registry: name -> render function -> description, and the method's family.
 struct MethodProperties {
   MethodFamily family = MethodFamily::Ray;
+  // The family's one-PE reference (the sequential tracer, the sequential raster pipeline):
+  // one task on one PE, the serial time Ts of the family's speed-ups; it runs at P = 1 only.
+  bool reference = false;
 };
 using RenderFunction = RenderOutcome (*)(std::string_view name, const RenderRequest& request);
 using RenderMethod = RegistryEntry<RenderFunction, MethodProperties>;

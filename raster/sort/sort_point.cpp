@@ -32,6 +32,8 @@ const SortPointRegistry& sortPoints() {
            &makeSortFirst},
           {"sort-middle", "screen triangles sent from geometry to the region owners, who rasterize", &makeSortMiddle},
           {"sort-last", "every PE renders its primitives full screen; pixels depth-composited by region", &makeSortLast},
+          {"sequential-raster", "one PE, the sequential pipeline, nothing sorted (the reference: the family's Ts)",
+           &makeSequentialRaster},
       });
   return kSortPoints;
 }

@@ -72,7 +72,8 @@ class SortPoint {
   virtual ~SortPoint() = default;
   // The shading counters of the last frame, per PE, reset by the call (the plan's skipped work).
   virtual std::vector<ShadeCounters> takeShadeCounters() = 0;
-  virtual std::string_view name() const = 0;  // "sort-first" | "sort-middle" | "sort-last"
+  // "sort-first" | "sort-middle" | "sort-last" | "sequential-raster" (no sort point: the reference)
+  virtual std::string_view name() const = 0;
   // Whether renderFrame runs on a runtime whose PEs live in several ranks (mpirun): every rank
   // calls it (SPMD), each holding its own PEs' buffers, and what crosses ranks is a message.
   virtual bool runsAcrossRanks() const { return false; }
@@ -88,6 +89,8 @@ class SortPoint {
 std::unique_ptr<SortPoint> makeSortFirst();
 std::unique_ptr<SortPoint> makeSortMiddle();
 std::unique_ptr<SortPoint> makeSortLast();
+// The sequential pipeline as one task on PE 0: the family's Ts, with no sort point (sequential.cpp).
+std::unique_ptr<SortPoint> makeSequentialRaster();
 
 // Registry: name -> factory -> description (feeds --help and validation).
 using SortPointInfo = RegistryEntry<std::unique_ptr<SortPoint> (*)()>;

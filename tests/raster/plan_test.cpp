@@ -41,12 +41,12 @@ std::vector<glm::vec3> sequential(const scene::Scene& s, const scene::Camera& ca
 // Every sort point at P = 3 with `effects` gives `expected`, and books `counterName` > 0.
 void checkSortPoints(const scene::Scene& s, const scene::Camera& cam, scene::EffectSet effects,
                      const std::vector<glm::vec3>& expected, const std::string& counterName) {
-  for (const char* method : {"sort-first", "sort-middle", "sort-last"}) {
-    CAPTURE(method);
+  for (const SortPointInfo& info : sortPoints()) {  // the sequential-raster reference included
+    CAPTURE(info.name);
     par::Runtime rt(3);
     SortOptions options;
     options.effects = effects;
-    std::unique_ptr<SortPoint> sp = makeSortPoint(method);
+    std::unique_ptr<SortPoint> sp = info.make();
     const RegionFramebuffer fb = renderFrame(*sp, s, makeFrameView(cam, kW, kH), options, rt);
     CHECK(toImage(fb).pixels == expected);
     CHECK(test::counterTotal(rt.record(), counterName) > 0);

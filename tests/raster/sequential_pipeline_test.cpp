@@ -8,7 +8,10 @@
 #include <random>
 #include <vector>
 
+#include "common/parallel/runtime.h"
+#include "raster/parallel_pipeline.h"
 #include "raster/sequential_pipeline.h"
+#include "raster/sort/sort_point.h"
 #include "raster/stages/depth_resolve.h"
 #include "raster/raster_test_scenes.h"
 
@@ -202,6 +205,24 @@ TEST_CASE("SequentialPipeline: exact depth ties go to the lower primitive id") {
     CAPTURE(reverse);
     CHECK(covered > 50);
     CHECK(wrong == 0);
+  }
+}
+
+TEST_CASE("SequentialRaster: the family's reference is the sequential pipeline, one task on PE 0, nothing sent") {
+  const scene::Scene s = busyScene();
+  const FrameView view = makeFrameView(busyCamera(), kW, kH);
+  const RegionFramebuffer expected = renderSequential(s, view);
+  for (const char* schedule : {"demand", "distributed"}) {
+    CAPTURE(schedule);
+    par::Runtime rt(3, schedule);
+    std::unique_ptr<SortPoint> reference = makeSortPoint("sequential-raster");
+    CHECK(identical(renderFrame(*reference, s, view, SortOptions{}, rt), expected));
+    const par::RunRecord& record = rt.record();
+    REQUIRE(record.stages.size() == 1);
+    CHECK(record.stages[0].kind == par::kOnePeStage);
+    CHECK(record.stages[0].channels.empty());
+    REQUIRE(record.timeline.size() == 1);
+    CHECK(record.timeline[0].pe == 0);
   }
 }
 

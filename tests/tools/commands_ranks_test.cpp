@@ -31,7 +31,7 @@ nlohmann::json readJson(const std::filesystem::path& file) {
   return nlohmann::json::parse(in);
 }
 
-// Every method but sequential runs across ranks; with each integrator when it traces rays.
+// Every method but the one-PE references (sequential, sequential-raster) runs across ranks; with each integrator when it traces rays.
 const std::set<std::string> kRayMethods = {"image-space", "image-space-cached", "object-space", "object"};
 const std::set<std::string> kRasterMethods = {"sort-first", "sort-middle", "sort-last"};
 const std::set<std::string> kIntegrators = {"whitted", "path", "photonmap"};
@@ -73,6 +73,7 @@ TEST_CASE("CommandsRanks: every method x integrator at R = 1, 2, 3, 4 ranks x T 
       }
       CHECK(rowRanks == ranks);
       if (ranks > 1) CHECK(row["method"] != "sequential");
+      if (ranks > 1) CHECK(row["method"] != "sequential-raster");
       ran.insert({row["method"], row["integrator"], pes / ranks});
     }
     for (int threads : {1, 2}) {
@@ -88,8 +89,9 @@ TEST_CASE("CommandsRanks: every method x integrator at R = 1, 2, 3, 4 ranks x T 
         CHECK(ran.count({m, "-", threads}) == 1);
       }
     }
-    // sequential and the 4 tracers per integrator, the 3 sort points (sort-last twice)
-    if (ranks > 1) CHECK(alone == 5 * 3 + 4);
+    // sequential and the 4 tracers per integrator, sequential-raster and the 3 sort points
+    // (sort-last twice)
+    if (ranks > 1) CHECK(alone == 5 * 3 + 5);
   }
 }
 

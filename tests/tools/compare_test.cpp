@@ -35,13 +35,14 @@ TEST_CASE("Compare: images agree only when every float of every pixel does") {
 TEST_CASE("Compare: every valid combination is a row, the invalid ones are skipped with their reason") {
   const std::filesystem::path dir = pr::test::scratchDir("compare");
   const auto r = runParrender(join({"compare ", cornell(), " --width 24 --height 16 --spp 1 --max-depth 2",
-                                    " --methods sequential,image-space,object-space,sort-middle,sort-last --threads 1,2,3",
+                                    " --methods sequential,image-space,object-space,sequential-raster,sort-middle,sort-last --threads 1,2,3",
                                     " --compositors direct-send,binary-swap --repeat 2 --reference-spp 4",
                                     " --reference-dir \"", (dir / "refs").string(), "\" --csv \"", (dir / "c.csv").string(),
                                     "\" --json \"", (dir / "c.json").string(), "\" --images \"", (dir / "img").string(), "\""}));
   INFO(r.output);
   REQUIRE(r.exitStatus == 0);
   CHECK(r.output.find("skipped sequential demand path P=2: sequential is the one-PE reference") != std::string::npos);
+  CHECK(r.output.find("skipped sequential-raster demand P=3: sequential-raster is the one-PE reference") != std::string::npos);
   CHECK(r.output.find("skipped sort-last demand binary-swap P=3: binary-swap needs P a power of two") != std::string::npos);
   CHECK(r.output.find("--spp is a ray-tracing option") != std::string::npos);
   CHECK(r.output.find("every render is bit-identical") != std::string::npos);
@@ -49,8 +50,9 @@ TEST_CASE("Compare: every valid combination is a row, the invalid ones are skipp
 
   std::ifstream in(dir / "c.json");
   const nlohmann::json j = nlohmann::json::parse(in);
-  // sequential 1 + image-space 3 + object-space 3 + sort-middle 3 + sort-last 3 + 2 (binary-swap at P = 1, 2)
-  REQUIRE(j["rows"].size() == 15);
+  // sequential 1 + image-space 3 + object-space 3 + sequential-raster 1 + sort-middle 3 + sort-last 3
+  // + 2 (binary-swap at P = 1, 2)
+  REQUIRE(j["rows"].size() == 16);
   CHECK(j["mismatches"] == 0);
   int binarySwap = 0;
   for (const nlohmann::json& row : j["rows"]) {
@@ -65,11 +67,14 @@ TEST_CASE("Compare: every valid combination is a row, the invalid ones are skipp
     // The partitioned tracer's rays travel between PEs; the replicated-scene methods send none.
     if (row["method"] == "object-space" && p > 1) CHECK(row["byKind"]["rays"]["messages"].get<int>() > 0);
     if (row["method"] == "image-space") CHECK_FALSE(row["byKind"].contains("rays"));
+    // Each family's Ts is its one-PE reference, the program with no parallel method.
     if (row["family"] == "ray-tracing") CHECK(row["serialReference"] == "sequential demand path P=1");
+    else CHECK(row["serialReference"] == "sequential-raster demand P=1");
   }
   CHECK(binarySwap == 2);
   // One family's image check: the rasterizers all match the first rasterizer, so their RMSE is one number.
-  CHECK(j["rows"][7]["rmse"] == j["rows"][14]["rmse"]);
+  CHECK(j["rows"][7]["rmse"] == j["rows"][15]["rmse"]);
+  CHECK(j["rows"][7]["method"] == "sequential-raster");
 
   std::ifstream csv(dir / "c.csv");
   std::string header, line;
@@ -78,7 +83,7 @@ TEST_CASE("Compare: every valid combination is a row, the invalid ones are skipp
   CHECK(header.find("rays_messages,rays_bytes") != std::string::npos);
   int lines = 0;
   while (std::getline(csv, line)) ++lines;
-  CHECK(lines == 15);
+  CHECK(lines == 16);
   CHECK(std::filesystem::exists(dir / "img" / "reference.png"));
   CHECK(std::filesystem::exists(dir / "img" / "object-space_demand_path_P-2_diff8.png"));
 }

@@ -107,9 +107,10 @@ bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 // Why the combination cannot run, or empty.
 std::string whyInvalid(const Combination& c, const ComparisonSpec& spec) {
-  if (c.method == "sequential" && c.pes > 1) return "sequential is the one-PE reference; it runs at P = 1 only";
-  if (c.method == "sequential" && c.schedule != spec.schedules.front())
-    return "sequential runs one task on one PE: every schedule gives the run measured under " + spec.schedules.front();
+  const bool reference = findRenderMethod(c.method).properties.reference;
+  if (reference && c.pes > 1) return c.method + " is the one-PE reference; it runs at P = 1 only";
+  if (reference && c.schedule != spec.schedules.front())
+    return c.method + " runs one task on one PE: every schedule gives the run measured under " + spec.schedules.front();
   if (c.compositor == "binary-swap" && !isPowerOfTwo(c.pes)) return "binary-swap needs P a power of two";
   if (c.ranks > 1 && !runsAcrossRanks(findRenderMethod(c.method)))
     return c.method + " does not run across processes; it ran on rank 0 alone";
@@ -290,8 +291,9 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
   }
 
   // Speed-ups: T1 is the same combination at P = 1 (a farm's: image-space's with the schedule
-  // of its servers' PEs); Ts the family's serial reference for the
-  // integrator, the sequential tracer when it ran, else the family's fastest run at P = 1.
+  // of its servers' PEs); Ts the family's serial reference for the integrator, its one-PE
+  // reference method when it ran (the sequential tracer, the sequential raster pipeline),
+  // else the family's fastest run at P = 1.
   for (ComparisonRow& row : out.rows) {
     const ComparisonRow* one = nullptr;
     const ComparisonRow* serial = nullptr;
@@ -300,9 +302,9 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
       // A farm at P = 1 (one server) is no one-PE baseline: a master runs beside it.
       if (o.pes != 1 || !o.farm.empty() || o.family != row.what.family || o.integrator != row.what.integrator) continue;
       if (o.method == row.what.method && o.schedule == row.what.schedule && o.compositor == row.what.compositor) one = &other;
-      const bool sequential = o.method == "sequential";
-      if (!serial || (sequential && serial->what.method != "sequential") ||
-          (sequential == (serial->what.method == "sequential") && other.wall < serial->wall))
+      const auto isReference = [](const ComparisonRow& r) { return findRenderMethod(r.what.method).properties.reference; };
+      const bool reference = isReference(other);
+      if (!serial || (reference && !isReference(*serial)) || (reference == isReference(*serial) && other.wall < serial->wall))
         serial = &other;
     }
     if (one && row.wall > 0.0) {

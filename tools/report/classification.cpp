@@ -12,7 +12,11 @@ MethodClass classifyMethod(std::string_view method) {
   static const std::map<std::string, MethodClass, std::less<>> kClasses = {
       {"sequential",
        {"none: one task on one PE", "-", "world model: the whole scene in one memory (§4.1)",
-        "the serial time Ts every speed-up is measured against", "§2.4.2"}},
+        "the serial time Ts the ray tracers' speed-ups are measured against", "§2.4.2"}},
+      {"sequential-raster",
+       {"none: the sequential raster pipeline, one task on one PE, nothing sorted", "-",
+        "world model: the whole scene in one memory (§4.1)",
+        "the serial time Ts the sort points' speed-ups are measured against", "§2.4.2"}},
       {"image-space",
        {"screen space: image tiles are the tasks, rays never leave their PE", "-",
         "world model: the scene and its BVH replicated on every PE (§4.1); photon maps replicated",
