@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # ThreadSanitizer job for the parallel runtime (common/parallel): configures its own build
-# directory with -DPARRENDER_SANITIZE=thread, builds parrender_tests, and runs the runtime's
-# test cases only. Any ThreadSanitizer report stops the run with a non-zero status
-# (halt_on_error=1), so CI fails on the first data race.
+# directory with -DPARRENDER_SANITIZE=thread, builds parrender_tests from the test files that
+# hold the runtime's test cases (below), and runs those cases only. Any ThreadSanitizer report
+# stops the run with a non-zero status (halt_on_error=1), so CI fails on the first data race.
 # Usage: tools/ci/tsan.sh [build-dir]   (default: build-tsan next to the sources; JOBS=2)
 set -euo pipefail
 
@@ -23,9 +23,25 @@ jobs="${JOBS:-2}"
 # Farm (common/parallel): a farm's master and servers on threads, passing messages.
 runtime_tests="Scheduler*,DemandPool*,DataDriven*,DemandDriven*,Hybrid*,TaskManager*,Distributed*,PreferredBias*,Runtime*,Channel*,BatchedChannel*,RayBatches*,CachedImageSpace*,Termination*,Simulator*,Metrics*,RunRecord*,DataManager*,RunOptions*,TilePull*,GatherToRoot*,PhotonPass*,TileAffinity*,ObjectSpace*,RankStage*,SortFirst*,Farm*"
 
-cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread
+# The test program is built from the files that hold those cases alone (PARRENDER_TEST_FILES),
+# not from the whole suite and the parrender program: a case that needs the program is left out.
+# doctest's -tc is case-insensitive: so is the search.
+pattern="^[[:space:]]*TEST_CASE[A-Z_]*\\([[:space:]]*\"($(echo "$runtime_tests" | sed 's/\*//g; s/,/|/g'))"
+files=$(cd "$source_dir/tests" && grep -rliE --include='*_test.cpp' "$pattern" . | sed 's|^\./||' | sort | paste -sd';') || files=
+[ -n "$files" ] || { echo "tsan: no test file holds the runtime's cases" >&2; exit 1; }
+without_program="Simulator: parrender simulate*"
+
+cmake -S "$source_dir" -B "$build_dir" -DCMAKE_BUILD_TYPE=RelWithDebInfo -DPARRENDER_SANITIZE=thread \
+  "-DPARRENDER_TEST_FILES=$files"
 cmake --build "$build_dir" -j"$jobs" --target parrender_tests
 
 export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 ${TSAN_OPTIONS:-}"
-"$build_dir/tests/parrender_tests" -tc="$runtime_tests"
+# Every concept name must name at least one case of the program, or its file was not found.
+IFS=, read -ra concepts <<<"$runtime_tests"
+for concept in "${concepts[@]}"; do
+  listed=$("$build_dir/tests/parrender_tests" -ltc -tc="$concept")
+  grep -q "^${concept%\*}" <<<"$listed" ||
+    { echo "tsan: no test case '$concept' in the program built from: $files" >&2; exit 1; }
+done
+"$build_dir/tests/parrender_tests" -tc="$runtime_tests" -tce="$without_program"
 echo "tsan: runtime tests passed with no ThreadSanitizer report"
