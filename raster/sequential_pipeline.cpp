@@ -37,7 +37,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
   };
   if (options.regions.empty()) {
     draw(tris, image.window());
-    if (showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
+    if (options.background && showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
     return;
   }
 
@@ -55,7 +55,7 @@ void renderSequential(const scene::Scene& scene, const FrameView& view, const Se
     }
     draw(bin, image.window(r));
   }
-  if (showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
+  if (options.background && showsEnvironment(scene, options.headlight)) fillBackground(view, *scene.environment, image);
 }
 
 RegionFramebuffer renderSequential(const scene::Scene& scene, const FrameView& view,

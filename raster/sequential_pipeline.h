@@ -27,6 +27,9 @@ struct SequentialOptions {
   scene::EffectSet effects = scene::EffectSet::all();
   // --headlight: a scene without lights is lit from the eye instead of by its environment.
   bool headlight = false;
+  // Fill the uncovered pixels with the environment (when the scene shows one). Off where the
+  // caller fills them itself (renderFrame does for every sort point, sequential-raster's too).
+  bool background = true;
 };
 
 struct RasterStats {

@@ -133,8 +133,8 @@ void run(CompareArgs& a) {
     std::printf("image-space farm: rank 0 the master, the other %d ranks servers; P counts the servers' PEs, the schedule is "
                 "among each server's PEs, the master orders jobs of %s by %s\n",
                 ranks - 1, a.farm.job.c_str(), a.farm.schedule.c_str());
-  std::printf("T1/Tn against the same combination at P=1, Ts/Tn against the family's sequential run (else its fastest "
-              "at P=1)");
+  std::printf("T1/Tn against the same combination at P=1, Ts/Tn against the family's one-PE reference (sequential, "
+              "sequential-raster; else its fastest at P=1)");
   if (!c.reference.image.empty())
     std::printf("; rmse against a path-traced reference, %d spp, depth %d%s", a.referenceSpp, a.referenceDepth,
                 c.reference.cached ? " (cached)" : "");

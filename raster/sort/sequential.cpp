@@ -23,6 +23,7 @@ class SequentialRaster final : public SortPoint {
     options.batchSize = f.options.batchSize;
     options.effects = f.options.effects;
     options.headlight = f.options.headlight;
+    options.background = false;  // renderFrame fills it after every sort point, this one's too
     shade_.assign(size_t(rt.pes()), ShadeCounters{});
     // PE 0 holds the image: the one-PE stage draws straight into it.
     rt.runOnOnePe("sequential-raster frame", 0, [&](par::Pe& pe) {

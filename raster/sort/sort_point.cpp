@@ -1,5 +1,6 @@
 // The sort-point registry (name -> factory -> description) and the counters' names: what the
-// render command and the tests use to pick sort-first, sort-middle or sort-last by name.
+// render command and the tests use to pick sequential-raster (the one-PE reference),
+// sort-first, sort-middle or sort-last by name.
 #include "raster/sort/sort_point.h"
 
 #include "common/util/error.h"
@@ -28,12 +29,13 @@ const SortPointRegistry& sortPoints() {
   static const SortPointRegistry kSortPoints(
       "raster method",
       {
+          // The reference first: compare checks every image of the family against the first.
+          {"sequential-raster", "one PE, the sequential pipeline, nothing sorted (the reference: the family's Ts)",
+           &makeSequentialRaster},
           {"sort-first", "primitives pre-transformed and sent to screen-region owners, who run the whole pipeline",
            &makeSortFirst},
           {"sort-middle", "screen triangles sent from geometry to the region owners, who rasterize", &makeSortMiddle},
           {"sort-last", "every PE renders its primitives full screen; pixels depth-composited by region", &makeSortLast},
-          {"sequential-raster", "one PE, the sequential pipeline, nothing sorted (the reference: the family's Ts)",
-           &makeSequentialRaster},
       });
   return kSortPoints;
 }

@@ -3,6 +3,8 @@
 // sort-middle sends screen triangles between geometry and rasterization, sort-last sends
 // shaded pixels after rasterization. All three call the stage functions of raster/stages and
 // move data between PEs only through counted par::Channels (shared/DESIGN.md rules 1 and 4).
+// The registry also holds sequential-raster, the sequential pipeline as one task on PE 0 with
+// nothing sorted: the family's one-PE reference, renderable wherever a sort point is.
 #pragma once
 
 #include <cstdint>

@@ -39,7 +39,7 @@ const std::set<std::string> kIntegrators = {"whitted", "path", "photonmap"};
 }  // namespace
 
 // The glass box: an area light, a mirror and glass (caustics for the photon map); small images,
-// few photons, so that the 45 renders of each R stay within seconds.
+// few photons, so that the renders of each R stay within seconds.
 TEST_CASE("CommandsRanks: every method x integrator at R = 1, 2, 3, 4 ranks x T = 1, 2 PEs equals the single-process image") {
   const std::filesystem::path dir = pr::test::scratchDir("commands_ranks_matrix");
   const std::string args = join({"compare ", cornellGlass(),
@@ -58,7 +58,7 @@ TEST_CASE("CommandsRanks: every method x integrator at R = 1, 2, 3, 4 ranks x T 
     CHECK(j["mismatches"] == 0);
     // Which (method, integrator, T) ran across every rank, each agreeing with the P = 1 image;
     // under mpirun the P = 1 rows ran on rank 0 alone (the T1 and Ts of every row), and
-    // sequential nowhere else.
+    // sequential and sequential-raster nowhere else.
     std::set<std::tuple<std::string, std::string, int>> ran;
     int alone = 0;
     for (const nlohmann::json& row : j["rows"]) {

@@ -410,6 +410,11 @@ TEST_CASE("RenderRanks: what does not run across ranks exits 2 with one message 
   CHECK(occurrences(sequential.output, "method sequential does not run across processes") == 1);
   CHECK(sequential.output.find("image-space, image-space-cached, object-space, object, sort-first, sort-middle, sort-last") !=
         std::string::npos);
+  // So is the raster family's.
+  const CommandResult sequentialRaster =
+      mpiParrender(2, join({"render ", cornell(), " -m sequential-raster --width 8 --height 8 -o /tmp/never.png"}));
+  CHECK(sequentialRaster.exitStatus == 2);
+  CHECK(occurrences(sequentialRaster.output, "method sequential-raster does not run across processes") == 1);
   // CLI11's output is rank 0's alone, and every rank ends through the group.
   const CommandResult help = mpiParrender(2, "--help");
   CHECK(help.exitStatus == 0);

@@ -273,6 +273,7 @@ void benchScene(const std::string& label, const std::string& path, const Options
     variants.push_back(std::move(v));
   };
   for (const raster::SortPointInfo& info : raster::sortPoints()) {
+    if (info.name == "sequential-raster") continue;  // the sequential pipeline, timed above by stage
     add(info, std::string(info.name), false, "demand");
     if (info.name == "sort-last") {
       // Sparse compositing (bounding rectangles), with geometry batches on demand, in equal

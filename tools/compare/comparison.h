@@ -93,7 +93,7 @@ struct Comparison {
 
 // Throws pr::InputError for an empty dimension or an unknown name, and for a farm without a
 // server or the farm's bad use (checkFarm); a combination that cannot
-// run (sequential at P > 1, binary-swap at P not a power of two, a request over the memory
+// run (a one-PE reference, sequential or sequential-raster, at P > 1; binary-swap at P not a power of two, a request over the memory
 // limit) is skipped with the reason. Under mpirun with R ranks, each value T of spec.threads
 // gives a row at P = R x T across every rank, and every combination also runs at P = 1 on
 // rank 0 alone, the other ranks waiting (unless !oneRankBaseline): its T1 and the family's
