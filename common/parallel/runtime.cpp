@@ -334,6 +334,8 @@ void Runtime::peLoop(int p, const StageJob& job) {
       if (tasksLeft) {
         nextTasks(pe, scheduler, askController, grab, spans, reports, asked);
         if (grab.tasks.empty()) {
+          // A search that found no task still sent its requests (a work-stealing PE's last).
+          bookScheduling(p, std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), askController);
           tasksLeft = false;
           if (acrossRanks) outstanding_.done();
           continue;

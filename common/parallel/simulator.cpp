@@ -322,7 +322,11 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       ready.pop();
       handle(p, t, handlerSeconds[p] * (totalWork > 0.0 ? handedWork / totalWork : 1.0));
       scheduler->next(p, t, grab);
+      // Steal requests answered empty: a round trip each, waited for one after the other.
+      t += grab.emptyAnswers * net.seconds(2, kTaskRequestBytes + kTaskPacketHeaderBytes);
       if (grab.tasks.empty()) {  // this PE is done with the stage's tasks: the rest of its messages
+        sr.pes[p].schedulingMessages += grab.requests + grab.packets;
+        sr.pes[p].schedulingBytes += grab.transferBytes();
         handle(p, t, handlerSeconds[p]);
         lastEnd[p] = std::max(lastEnd[p], t);
         continue;
@@ -332,11 +336,12 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       if (grab.from != p && messages > 0) {
         r.schedulingMessages += messages;
         r.schedulingBytes += grab.transferBytes();
-        if (grab.blocking && grab.packets > 0) {
+        const int packets = grab.packets - grab.emptyAnswers;  // those that brought tasks
+        if (grab.blocking && packets > 0) {
           // Idle until the first packet arrives; refills in the same answer travel while it computes.
-          const std::uint64_t first = (grab.requests > 0 ? kTaskRequestBytes : 0) + kTaskPacketHeaderBytes +
-                                      grab.moved / grab.packets * kTaskEntryBytes;
-          t += net.seconds((grab.requests > 0 ? 1 : 0) + 1, first);
+          const std::uint64_t first = (grab.requests > grab.emptyAnswers ? kTaskRequestBytes : 0) +
+                                      kTaskPacketHeaderBytes + grab.moved / std::uint64_t(packets) * kTaskEntryBytes;
+          t += net.seconds((grab.requests > grab.emptyAnswers ? 1 : 0) + 1, first);
         }
       }
       for (TaskId id : grab.tasks) handedWork += stage.costs[id];

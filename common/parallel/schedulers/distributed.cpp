@@ -4,7 +4,8 @@
 // instead of going to the controller. Work stealing in today's words. Across ranks each rank
 // keeps its own PEs' pools; a search that reaches a PE on another rank asks it by message
 // (Scheduler::localPoolsAcrossRanks), in the same ring order, and does not ask a pool that
-// answered empty again in the stage.
+// answered empty again in the stage. Every pool asked is a request and an answer, an empty one
+// too (Grab::emptyAnswers): in one process as across ranks, and in the simulator.
 #include <algorithm>
 #include <deque>
 #include <mutex>
@@ -51,8 +52,11 @@ class DistributedScheduler : public Scheduler {
       if (takeOwn(pe, out)) return;
       std::vector<TaskId> stolen;
       int victim = -1;
-      for (int d = 1; d < pes_ && victim < 0; ++d) {
-        for (int q : {(pe + d) % pes_, ((pe - d) % pes_ + pes_) % pes_}) {
+      // Each other PE once: at distance d = P / 2 (P even) the two ways round meet at one PE.
+      for (int d = 1; d <= pes_ / 2 && victim < 0; ++d) {
+        const int after = (pe + d) % pes_, before = ((pe - d) % pes_ + pes_) % pes_;
+        for (int way = 0; way < (after == before ? 1 : 2); ++way) {
+          const int q = way == 0 ? after : before;
           if (!local(q)) {  // its pool is on another rank: ask it, unless it answered empty
             std::vector<char>& empty = answeredEmpty_[std::size_t(pe)];
             if (!empty.empty() && empty[std::size_t(q)]) continue;
@@ -60,7 +64,12 @@ class DistributedScheduler : public Scheduler {
             return;
           }
           stolen = stealFrom(q);
-          if (stolen.empty()) continue;
+          if (stolen.empty()) {  // asked, and answered with an empty packet
+            out.requests += 1;
+            out.packets += 1;
+            out.emptyAnswers += 1;
+            continue;
+          }
           victim = q;
           break;
         }

@@ -46,6 +46,10 @@ struct Grab {
   int requests = 0;           // request messages sent (none for an unprompted static portion)
   int packets = 0;
   std::size_t moved = 0;
+  // Of those requests and packets: steal requests another PE answered with an empty packet
+  // (distributed's search), one round trip each that the asking PE waits for. A grab with no
+  // tasks may still carry them: the search that found every pool empty cost its messages.
+  int emptyAnswers = 0;
   bool blocking = true;
   // Across ranks, for a strategy with local pools (Scheduler::localPoolsAcrossRanks), no tasks
   // yet and: askPe >= 0, a stealing search reached PE askPe on another rank (the runtime asks
@@ -64,6 +68,7 @@ struct Grab {
     requests = 0;
     packets = 0;
     moved = 0;
+    emptyAnswers = 0;
     blocking = true;
     askPe = -1;
     refillRequests = 0;
