@@ -43,7 +43,7 @@ const std::vector<PeFigure>& peFigures() {
       // Task hand-outs go through the shared scheduler, not a Channel: their count is measured,
       // their size is what a distributed implementation would send (scheduler.h).
       {"schedulingMessages", [](const PeStageRecord& r) { return double(r.schedulingMessages); },
-       "modelled: one request and one task packet per hand-out from another PE or the controller"},
+       "modelled: one request and one task packet per hand-out from another PE or the controller, and per steal request answered empty"},
       {"schedulingBytes", [](const PeStageRecord& r) { return double(r.schedulingBytes); },
        "modelled: 16-byte requests, 16-byte packet headers and 8 bytes per task id"},
       {"broadcastBytesReceived", [](const PeStageRecord& r) { return double(r.broadcastBytesReceived); },

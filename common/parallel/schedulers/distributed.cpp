@@ -28,6 +28,7 @@ class DistributedScheduler : public Scheduler {
   void reset(const TaskSet& tasks, int pes, const ScheduleParams& params) override {
     pes_ = pes;
     answeredEmpty_.assign(std::size_t(pes), {});
+    askedEmpty_.assign(std::size_t(pes), std::vector<char>(std::size_t(pes), 0));
     grain_ = std::max(1, params.grain);
     pools_.clear();
     for (int p = 0; p < pes_; ++p) pools_.push_back(std::make_unique<Pool>());
@@ -63,8 +64,11 @@ class DistributedScheduler : public Scheduler {
             out.askPe = q;
             return;
           }
+          std::vector<char>& askedEmpty = askedEmpty_[std::size_t(pe)];
+          if (askedEmpty[std::size_t(q)]) continue;  // asked before another rank's answer
           stolen = stealFrom(q);
           if (stolen.empty()) {  // asked, and answered with an empty packet
+            askedEmpty[std::size_t(q)] = 1;
             out.requests += 1;
             out.packets += 1;
             out.emptyAnswers += 1;
@@ -74,6 +78,7 @@ class DistributedScheduler : public Scheduler {
           break;
         }
       }
+      std::fill(askedEmpty_[std::size_t(pe)].begin(), askedEmpty_[std::size_t(pe)].end(), 0);  // the search is over
       if (victim < 0) return;  // every pool is empty: the stage's tasks are all handed out
       addToPool(pe, stolen);
       out.from = victim;
@@ -101,6 +106,7 @@ class DistributedScheduler : public Scheduler {
       empty[std::size_t(victim)] = 1;
       return;
     }
+    std::fill(askedEmpty_[std::size_t(pe)].begin(), askedEmpty_[std::size_t(pe)].end(), 0);  // the search is over
     addToPool(pe, tasks);
   }
 
@@ -134,6 +140,10 @@ class DistributedScheduler : public Scheduler {
   int firstLocal_ = 0, localCount_ = -1;  // -1: every PE is local
   // Per PE (by its own thread only): the PEs on other ranks whose pools answered it empty.
   std::vector<std::vector<char>> answeredEmpty_;
+  // Per PE (by its own thread only): the pools on its rank that answered empty in the current
+  // search, which an answer from another rank interrupts; so that the search goes on where it
+  // was, asking each pool once, as in one process.
+  std::vector<std::vector<char>> askedEmpty_;
 };
 
 }  // namespace
