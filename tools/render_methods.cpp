@@ -228,6 +228,8 @@ const RenderMethodRegistry& renderMethods() {
 
 const RenderMethod& findRenderMethod(std::string_view name) { return renderMethods().find(name); }
 
+bool isOnePeReference(std::string_view method) { return findRenderMethod(method).properties.reference; }
+
 std::string describeRenderMethods() {
   std::string out;
   for (const RenderMethod& m : renderMethods())

@@ -107,6 +107,8 @@ using RenderFunction = RenderOutcome (*)(std::string_view name, const RenderRequ
 using RenderMethod = RegistryEntry<RenderFunction, MethodProperties>;
 using RenderMethodRegistry = Registry<RenderFunction, MethodProperties>;
 
+// Whether the named method is its family's one-PE reference (MethodProperties::reference).
+bool isOnePeReference(std::string_view method);
 // Every method, ray tracers first (from the raytrace partition registry).
 const RenderMethodRegistry& renderMethods();
 // Throws pr::InputError naming the unknown method and listing the valid ones.

@@ -333,15 +333,14 @@ void Runtime::peLoop(int p, const StageJob& job) {
       if (handleMessages(pe, spans)) continue;
       if (tasksLeft) {
         nextTasks(pe, scheduler, askController, grab, spans, reports, asked);
+        // Asked of rank 0's controller, and answered, by messages between ranks; a search that
+        // found no task still sent its requests (a work-stealing PE's last).
+        if (grab.from != p) bookScheduling(p, std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), askController);
         if (grab.tasks.empty()) {
-          // A search that found no task still sent its requests (a work-stealing PE's last).
-          bookScheduling(p, std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), askController);
           tasksLeft = false;
           if (acrossRanks) outstanding_.done();
           continue;
         }
-        // Asked of rank 0's controller, and answered, by messages between ranks.
-        if (grab.from != p) bookScheduling(p, std::uint64_t(grab.requests + grab.packets), grab.transferBytes(), askController);
         for (TaskId id : grab.tasks) {
           if (abort_.load(std::memory_order_relaxed)) break;
           current = id;

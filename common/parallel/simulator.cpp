@@ -324,25 +324,23 @@ Prediction predictWith(const Workload& workload, std::string_view schedule, Sche
       scheduler->next(p, t, grab);
       // Steal requests answered empty: a round trip each, waited for one after the other.
       t += grab.emptyAnswers * net.seconds(2, kTaskRequestBytes + kTaskPacketHeaderBytes);
+      PeStageRecord& r = sr.pes[p];
+      const std::uint64_t messages = grab.requests + grab.packets;
+      if (grab.from != p && messages > 0) {  // a search that found no task sent its requests too
+        r.schedulingMessages += messages;
+        r.schedulingBytes += grab.transferBytes();
+      }
       if (grab.tasks.empty()) {  // this PE is done with the stage's tasks: the rest of its messages
-        sr.pes[p].schedulingMessages += grab.requests + grab.packets;
-        sr.pes[p].schedulingBytes += grab.transferBytes();
         handle(p, t, handlerSeconds[p]);
         lastEnd[p] = std::max(lastEnd[p], t);
         continue;
       }
-      PeStageRecord& r = sr.pes[p];
-      const std::uint64_t messages = grab.requests + grab.packets;
-      if (grab.from != p && messages > 0) {
-        r.schedulingMessages += messages;
-        r.schedulingBytes += grab.transferBytes();
-        const int packets = grab.packets - grab.emptyAnswers;  // those that brought tasks
-        if (grab.blocking && packets > 0) {
-          // Idle until the first packet arrives; refills in the same answer travel while it computes.
-          const std::uint64_t first = (grab.requests > grab.emptyAnswers ? kTaskRequestBytes : 0) +
-                                      kTaskPacketHeaderBytes + grab.moved / std::uint64_t(packets) * kTaskEntryBytes;
-          t += net.seconds((grab.requests > grab.emptyAnswers ? 1 : 0) + 1, first);
-        }
+      const int packets = grab.packets - grab.emptyAnswers;  // those that brought tasks
+      if (grab.from != p && grab.blocking && packets > 0) {
+        // Idle until the first packet arrives; refills in the same answer travel while it computes.
+        const std::uint64_t first = (grab.requests > grab.emptyAnswers ? kTaskRequestBytes : 0) +
+                                    kTaskPacketHeaderBytes + grab.moved / std::uint64_t(packets) * kTaskEntryBytes;
+        t += net.seconds((grab.requests > grab.emptyAnswers ? 1 : 0) + 1, first);
       }
       for (TaskId id : grab.tasks) handedWork += stage.costs[id];
       for (TaskId id : grab.tasks) {

@@ -107,7 +107,7 @@ bool isPowerOfTwo(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
 // Why the combination cannot run, or empty.
 std::string whyInvalid(const Combination& c, const ComparisonSpec& spec) {
-  const bool reference = findRenderMethod(c.method).properties.reference;
+  const bool reference = isOnePeReference(c.method);
   if (reference && c.pes > 1) return c.method + " is the one-PE reference; it runs at P = 1 only";
   if (reference && c.schedule != spec.schedules.front())
     return c.method + " runs one task on one PE: every schedule gives the run measured under " + spec.schedules.front();
@@ -302,9 +302,9 @@ Comparison runComparison(const ComparisonSpec& given, const RenderInput& input) 
       // A farm at P = 1 (one server) is no one-PE baseline: a master runs beside it.
       if (o.pes != 1 || !o.farm.empty() || o.family != row.what.family || o.integrator != row.what.integrator) continue;
       if (o.method == row.what.method && o.schedule == row.what.schedule && o.compositor == row.what.compositor) one = &other;
-      const auto isReference = [](const ComparisonRow& r) { return findRenderMethod(r.what.method).properties.reference; };
-      const bool reference = isReference(other);
-      if (!serial || (reference && !isReference(*serial)) || (reference == isReference(*serial) && other.wall < serial->wall))
+      const bool reference = isOnePeReference(o.method);
+      const bool serialIsReference = serial && isOnePeReference(serial->what.method);
+      if (!serial || (reference && !serialIsReference) || (reference == serialIsReference && other.wall < serial->wall))
         serial = &other;
     }
     if (one && row.wall > 0.0) {

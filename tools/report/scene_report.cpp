@@ -63,7 +63,7 @@ std::uint64_t broadcastCopy(const ComparisonRow& r, bool messages = false) {
 std::string measuredFigure(const ComparisonRow& r, int width, int height) {
   const std::string& m = r.what.method;
   const int p = r.what.pes;
-  if (findRenderMethod(m).properties.reference) return "Ts = " + fmt(r.wall, "%.3f") + " s";
+  if (isOnePeReference(m)) return "Ts = " + fmt(r.wall, "%.3f") + " s";
   if (m == "image-space")
     return "broadcast " + formatBytes(broadcastCopy(r)) + " to each PE but PE 0, " +
            std::to_string(kindBytes(r, "rays", true)) + " ray messages (P=" + std::to_string(p) + ")";
@@ -265,7 +265,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   const std::vector<int> predictedPes = powersOfTwo(spec.maxPredictedPes);
   nlohmann::json scalingData = nlohmann::json::array();
   for (auto& [method, s] : scaling) {
-    if (findRenderMethod(method).properties.reference || !s.largest) continue;
+    if (isOnePeReference(method) || !s.largest) continue;
     s.predicted = predictScaling(s.largest->record, network, predictedPes, s.measuredOne);
     // Every measured P (and 1, the baseline) on this machine's network, beside the measurements.
     std::vector<int> atMeasured = {1};
@@ -319,7 +319,7 @@ std::string sceneSection(const SceneRuns& r, const ReportSpec& spec, const std::
   html += chart(dir, relDir, "efficiency", scalingSpec("efficiency", false), scalingData, "Efficiency against P");
   std::vector<std::vector<std::string>> fitRows;
   for (const auto& [method, s] : scaling) {
-    if (findRenderMethod(method).properties.reference || s.predicted.empty()) continue;
+    if (isOnePeReference(method) || s.predicted.empty()) continue;
     fitRows.push_back({method, residuals(s), std::isfinite(s.serialFraction) ? fmt(s.serialFraction, "%.4f") : "-",
                        std::isfinite(s.serialFraction) && s.serialFraction > 0 ? fmt(1.0 / s.serialFraction, "%.1f") : "-",
                        std::to_string(s.bestPredictedPes), fmt(s.predicted.back().speedup, "%.3g"),

@@ -78,7 +78,7 @@ class DistributedScheduler : public Scheduler {
           break;
         }
       }
-      std::fill(askedEmpty_[std::size_t(pe)].begin(), askedEmpty_[std::size_t(pe)].end(), 0);  // the search is over
+      endSearch(pe);
       if (victim < 0) return;  // every pool is empty: the stage's tasks are all handed out
       addToPool(pe, stolen);
       out.from = victim;
@@ -106,7 +106,7 @@ class DistributedScheduler : public Scheduler {
       empty[std::size_t(victim)] = 1;
       return;
     }
-    std::fill(askedEmpty_[std::size_t(pe)].begin(), askedEmpty_[std::size_t(pe)].end(), 0);  // the search is over
+    endSearch(pe);
     addToPool(pe, tasks);
   }
 
@@ -120,6 +120,9 @@ class DistributedScheduler : public Scheduler {
     std::lock_guard lock(pools_[pe]->mutex);
     pools_[pe]->tasks.insert(pools_[pe]->tasks.end(), tasks.begin(), tasks.end());
   }
+
+  // A search is over (a steal, or every pool empty): the next one asks every pool again.
+  void endSearch(int pe) { std::fill(askedEmpty_[std::size_t(pe)].begin(), askedEmpty_[std::size_t(pe)].end(), 0); }
 
   bool local(int q) const { return localCount_ < 0 || (q >= firstLocal_ && q < firstLocal_ + localCount_); }
 
