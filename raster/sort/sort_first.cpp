@@ -53,25 +53,38 @@ void transformPrimitives(const scene::Scene& scene, const FrameView& view, std::
   }
 }
 
+// The union of the pixel bounds of the pieces of one primitive, grown by a piece.
+void grow(Rect& b, const Rect& r) {
+  if (r.empty()) return;
+  b = b.empty() ? r : Rect{std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
+}
+
+// Pixel bounds of every primitive of a sorted id list from its pieces (which come in id order):
+// empty where it was culled or clipped away.
+std::vector<Rect> boundsOfPieces(std::span<const uint32_t> ids, std::span<const ScreenTriangle> pieces) {
+  std::vector<Rect> bounds(ids.size());
+  size_t k = 0;
+  for (const ScreenTriangle& t : pieces) {
+    while (ids[k] != t.primitive) ++k;
+    PR_DCHECK(k < ids.size(), "sort-first: a piece of a primitive outside the list");
+    grow(bounds[k], pixelBounds(t));
+  }
+  return bounds;
+}
+
 // The pre-transform: pixel bounds of all pieces of each primitive of a sorted id list (empty
 // when it is culled or clipped away), by the same geometry function the owners run in full.
 std::vector<Rect> primitiveBounds(const scene::Scene& scene, const FrameView& view, std::span<const uint32_t> ids) {
-  std::vector<Rect> bounds(ids.size());
+  std::vector<Rect> bounds;
+  bounds.reserve(ids.size());
   std::vector<ScreenTriangle> pieces;
   constexpr size_t kChunk = 4096;
   for (size_t c0 = 0; c0 < ids.size(); c0 += kChunk) {
-    const size_t c1 = std::min(ids.size(), c0 + kChunk);
+    const std::span<const uint32_t> chunk = ids.subspan(c0, std::min(kChunk, ids.size() - c0));
     pieces.clear();
-    transformPrimitives(scene, view, ids.subspan(c0, c1 - c0), pieces);
-    size_t k = c0;
-    for (const ScreenTriangle& t : pieces) {
-      while (ids[k] != t.primitive) ++k;  // pieces come in id order
-      PR_DCHECK(k < c1, "sort-first: a piece of a primitive outside the chunk");
-      const Rect r = pixelBounds(t);
-      if (r.empty()) continue;
-      Rect& b = bounds[k];
-      b = b.empty() ? r : Rect{std::min(b.x0, r.x0), std::min(b.y0, r.y0), std::max(b.x1, r.x1), std::max(b.y1, r.y1)};
-    }
+    transformPrimitives(scene, view, chunk, pieces);
+    const std::vector<Rect> b = boundsOfPieces(chunk, pieces);
+    bounds.insert(bounds.end(), b.begin(), b.end());
   }
   return bounds;
 }
@@ -138,39 +151,44 @@ class SortFirst : public SortPoint {
       held_.assign(pes, {});
       for (int p = 0; p < pes; ++p) {
         const auto [lo, hi] = primitiveShare(total, p, pes);
-        for (uint32_t i = lo; i < hi; ++i) held_[p].push_back(i);
+        for (uint32_t i = lo; i < hi; ++i) held_[p].ids.push_back(i);
       }
       previous_.reset();
     }
 
     par::PerPe<Tally> counters(pes);
-    std::vector<std::vector<uint32_t>> kept(pes);  // what each PE keeps without a message
+    std::vector<std::vector<uint32_t>> draw(pes);  // what each PE draws without a message
+    std::vector<Held> unseen(pes);                 // what it keeps without drawing it
     par::Channel<PrimitiveBatch> primitives(rt, "scene primitives", par::MessageKind::Primitives);
 
     // Stage 1, pre-transform and the sort, each PE on the primitives it holds. A primitive held
     // by several PEs (it overlapped several owners last frame) is forwarded by one of them only:
     // the lowest of its previous owners (its primary); an unseen primitive has one holder. The
     // primary also counts a migration when the primitive's owner set differs from last frame's
-    // (a new owner, a lost one, or entering or leaving the screen).
+    // (a new owner, a lost one, or entering or leaving the screen). Last frame's owners come
+    // from the bounds each PE kept of what it held, so nothing is transformed twice.
     rt.runOnEachPe("sort-first pre-transform", [&](par::Pe& pe) {
       const int p = pe.id();
       Tally& c = counters[p];
       std::vector<PrimitiveBatch> out(pes, PrimitiveBatch{&f.scene, {}, {}});
       std::vector<char> scratch(pes, 0);
       std::vector<int> owners, before;
-      const std::vector<uint32_t>& held = held_[p];  // sorted
-      const scene::Scene& geometry = geometryOf(f, p);
-      const std::vector<Rect> now = primitiveBounds(geometry, f.view, held);
-      const std::vector<Rect> then = previous_ ? primitiveBounds(geometry, previous_->view, held) : std::vector<Rect>();
-      c.preTransforms += held.size() + then.size();
-      for (size_t k = 0; k < held.size(); ++k) {
-        const uint32_t id = held[k];
+      const Held& held = held_[p];  // sorted by id
+      const std::vector<Rect> now = primitiveBounds(geometryOf(f, p), f.view, held.ids);
+      c.preTransforms += held.ids.size();
+      for (size_t k = 0; k < held.ids.size(); ++k) {
+        const uint32_t id = held.ids[k];
         ownersOf(grid, now[k], scratch, owners);
         before.clear();
-        if (previous_) ownersOf(previous_->grid, then[k], scratch, before);
+        if (previous_) ownersOf(previous_->grid, held.bounds[k], scratch, before);
         const bool primary = before.empty() || before.front() == p;
         const bool ownNow = std::binary_search(owners.begin(), owners.end(), p);
-        if (ownNow || (primary && owners.empty())) kept[p].push_back(id);  // keeper of an unseen one
+        if (ownNow) {
+          draw[p].push_back(id);
+        } else if (primary && owners.empty()) {  // keeper of an unseen one: held, not drawn
+          unseen[p].ids.push_back(id);
+          unseen[p].bounds.push_back(now[k]);
+        }
         if (!primary) continue;
         c.routed += owners.size();
         if (!owners.empty()) c.duplicated += owners.size() - 1;
@@ -190,20 +208,23 @@ class SortFirst : public SortPoint {
     for (int p = 0; p < pes; ++p) received[p] = primitives.drain(p);
 
     // Stage 2, the whole pipeline on each owner's regions: geometry again on every primitive
-    // it holds, then rasterize and shade.
+    // it draws (those overlapping its regions), then rasterize and shade. What it draws and
+    // what it keeps unseen are what it holds next frame, with their bounds in this frame.
     drawers_.resize(pes);
+    std::vector<Held> next(pes);
     rt.runOnEachPe("sort-first render", [&](par::Pe& pe) {
       const int p = pe.id();
-      std::vector<uint32_t>& mine = kept[p];
+      std::vector<uint32_t>& mine = draw[p];
       install(p, received[p]);
       addIds(received[p], mine);
       std::vector<ScreenTriangle> tris;
       transformPrimitives(geometryOf(f, p), f.view, mine, tris);
       counters[p].geometryRepeated += mine.size();
+      next[p] = merged(unseen[p], mine, boundsOfPieces(mine, tris));
       drawers_[p].draw(pe, shadingOf(p, ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
 
-    held_ = std::move(kept);
+    held_ = std::move(next);
     previous_.emplace(Previous{f.view, grid});
     scene_ = &f.scene;
     triangles_ = total;
@@ -301,6 +322,25 @@ class SortFirst : public SortPoint {
     FrameView view;
     RegionGrid grid;
   };
+  // The primitives a PE holds, sorted by id, with their pixel bounds in the previous frame
+  // (none on a frame that starts from the initial shares).
+  struct Held {
+    std::vector<uint32_t> ids;
+    std::vector<Rect> bounds;
+  };
+  // Two disjoint held lists, each sorted by id, as one.
+  static Held merged(const Held& a, std::span<const uint32_t> ids, std::span<const Rect> bounds) {
+    Held out;
+    out.ids.reserve(a.ids.size() + ids.size());
+    out.bounds.reserve(out.ids.capacity());
+    size_t i = 0, j = 0;
+    while (i < a.ids.size() || j < ids.size()) {
+      const bool fromA = j == ids.size() || (i < a.ids.size() && a.ids[i] < ids[j]);
+      out.ids.push_back(fromA ? a.ids[i] : ids[j]);
+      out.bounds.push_back(fromA ? a.bounds[i++] : bounds[j++]);
+    }
+    return out;
+  }
   par::PerPe<RegionDrawer> drawers_;  // per PE, kept between frames (binning storage)
   RegionBufferPool pool_;              // region message storage, kept between frames
   SceneDistribution distribution_;
@@ -309,7 +349,7 @@ class SortFirst : public SortPoint {
   std::vector<std::unique_ptr<scene::Scene>> views_;
   std::vector<std::optional<ShadingContext>> shading_;  // per PE, over its copy, this frame
   // Between frames: the primitives each PE holds, and the view and regions they were sorted by.
-  std::vector<std::vector<uint32_t>> held_;
+  std::vector<Held> held_;
   std::optional<Previous> previous_;
   const scene::Scene* scene_ = nullptr;
   uint32_t triangles_ = 0;

@@ -67,6 +67,28 @@ TEST_CASE("SortFirst: a repeated frame reuses the assignment and sends no primit
   CHECK(identical(again, renderSequential(s, view)));
 }
 
+TEST_CASE("SortFirst: a primitive off the screen is held but never drawn, and each frame pre-transforms it once") {
+  // The three triangles plus one far left of the 16 x 16 screen (x in [-30, -26]): PE 1
+  // (strips; contiguous start: PE 0 holds {0, 1}, PE 1 holds {2, 3}) keeps it unseen.
+  scene::Scene s = test::threeTriangles();
+  test::addTriangle(s, {-30, 6, 0}, {-30, 2, 0}, {-26, 6, 0});
+  const FrameView view = test::tinyView();
+  SortOptions options;
+  options.regions = RegionStrategy::StaticStrips;
+  par::Runtime rt(2, "balanced");
+  std::unique_ptr<SortPoint> sf = makeSortPoint("sort-first");
+  for (int frame = 0; frame < 3; ++frame) {
+    CAPTURE(frame);
+    RegionFramebuffer image;
+    test::CounterTotals c = test::frameCounters(rt, [&] { image = renderFrame(*sf, s, view, options, rt); });
+    CHECK(identical(image, renderSequential(s, view)));
+    // The 4 initial shares, then 5 held: triangle 2 overlaps both strips, so both owners hold it.
+    CHECK(c["Sort/pre_transforms"] == (frame == 0 ? 4 : 5));
+    CHECK(c["Sort/geometry_repeated"] == 4);  // the three on screen (2 twice), not the unseen one
+    CHECK(c["Sort/primitives_routed"] == 4);
+  }
+}
+
 // A ring of small triangles around the origin, so turning the camera moves them across regions.
 scene::Scene ring() {
   scene::Scene t = test::emptyScene();
