@@ -76,10 +76,12 @@ void FrameAssembly::serve(par::Pe& pe) {
   if (!assembles(pe)) return;
   // As the runtime does between tasks (and TilePull inside one): a handled message is done;
   // the task calling this is still outstanding, so this is never the stage's last unit.
+  const double t0 = runtime_.now();
   while (regions_.handleOne(pe)) {
     pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
     runtime_.outstanding().done();
   }
+  servedSeconds_ += runtime_.now() - t0;
 }
 
 void FrameAssembly::deliver(par::Pe& pe, RegionFramebuffer&& region) {

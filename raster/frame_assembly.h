@@ -91,6 +91,8 @@ class FrameAssembly {
   // all its regions in one task calls this between them; otherwise every other PE's regions
   // would stay in flight (and their buffers out of the pool, out of cache) until it is done.
   void serve(par::Pe& pe);
+  // Seconds the assembler has spent in serve() so far (read on the assembler only).
+  double servedSeconds() const { return servedSeconds_; }
 
  private:
   void store(RegionFramebuffer&& region);
@@ -99,6 +101,7 @@ class FrameAssembly {
   RegionFramebuffer& frame_;
   RegionBufferPool& pool_;
   par::Channel<RegionFramebuffer> regions_;
+  double servedSeconds_ = 0.0;
 };
 
 }  // namespace pr::raster

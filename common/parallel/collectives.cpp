@@ -90,6 +90,8 @@ void mergeRankPart(RunRecord& into, const RunRecord& part, int first, int count,
       span.end += offset;
       into.timeline.push_back(span);
     }
+  for (const CellSpan& cell : part.cells)
+    if (mine(cell.pe)) into.cells.push_back(cell);
   // A rank's counters for its own PEs are the ones it measured: whatever rank 0 booked for
   // them (code run on every rank may add a figure for every PE) is replaced, 0 where the rank
   // has no such counter.

@@ -78,12 +78,22 @@ struct StageRecord {
   // What the owners alone cannot say (at P = 1 every owner-pinned stage has owners {0}): one
   // of the kinds below, or empty for a stage run under a schedule or pinned by a method's split.
   std::string kind;
+  // A stage whose PEs' work is made of cells (RunRecord::cells), dealt to PEs by a rule that is
+  // a function of P: the rule (cell_split.h), or empty; how many cells there are (a
+  // cell without work has no entry); and the PE that every cell's result goes to (-1: none),
+  // which records its storing of other PEs' results as kCollectCell.
+  std::string cellSplit;
+  int cellCount = 0;
+  int cellCollector = -1;
 };
 
 // Runtime::runOnEachPe: one task per PE, owner-local work that divides among the owners.
 inline constexpr const char* kEachPeStage = "each PE";
 // Runtime::runOnOnePe and runOncePerRank: work done once (on each rank), whatever P.
 inline constexpr const char* kOnePeStage = "one PE";
+// Runtime::runOnEachPeInFull: one task per PE, each doing work that does not shrink with P (a
+// full-screen buffer of its own to clear).
+inline constexpr const char* kEachPeInFullStage = "each PE in full";
 
 // One task on one PE, or with task = kMessageSpan one message handler, with task = kSetupSpan
 // the PE's set-up at the start of a stage (Runtime::runStage with a SetupFn).
@@ -109,6 +119,20 @@ struct CounterRecord {
   std::vector<double> perPe;  // one value per PE
 };
 
+// Part of one task's work on one PE: a cell of the stage's split (a screen tile), measured so
+// the simulator can deal the cells again at another P (stage_replay.h); resultBytes is what
+// the cell's result sends to the collector when the cell's PE is not the collector. With cell
+// = kCollectCell: the collector storing other PEs' results inside its task, resultBytes the
+// bytes stored.
+inline constexpr int kCollectCell = -1;
+struct CellSpan {
+  int pe = 0;
+  int stage = 0;  // index into RunRecord::stages
+  int cell = 0;
+  double seconds = 0.0;
+  std::uint64_t resultBytes = 0;
+};
+
 struct RunRecord {
   int pes = 1;
   // The processes the PEs ran in: PEs [r * pes / ranks, (r + 1) * pes / ranks) on rank r.
@@ -118,6 +142,7 @@ struct RunRecord {
   double wallSeconds = 0.0;  // first stage start to last stage end
   std::vector<StageRecord> stages;
   std::vector<TaskSpan> timeline;
+  std::vector<CellSpan> cells;  // only for stages with a cellSplit
   std::vector<CounterRecord> counters;  // in the order first recorded
   std::string error;  // the error that ended the run, empty when it completed
   // A farm run (farm/farm.h): its servers and jobs. Its PEs are then the servers, one per rank.

@@ -11,6 +11,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/farm/farm_record_json.h"
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
@@ -130,6 +131,11 @@ json toJson(const RunRecord& record) {
     }
     if (!s.owners.empty()) js["owners"] = s.owners;  // owner-pinned stages: the PE of each task
     if (!s.kind.empty()) js["kind"] = s.kind;
+    if (!s.cellSplit.empty()) {
+      js["cellSplit"] = s.cellSplit;
+      js["cellCount"] = s.cellCount;
+      js["cellCollector"] = s.cellCollector;
+    }
     stages.push_back(js);
   }
   j["stages"] = stages;
@@ -137,6 +143,11 @@ json toJson(const RunRecord& record) {
   for (const TaskSpan& t : record.timeline)
     timeline.push_back({t.pe, t.stage, t.task, t.start, t.end, t.messagesSent, t.bytesSent, t.waitSeconds});
   j["timeline"] = timeline;
+  if (!record.cells.empty()) {
+    json cells = json::array();
+    for (const CellSpan& c : record.cells) cells.push_back({c.pe, c.stage, c.cell, c.seconds, c.resultBytes});
+    j["cells"] = cells;  // [pe, stage, cell, seconds, resultBytes]
+  }
   json counters = json::array();
   for (const CounterRecord& c : record.counters) counters.push_back({{"name", c.name}, {"perPe", c.perPe}});
   j["counters"] = counters;
@@ -403,9 +414,21 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
     if (!s.owners.empty() && s.owners.size() != s.tasks.size())
       throw InputError(origin + ": " + where + " \"owners\" must name one PE per task");
     s.kind = js.value("kind", std::string());  // optional: records written before stages had kinds
-    if (!s.kind.empty() && s.kind != kEachPeStage && s.kind != kOnePeStage)
-      throw InputError(origin + ": " + where + " \"kind\" must be \"" + kEachPeStage + "\" or \"" + kOnePeStage + "\", not \"" +
-                       s.kind + "\"");
+    if (!s.kind.empty() && s.kind != kEachPeStage && s.kind != kOnePeStage && s.kind != kEachPeInFullStage)
+      throw InputError(origin + ": " + where + " \"kind\" must be \"" + kEachPeStage + "\", \"" + kEachPeInFullStage + "\" or \"" +
+                       kOnePeStage + "\", not \"" + s.kind + "\"");
+    s.cellSplit = js.value("cellSplit", std::string());  // optional: only stages made of cells
+    if (!s.cellSplit.empty() && !isCellSplit(s.cellSplit))
+      throw InputError(origin + ": " + where + " \"cellSplit\" must be \"" + kRoundRobinCells + "\" or \"" + kStripCells +
+                       "\", not \"" + s.cellSplit + "\"");
+    if (!s.cellSplit.empty()) {
+      s.cellCount = numberAs<int>(field<json>(js, "cellCount", origin, where), origin + ": " + where + " cellCount");
+      if (s.cellCount < 1) throw InputError(origin + ": " + where + " \"cellCount\" must be at least 1");
+      s.cellCollector = numberAs<int>(field<json>(js, "cellCollector", origin, where), origin + ": " + where + " cellCollector");
+      if (s.cellCollector < -1 || s.cellCollector >= record.pes)
+        throw InputError(origin + ": " + where + " \"cellCollector\" must be -1 or one of the " + std::to_string(record.pes) +
+                         " PEs");
+    }
     record.stages.push_back(std::move(s));
   }
   const json timeline = field<json>(j, "timeline", origin, top);
@@ -427,6 +450,18 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
         span.task >= static_cast<TaskId>(record.stages[span.stage].tasks.size()))
       throw InputError(origin + ": \"timeline\" span names a PE, stage or task the record does not have");
     record.timeline.push_back(span);
+  }
+  // Optional: only runs with stages made of cells have them.
+  for (const json& jc : j.value("cells", json::array())) {
+    if (!jc.is_array() || jc.size() != 5) throw InputError(origin + ": \"cells\" entries must be [pe, stage, cell, seconds, resultBytes]");
+    const std::string what = origin + ": cell";
+    const CellSpan c{numberAs<int>(jc[0], what + " pe"), numberAs<int>(jc[1], what + " stage"), numberAs<int>(jc[2], what + " cell"),
+                     numberAs<double>(jc[3], what + " seconds"), numberAs<std::uint64_t>(jc[4], what + " resultBytes")};
+    if (c.stage < 0 || c.stage >= static_cast<int>(record.stages.size()) || record.stages[c.stage].cellSplit.empty() ||
+        c.pe < 0 || c.pe >= record.pes || c.cell < kCollectCell || c.cell >= record.stages[c.stage].cellCount ||
+        !(c.seconds >= 0.0))
+      throw InputError(origin + ": a \"cells\" entry names a PE, stage or cell the record does not have, or a negative time");
+    record.cells.push_back(c);
   }
   // Optional: records written before counters existed have none.
   for (const json& jc : j.value("counters", json::array())) {

@@ -8,6 +8,7 @@
 #include <condition_variable>
 #include <thread>
 
+#include "common/parallel/cell_split.h"
 #include "common/util/error.h"
 
 namespace pr::par {
@@ -41,6 +42,7 @@ Runtime::Runtime(RuntimeOptions options) : options_(std::move(options)), epoch_(
   pairBytes_ = std::vector<std::atomic<std::uint64_t>>(static_cast<std::size_t>(p) * p);
   for (int i = 0; i < p; ++i) bells_.push_back(std::make_unique<Doorbell>());
   spans_.resize(p);
+  cells_.resize(p);
   record_.pes = p;
   record_.ranks = ranks_;
   record_.schedule = options_.schedule;
@@ -118,6 +120,11 @@ void Runtime::runOnEachPe(std::string_view name, const std::function<void(Pe&)>&
   record_.stages.back().kind = kEachPeStage;
 }
 
+void Runtime::runOnEachPeInFull(std::string_view name, const std::function<void(Pe&)>& work) {
+  runOnEachPe(name, work);
+  record_.stages.back().kind = kEachPeInFullStage;
+}
+
 void Runtime::runOncePerRank(std::string_view name, const std::function<void(Pe&)>& work) {
   std::vector<int> owner;
   for (int r = 0; r < ranks_; ++r) owner.push_back(r * localPes_);
@@ -145,6 +152,25 @@ void Runtime::recordBroadcastWithinRanks(std::size_t bytes) {
 void Runtime::recordReplicated(std::size_t bytes) {
   PR_CHECK(!inStage_, "recordReplicated is called between stages");
   pendingBroadcasts_.push_back({bytes, 0, PendingBroadcast::To::WithinRanksReplicated});
+}
+
+void Runtime::recordCell(const Pe& pe, int cell, double seconds, std::uint64_t resultBytes) {
+  PR_CHECK(cell >= kCollectCell, "recordCell: cell " + std::to_string(cell));
+  if (options_.recordTimeline) cells_[pe.id()].push_back({pe.id(), pe.stage(), cell, std::max(0.0, seconds), resultBytes});
+}
+
+void Runtime::describeCells(std::string_view split, int cells, int collector) {
+  PR_CHECK(!inStage_ && !record_.stages.empty(), "describeCells is called after the stage it describes");
+  PR_CHECK(isCellSplit(split), "describeCells: unknown split '" + std::string(split) + "'");
+  PR_CHECK(cells > 0 && collector >= -1 && collector < options_.pes,
+           "describeCells: " + std::to_string(cells) + " cells, collector " + std::to_string(collector));
+  StageRecord& stage = record_.stages.back();
+  stage.cellSplit = std::string(split);
+  stage.cellCount = cells;
+  stage.cellCollector = collector;
+  const int index = static_cast<int>(record_.stages.size()) - 1;
+  for (const CellSpan& c : record_.cells)
+    PR_CHECK(c.stage != index || c.cell < cells, "describeCells: cell " + std::to_string(c.cell) + " of " + std::to_string(cells));
 }
 
 void Runtime::addCounter(std::string_view name, int pe, double value) {
@@ -393,6 +419,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   for (auto& a : pairBytes_) a.store(0, std::memory_order_relaxed);
   for (auto& bell : bells_) bell->rung = false;
   for (auto& s : spans_) s.clear();
+  for (auto& c : cells_) c.clear();
   abort_.store(false);
   error_ = nullptr;
   // Every task and every PE's set-up is outstanding work until it returns (termination.h);
@@ -501,6 +528,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   pendingBroadcasts_.clear();
   record_.stages.push_back(std::move(sr));
   for (auto& s : spans_) record_.timeline.insert(record_.timeline.end(), s.begin(), s.end());
+  for (auto& c : cells_) record_.cells.insert(record_.cells.end(), c.begin(), c.end());
   record_.wallSeconds = end - record_.stages.front().startSeconds;
 
   if (error_) std::rethrow_exception(error_);

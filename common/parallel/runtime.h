@@ -168,6 +168,10 @@ class Runtime {
   // One task on each PE, task p on PE p: owner-local work (build my BVHs, clear my buffers,
   // composite my rectangle) that no other PE may do for it (shared/DESIGN.md rule 1).
   void runOnEachPe(std::string_view name, const std::function<void(Pe&)>& work);
+  // The same for work each PE does in full whatever P (clear my full-screen buffer): the record
+  // says so (kEachPeInFullStage), and the simulator gives every PE at another P the recorded
+  // mean instead of splitting the total.
+  void runOnEachPeInFull(std::string_view name, const std::function<void(Pe&)>& work);
   // One task on the first PE of every rank (PE 0 alone on one rank): work each rank does for
   // itself from what it already holds (the world BVH from the scene every rank loaded), a
   // replicated computation the record shows on each rank's first PE, not a transfer.
@@ -190,6 +194,15 @@ class Runtime {
   // first PE as a replicated copy (PeStageRecord::replicatedBytes), not traffic. So a P = R x T
   // run books P - 1 copies whatever R: broadcasts within ranks, replicated between them.
   void recordReplicated(std::size_t bytes);
+
+  // A stage whose PEs' work is made of cells dealt by a rule that depends on P (cell_split.h:
+  // static screen tiles dealt round-robin, rows in strips): inside its tasks each PE records
+  // each cell's seconds and what the cell's result sends to the collector (kCollectCell: the
+  // collector's storing of others' results), and after it describeCells names the rule, the
+  // number of cells and the collector (-1: none), so the simulator can deal the cells again at
+  // another P (stage_replay.h). Kept with the timeline only.
+  void recordCell(const Pe& pe, int cell, double seconds, std::uint64_t resultBytes);
+  void describeCells(std::string_view split, int cells, int collector);
 
   // Adds value to the named per-PE counter (created at zero for every PE on first use).
   // Thread-safe: callable from tasks, handlers or the controlling thread.
@@ -297,6 +310,7 @@ class Runtime {
   std::vector<std::atomic<std::uint64_t>> pairMessages_, pairBytes_;  // P x P, row = sender
   std::vector<std::unique_ptr<Doorbell>> bells_;
   std::vector<std::vector<TaskSpan>> spans_;
+  std::vector<std::vector<CellSpan>> cells_;  // per PE, this stage's (recordCell)
   OutstandingWork outstanding_;
   std::atomic<bool> abort_{false};
   bool inStage_ = false;

@@ -136,6 +136,26 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
     if (seenCount != n)
       throw InputError(origin + ": stage '" + sr.name + "' has " + std::to_string(n) + " tasks but the timeline has spans for " +
                        std::to_string(seenCount) + " (record the run with its timeline)");
+    stage.cellSplit = sr.cellSplit;
+    stage.cellCollector = sr.cellCollector;
+    if (!sr.cellSplit.empty()) {
+      stage.cellCosts.assign(static_cast<std::size_t>(sr.cellCount), 0.0);
+      stage.cellBytes.assign(stage.cellCosts.size(), 0);
+    }
+    bool anyCell = false;
+    for (const CellSpan& c : record.cells) {
+      if (c.stage != static_cast<int>(s)) continue;
+      anyCell = true;
+      if (c.cell == kCollectCell) {
+        stage.collectInTaskSeconds += c.seconds;
+        continue;
+      }
+      stage.cellCosts[c.cell] += c.seconds;
+      stage.cellBytes[c.cell] = c.resultBytes;
+      if (c.pe != stage.cellCollector) stage.collectedCells += 1, stage.collectedBytes += c.resultBytes;
+    }
+    if (!stage.cellSplit.empty() && !anyCell)
+      throw InputError(origin + ": stage '" + sr.name + "' is made of cells but the record has none (record the run with its timeline)");
     w.stages.push_back(std::move(stage));
   }
   if (w.stages.empty()) throw InputError(origin + ": the run record has no stages");

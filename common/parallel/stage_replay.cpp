@@ -7,6 +7,7 @@
 #include <numeric>
 #include <utility>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/schedulers/scheduler.h"
 #include "common/util/error.h"
 
@@ -16,6 +17,8 @@ std::string_view replayRuleName(ReplayRule rule) {
   switch (rule) {
     case ReplayRule::Scheduled: return "scheduled";
     case ReplayRule::AsRecorded: return "as recorded";
+    case ReplayRule::Cells: return "cells";
+    case ReplayRule::EachPeInFull: return "each PE in full";
     case ReplayRule::EachPe: return "each PE";
     case ReplayRule::RoundRobin: return "round-robin";
     case ReplayRule::SingleOwner: return "single owner";
@@ -71,6 +74,68 @@ std::string seconds(double s) {
   return text;
 }
 
+// The cells rule (stage_replay.h): the recorded cells dealt round-robin over `pes` owners.
+StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay r) {
+  r.rule = ReplayRule::Cells;
+  const std::size_t cells = stage.cellCosts.size();
+  const double total = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0);
+  const double inCells = std::accumulate(stage.cellCosts.begin(), stage.cellCosts.end(), 0.0);
+  const double rest = std::max(0.0, total - inCells - stage.collectInTaskSeconds);
+  // The collector's storing of results: inside its tasks and in its handlers, per stored byte.
+  const int recordedCollector = stage.cellCollector;
+  double collectSeconds = stage.collectInTaskSeconds;
+  std::vector<PeLoad> handlers = stage.handlers;
+  if (recordedCollector >= 0 && static_cast<std::size_t>(recordedCollector) < handlers.size())
+    collectSeconds += std::exchange(handlers[recordedCollector], PeLoad{}).seconds;
+  const double perByte = stage.collectedBytes > 0 ? collectSeconds / double(stage.collectedBytes) : 0.0;
+  r.handlers = perPeAt(handlers, recordedPes, pes);
+  const int collector = recordedCollector < 0 ? -1 : recordedCollector < pes ? recordedCollector : 0;
+
+  std::uint64_t taskMessages = 0, taskBytes = 0;
+  for (std::uint32_t m : stage.messages) taskMessages += m;
+  for (std::uint64_t b : stage.bytes) taskBytes += b;
+  const std::uint64_t otherMessages = taskMessages > stage.collectedCells ? taskMessages - stage.collectedCells : 0;
+  const std::uint64_t otherBytes = taskBytes > stage.collectedBytes ? taskBytes - stage.collectedBytes : 0;
+
+  const std::size_t n = static_cast<std::size_t>(pes);
+  r.stage.tasks = TaskSet::uniform(n);
+  r.stage.costs.assign(n, rest / pes);
+  r.stage.messages.assign(n, 0);
+  r.stage.bytes.assign(n, 0);
+  r.stage.owners.resize(n);
+  std::uint64_t results = 0, resultBytes = 0;
+  double largest = 0.0;
+  for (std::size_t c = 0; c < cells; ++c) {
+    const int owner = cellOwner(stage.cellSplit, static_cast<int>(c), static_cast<int>(cells), pes);
+    r.stage.costs[owner] += stage.cellCosts[c];
+    largest = std::max(largest, stage.cellCosts[c]);
+    if (owner != collector && collector >= 0) {
+      r.stage.messages[owner] += 1;
+      r.stage.bytes[owner] += stage.cellBytes[c];
+      results += 1;
+      resultBytes += stage.cellBytes[c];
+    }
+  }
+  if (collector >= 0) r.stage.costs[collector] += perByte * double(resultBytes);
+  for (int p = 0; p < pes; ++p) {
+    r.stage.owners[p] = p;
+    r.stage.messages[p] += static_cast<std::uint32_t>(evenShare(otherMessages, pes, p));
+    r.stage.bytes[p] += evenShare(otherBytes, pes, p);
+  }
+  r.note = std::to_string(cells) + " cells (" + seconds(inCells) + ", the largest " + seconds(largest) + ") dealt " +
+           (stage.cellSplit == kStripCells ? std::string("in strips") : stage.cellSplit) + " over " + std::to_string(pes) +
+           " owners; " + seconds(rest) +
+           " of other per-PE work split evenly (assumes it divides evenly)";
+  if (collector >= 0 && results == 0) r.note += "; every cell on the collector, PE " + std::to_string(collector) + ": no result sent";
+  if (collector >= 0 && results > 0) {
+    r.note += "; " + std::to_string(results) + " results (" + std::to_string(resultBytes) + " bytes) to PE " +
+              std::to_string(collector);
+    r.note += stage.collectedBytes > 0 ? ", stored at the record's " + seconds(perByte * 1e6) + " per MB"
+                                       : ", their storing not charged (the record has no result from another PE to time it by)";
+  }
+  return r;
+}
+
 }  // namespace
 
 namespace {
@@ -117,6 +182,22 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
   if (pes == recordedPes) {
     r.rule = ReplayRule::AsRecorded;
     r.note = "owners as recorded";
+    return r;
+  }
+  if (!stage.cellSplit.empty() && stage.kind == kEachPeStage && isEachPe(owners, recordedPes))
+    return cellsAt(stage, recordedPes, pes, std::move(r));
+  if (stage.kind == kEachPeInFullStage && isEachPe(owners, recordedPes)) {
+    // Every PE does the work whole at any P: P' tasks of the recorded mean.
+    r.rule = ReplayRule::EachPeInFull;
+    const double mean = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0) / double(std::max<std::size_t>(n, 1));
+    r.stage.tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
+    r.stage.costs.assign(static_cast<std::size_t>(pes), mean);
+    r.stage.messages.assign(static_cast<std::size_t>(pes), 0);
+    r.stage.bytes.assign(static_cast<std::size_t>(pes), 0);
+    r.stage.owners.resize(static_cast<std::size_t>(pes));
+    for (int p = 0; p < pes; ++p) r.stage.owners[p] = p;
+    r.note = "one task per PE, each doing the work in full: the recorded mean, " + seconds(mean) + ", on each of " +
+             std::to_string(pes) + " PEs (an upper bound where the work shrinks with the PE's share)";
     return r;
   }
   if (stage.kind == kOnePeStage && n > 0) {

@@ -5,6 +5,17 @@
 // the method would split its data at P', from what the record holds:
 //
 //   as recorded   P' = the recorded P: the recorded owners and task costs.
+//   cells         a stage whose PEs' work is made of cells dealt by a rule of P (cell_split.h:
+//                 screen tiles dealt round-robin, rows in strips): the cells are dealt again at P',
+//                 each with its measured seconds; the rest of the PEs' work (binning, geometry
+//                 of what a PE draws) is split evenly, as each PE's. Every cell off the
+//                 collector sends its result there (its recorded bytes), and the collector
+//                 stores it at the record's seconds per byte of stored results (none known from
+//                 a record in which every cell was on the collector: then not charged, and the
+//                 note says so).
+//   each PE in full  a stage the record names "each PE in full" (a full-screen buffer each PE
+//                 clears): P' tasks, each the recorded mean (an upper bound where the work
+//                 shrinks with the PE's share).
 //   each PE       owners 0..P-1, one task per PE (build my BVHs, clear my buffers, composite my
 //                 rectangle): P' tasks of total/P' each. Assumes the work divides evenly over
 //                 owners, as the cost-balanced voxel and object splits and the strip regions
@@ -44,8 +55,9 @@
 
 namespace pr::par {
 
-enum class ReplayRule { Scheduled, AsRecorded, EachPe, RoundRobin, SingleOwner, OnePe, Excluded };
-// "scheduled", "as recorded", "each PE", "round-robin", "single owner", "one PE", "excluded".
+enum class ReplayRule { Scheduled, AsRecorded, Cells, EachPeInFull, EachPe, RoundRobin, SingleOwner, OnePe, Excluded };
+// "scheduled", "as recorded", "cells", "each PE in full", "each PE", "round-robin", "single owner",
+// "one PE", "excluded".
 std::string_view replayRuleName(ReplayRule rule);
 
 struct StageReplay {

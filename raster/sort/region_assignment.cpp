@@ -56,6 +56,8 @@ RegionGrid::RegionGrid(int width, int height, RegionStrategy strategy, int tileS
       dealt[size_t(to)] += 1.0;
       owner_.push_back(to);
     }
+    roundRobin_ = !dynamic_;
+    for (size_t i = 0; i < owner_.size() && roundRobin_; ++i) roundRobin_ = owner_[i] == static_cast<int>(i % size_t(pes));
   }
 }
 

@@ -45,6 +45,9 @@ class RegionGrid {
   int owner(int r) const { return owner_[r]; }
   const std::vector<int>& owners() const { return owner_; }
   bool dynamic() const { return dynamic_; }
+  // Static tiles dealt round-robin (equal shares): tile r on PE r mod P, a split the simulator
+  // can make again at any P from the tiles' measured costs (par::kRoundRobinCells).
+  bool roundRobin() const { return roundRobin_; }
   // Regions of PE pe, in row-major order.
   std::vector<int> regionsOf(int pe) const;
 
@@ -74,6 +77,7 @@ class RegionGrid {
 
   Rect screen_;
   bool dynamic_ = false;
+  bool roundRobin_ = false;
   std::vector<int> xs_, ys_;  // cell boundaries, first 0, last width/height
   std::vector<Rect> regions_;
   std::vector<int> owner_;

@@ -23,6 +23,7 @@
 #include <optional>
 #include <span>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/channel.h"
 #include "common/parallel/per_pe.h"
 #include "common/scene/poisoned_view.h"
@@ -223,6 +224,7 @@ class SortFirst : public SortPoint {
       next[p] = merged(unseen[p], mine, boundsOfPieces(mine, tris));
       drawers_[p].draw(pe, shadingOf(p, ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
+    if (grid.roundRobin()) rt.describeCells(par::kRoundRobinCells, grid.regionCount(), kAssemblerPe);
 
     held_ = std::move(next);
     previous_.emplace(Previous{f.view, grid});

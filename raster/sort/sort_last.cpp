@@ -18,6 +18,7 @@
 // where a pixel's triangle is more often another PE's, above near terrain).
 #include <algorithm>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/per_pe.h"
 #include "common/util/error.h"
 
@@ -58,7 +59,7 @@ class SortLast : public SortPoint {
     buffers_.resize(pes);
     drawn_.resize(pes);
     pe_.resize(pes);
-    rt.runOnEachPe("sort-last clear", [&](par::Pe& pe) {
+    rt.runOnEachPeInFull("sort-last clear", [&](par::Pe& pe) {
       RegionFramebuffer& mine = buffers_[pe.id()];
       PeFrame& state = pe_[pe.id()];
       if (mine.rect() == screen) {
@@ -99,8 +100,13 @@ class SortLast : public SortPoint {
     rt.sumAcrossRanks(rowCost_);  // a rank holds its own PEs' costs: every rank cuts the same strips
     const std::vector<Rect> regions = compositor->composite(rt, buffers, drawn_, f.options.sparse, rowCost_);
 
-    // Stage 3, shading of the visible fragments of each PE's region, in its own buffer.
+    // Stage 3, shading of the visible fragments of each PE's region, in its own buffer. Where
+    // the regions are strips of equal height (direct-send's first frame), each screen row is a
+    // cell the simulator can cut into strips again at another P: its share of the PE's measured
+    // time in proportion to its work (its covered pixels and recomputed triangles).
+    const bool rowCells = equalStrips(regions, f.view.width, f.view.height);
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
+      const double t0 = rt.now();
       PeFrame& state = pe_[pe.id()];
       state.shade = ShadeCounters{};
       state.rowCost.assign(size_t(f.view.height), 0.0);
@@ -110,7 +116,9 @@ class SortLast : public SortPoint {
       PixelWindow pixels = buffers[pe.id()].window(visible);
       adoptForeignFragments(f, pixels, state.tris, state.adopted, state.rowCost);
       shadeRegion(ctx, state.tris, pixels, &state.shade);
+      if (rowCells) recordRowCells(rt, pe, visible, state.rowCost, rt.now() - t0);
     });
+    if (rowCells) rt.describeCells(par::kStripCells, f.view.height, -1);
 
     // Each PE delivers the rectangle it composited to the assembler (in place on PE 0).
     FrameAssembly frame(rt, image, pool_);
@@ -175,6 +183,25 @@ class SortLast : public SortPoint {
       }
       rowCost[size_t(y)] = double(covered) + kRecomputedTriangleCost * double(recomputed);
     }
+  }
+
+  // Whether the compositor's regions are the strips of equal height stripRegions cuts (PEs
+  // beyond the screen's rows owning nothing): the rule par::kStripCells deals rows by.
+  static bool equalStrips(const std::vector<Rect>& regions, int width, int height) {
+    const std::vector<Rect> strips = stripRegions(width, height, static_cast<int>(regions.size()));
+    for (size_t p = 0; p < regions.size(); ++p)
+      if (regions[p] != (p < strips.size() ? strips[p] : Rect{})) return false;
+    return true;
+  }
+
+  // The rows of `visible` as cells: the PE's measured seconds shared out by each row's work.
+  static void recordRowCells(par::Runtime& rt, const par::Pe& pe, const Rect& visible, const std::vector<double>& rowCost,
+                             double seconds) {
+    double total = 0.0;
+    for (int y = visible.y0; y < visible.y1; ++y) total += rowCost[size_t(y)];
+    if (!(total > 0.0)) return;
+    for (int y = visible.y0; y < visible.y1; ++y)
+      if (rowCost[size_t(y)] > 0.0) rt.recordCell(pe, y, seconds * rowCost[size_t(y)] / total, 0);
   }
 
   // What a PE writes while it renders and shades, kept between frames.

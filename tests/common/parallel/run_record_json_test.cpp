@@ -4,9 +4,11 @@
 
 #include <nlohmann/json.hpp>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/channel.h"
 #include "common/parallel/metrics.h"
 #include "common/parallel/run_record.h"
+#include "common/parallel/simulator.h"
 #include "common/util/error.h"
 
 using namespace pr::par;
@@ -198,4 +200,45 @@ TEST_CASE("RunRecord: a span's waiting survives JSON, a record without it reads 
   CHECK_THROWS_AS(
       runRecordFromJsonText(R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"kind":"sideways"}],"timeline":[]})", "bad"),
       pr::InputError);
+}
+
+TEST_CASE("RunRecord: a stage's cells come from recordCell, survive JSON, and are refused where the stage has no cell split") {
+  Runtime rt(2, "demand");
+  rt.runOnEachPe("draw", [&](Pe& pe) {
+    for (int tile = pe.id(); tile < 5; tile += 2) rt.recordCell(pe, tile, 0.001 * (tile + 1), 100u * (tile + 1));
+    if (pe.id() == 0) rt.recordCell(pe, kCollectCell, 0.002, 0);
+  });
+  rt.describeCells(kRoundRobinCells, 5, 0);
+  const RunRecord a = rt.record();
+  CHECK(a.stages[0].cellSplit == kRoundRobinCells);
+  CHECK(a.stages[0].cellCollector == 0);
+  CHECK(a.stages[0].cellCount == 5);
+  REQUIRE(a.cells.size() == 6);
+  const RunRecord b = runRecordFromJsonText(toJsonText(a), "test");
+  CHECK(b.stages[0].cellSplit == kRoundRobinCells);
+  CHECK(b.stages[0].cellCollector == 0);
+  CHECK(b.stages[0].cellCount == 5);
+  REQUIRE(b.cells.size() == 6);
+  for (std::size_t i = 0; i < a.cells.size(); ++i) {
+    CHECK(b.cells[i].pe == a.cells[i].pe);
+    CHECK(b.cells[i].cell == a.cells[i].cell);
+    CHECK(b.cells[i].seconds == a.cells[i].seconds);
+    CHECK(b.cells[i].resultBytes == a.cells[i].resultBytes);
+  }
+  // The simulator reads them as the stage's cells: tiles 1 and 3 were off the collector.
+  const Workload w = workloadFromRecord(b, "test");
+  CHECK(w.stages[0].cellCosts.size() == 5);
+  CHECK(w.stages[0].cellCosts[4] == doctest::Approx(0.005));
+  CHECK(w.stages[0].collectedCells == 2);
+  CHECK(w.stages[0].collectedBytes == 200 + 400);
+  CHECK(w.stages[0].collectInTaskSeconds == doctest::Approx(0.002));
+  const std::string head = R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]]}],"timeline":[],"cells":)";
+  CHECK_THROWS_AS(runRecordFromJsonText(head + "[[0,0,0,0.1,10]]}", "no split"), pr::InputError);
+  const std::string split = R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"cellSplit":)";
+  CHECK_THROWS_AS(runRecordFromJsonText(split + R"("spiral","cellCount":2,"cellCollector":0}],"timeline":[]})", "bad"), pr::InputError);
+  CHECK_THROWS_AS(runRecordFromJsonText(split + R"("strips","cellCount":0,"cellCollector":0}],"timeline":[]})", "bad"), pr::InputError);
+  // A cell beyond the stage's count is refused; one within it is read.
+  const std::string strips = split + R"("strips","cellCount":2,"cellCollector":-1}],"timeline":[],"cells":)";
+  CHECK(runRecordFromJsonText(strips + "[[0,0,1,0.1,0]]}", "good").cells.size() == 1);
+  CHECK_THROWS_AS(runRecordFromJsonText(strips + "[[0,0,2,0.1,0]]}", "bad"), pr::InputError);
 }

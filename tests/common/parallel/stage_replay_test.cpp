@@ -4,6 +4,7 @@
 // makespans on the zero-cost network.
 #include <doctest/doctest.h>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/simulator.h"
 #include "common/parallel/stage_replay.h"
 #include "common/util/error.h"
@@ -218,4 +219,100 @@ TEST_CASE("StageReplay: on one PE no data message is charged, the work stays") {
   CHECK(r.stages[0].pes[0].messagesSent == 0);
   CHECK(r.wallSeconds == doctest::Approx(2 * 2.0 + 3.0));  // 2 tasks, each a request and a packet of 1 s; 3 s of work
   CHECK(planReplay(s, 2, 3, "").stage.messages == std::vector<std::uint32_t>{2, 0});  // kept at P > 1
+}
+
+namespace {
+
+// Four screen tiles dealt round-robin, recorded at P = 1: one task of 1 s on PE 0, of which the
+// tiles took 0.4, 0.1, 0.1 and 0.1 s (each result 1000 bytes) and 0.3 s was other work.
+SimStage tiledStage() {
+  SimStage s = pinnedStage("rasterize", {1.0}, {0});
+  s.kind = kEachPeStage;
+  s.cellSplit = kRoundRobinCells;
+  s.cellCollector = 0;
+  s.cellCosts = {0.4, 0.1, 0.1, 0.1};
+  s.cellBytes = {1000, 1000, 1000, 1000};
+  return s;
+}
+
+}  // namespace
+
+TEST_CASE("StageReplay: cells dealt round-robin are dealt again at P' from their own costs") {
+  const Workload w = recordedWorkload({tiledStage()}, 1);
+  // P = 2: PE 0 tiles 0 and 2 (0.5 s), PE 1 tiles 1 and 3 (0.2 s), each 0.15 s of the rest:
+  // 0.65 s, where splitting the stage evenly would say 0.5 s.
+  const Prediction two = predict(w, "", at(2));
+  CHECK(two.stages[0].rule == "cells");
+  CHECK(two.stages[0].note.find("4 cells (0.7 s, the largest 0.4 s) dealt round-robin over 2 owners") != std::string::npos);
+  CHECK(two.stages[0].note.find("not charged") != std::string::npos);  // no result from another PE in a P = 1 record
+  CHECK(two.record.wallSeconds == doctest::Approx(0.65));
+  CHECK(two.record.stages[0].pes[1].busySeconds == doctest::Approx(0.35));
+  // PE 1's two tiles go to the collector, PE 0 sends nothing.
+  CHECK(two.record.stages[0].pes[0].messagesSent == 0);
+  CHECK(two.record.stages[0].pes[1].messagesSent == 2);
+  CHECK(two.record.stages[0].pes[1].bytesSent == 2000);
+  // P = 8: four PEs have a tile each, the slowest 0.4 s; the rest is 0.3 / 8 s per PE.
+  const Prediction eight = predict(w, "", at(8));
+  CHECK(eight.record.wallSeconds == doctest::Approx(0.4 + 0.3 / 8));
+  CHECK(eight.record.stages[0].pes[7].busySeconds == doctest::Approx(0.3 / 8));
+}
+
+TEST_CASE("StageReplay: the collector stores other PEs' results at the recorded time per byte") {
+  // Recorded at P = 2: tiles 1 and 3 (1000 bytes each) were drawn on PE 1 and stored by PE 0
+  // in 0.01 s inside its task and 0.01 s in its handlers: 1e-5 s per byte.
+  SimStage s = tiledStage();
+  s.owners = {0, 1};
+  s.costs = {0.5 + 0.15 + 0.01, 0.2 + 0.15};
+  s.tasks = TaskSet::fromCosts(s.costs);
+  s.messages = {0, 2};
+  s.bytes = {0, 2000};
+  s.collectInTaskSeconds = 0.01;
+  s.collectedCells = 2;
+  s.collectedBytes = 2000;
+  s.handlers = {{0.01, 2, 0, 0}, {}};
+  const Workload w = recordedWorkload({s}, 2);
+  // P = 4: one tile per PE; PE 0 stores 3 results, 0.03 s; the rest 0.3 / 4 s each.
+  const Prediction four = predict(w, "", at(4));
+  CHECK(four.stages[0].rule == "cells");
+  CHECK(four.stages[0].note.find("3 results (3000 bytes) to PE 0") != std::string::npos);
+  CHECK(four.record.stages[0].pes[0].busySeconds == doctest::Approx(0.4 + 0.075 + 0.03));
+  CHECK(four.record.stages[0].pes[0].messagesHandled == 0);  // its handlers' storing is in the cells rule
+  // P = 1: every tile on the collector, nothing sent or stored: the tiles and the rest alone.
+  const Prediction one = predict(w, "", at(1));
+  CHECK(one.record.wallSeconds == doctest::Approx(0.7 + 0.3));
+  CHECK(one.record.stages[0].pes[0].messagesSent == 0);
+}
+
+TEST_CASE("StageReplay: rows in strips are cut into P' strips of equal height, PEs beyond the rows idle") {
+  // Six rows (1, 1, 1, 1, 4, 4 s) recorded on one PE, no collector. P = 2: rows 0-2 (3 s) and
+  // 3-5 (9 s); P = 3: 2, 2 and 8 s; P = 8: one row each on PEs 0-5, the slowest 4 s.
+  SimStage s = pinnedStage("shade", {12.0}, {0});
+  s.kind = kEachPeStage;
+  s.cellSplit = kStripCells;
+  s.cellCosts = {1, 1, 1, 1, 4, 4};
+  s.cellBytes.assign(6, 0);
+  const Workload w = recordedWorkload({s}, 1);
+  const Prediction two = predict(w, "", at(2));
+  CHECK(two.stages[0].rule == "cells");
+  CHECK(two.stages[0].note.find("dealt in strips over 2 owners") != std::string::npos);
+  CHECK(two.record.wallSeconds == doctest::Approx(9.0));
+  CHECK(predict(w, "", at(3)).record.wallSeconds == doctest::Approx(8.0));
+  const Prediction eight = predict(w, "", at(8));
+  CHECK(eight.record.wallSeconds == doctest::Approx(4.0));
+  CHECK(eight.record.stages[0].pes[7].busySeconds == 0.0);
+  CHECK(eight.record.stages[0].pes[0].messagesSent == 0);  // no collector: no result sent
+}
+
+TEST_CASE("StageReplay: work each PE does in full keeps its recorded mean at any P") {
+  // A full-screen buffer cleared on each of 2 PEs (1 s and 3 s): 2 s on every PE at P = 8 and
+  // at P = 1, where splitting the total would say 0.5 s and 4 s.
+  SimStage s = pinnedStage("clear", {1.0, 3.0}, {0, 1});
+  s.kind = kEachPeInFullStage;
+  const Workload w = recordedWorkload({s}, 2);
+  const Prediction eight = predict(w, "", at(8));
+  CHECK(eight.stages[0].rule == "each PE in full");
+  CHECK(eight.record.wallSeconds == doctest::Approx(2.0));
+  for (const PeStageRecord& pe : eight.record.stages[0].pes) CHECK(pe.busySeconds == doctest::Approx(2.0));
+  CHECK(predict(w, "", at(1)).record.wallSeconds == doctest::Approx(2.0));
+  CHECK(predict(w, "", at(2)).stages[0].rule == "as recorded");
 }

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include "common/parallel/cell_split.h"
 #include "common/util/error.h"
 #include "raster/sort/bins.h"
 #include "raster/sort/region_assignment.h"
@@ -66,6 +67,28 @@ TEST_CASE("RegionAssignment: static tiles are dealt in proportion to shares, int
   const std::vector<double> equal{2.0, 2.0, 2.0};
   RegionGrid same(50, 30, RegionStrategy::StaticTiles, 16, 3, equal);
   for (int r = 0; r < same.regionCount(); ++r) CHECK(same.owner(r) == r % 3);
+  // The simulator deals cells as c mod P (par::kRoundRobinCells): only such a grid says it is one.
+  CHECK(same.roundRobin());
+  CHECK_FALSE(tiles.roundRobin());
+  CHECK_FALSE(RegionGrid(50, 30, RegionStrategy::StaticStrips, 16, 3).roundRobin());
+  CHECK_FALSE(RegionGrid(50, 30, RegionStrategy::Dynamic, 16, 3).roundRobin());
+  for (int pes = 1; pes <= 9; ++pes) CHECK(RegionGrid(100, 70, RegionStrategy::StaticTiles, 16, pes).roundRobin());
+}
+
+TEST_CASE("RegionAssignment: the simulator's cell splits deal as the regions do") {
+  // Tiles dealt in equal shares are round-robin cells; strips of equal height are strip cells
+  // (rows), PEs beyond the rows owning none.
+  for (int pes = 1; pes <= 12; ++pes)
+    for (int height : {1, 5, 7, 16, 30}) {
+      CAPTURE(pes);
+      CAPTURE(height);
+      const RegionGrid tiles(40, height, RegionStrategy::StaticTiles, 4, pes);
+      for (int r = 0; r < tiles.regionCount(); ++r)
+        CHECK(par::cellOwner(par::kRoundRobinCells, r, tiles.regionCount(), pes) == tiles.owner(r));
+      const std::vector<Rect> strips = stripRegions(40, height, pes);
+      for (int s = 0; s < static_cast<int>(strips.size()); ++s)
+        for (int y = strips[s].y0; y < strips[s].y1; ++y) CHECK(par::cellOwner(par::kStripCells, y, height, pes) == s);
+    }
 }
 
 TEST_CASE("TileShares: a PE slower per tile gets a smaller share, and balanced times keep the shares") {
