@@ -271,7 +271,7 @@ class DataManager {
     a.held = T{};
     Runtime& rt = pe.runtime();
     ItemId arrived = 0;
-    waitUntil(pe, requests_, kWhat, [&] {
+    waitUntil(pe, kWhat, [&] {
       Reply reply;
       while (items_.tryReceive(pe, reply)) a.travelling.push_back(std::move(reply));
       auto ready = std::min_element(a.travelling.begin(), a.travelling.end(),
@@ -334,13 +334,13 @@ class DataManager {
   }
 
   inline static const std::string kWhat = "a data item";
-  Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, requests_, kWhat); }
+  Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, kWhat); }
 
   // The simulated latency of a reply already received: waits (serving requests, booked as
   // waiting) until it is usable.
   void waitUntilReady(Pe& pe, const Reply& reply) {
     Runtime& rt = pe.runtime();
-    waitUntil(pe, requests_, kWhat, [&] { return rt.now() >= reply.readyAt; });
+    waitUntil(pe, kWhat, [&] { return rt.now() >= reply.readyAt; });
   }
 
   OwnerMap owners_;

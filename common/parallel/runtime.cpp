@@ -310,6 +310,18 @@ std::optional<double> Runtime::timed(Pe& pe, TaskId task, std::vector<TaskSpan>&
   return t1 - t0;
 }
 
+bool Runtime::serveOne(Pe& pe) {
+  PR_CHECK(inStage_, "serveOne is called by a PE inside a task");
+  // channels_ changes only between stages, so a stage reads it without the lock.
+  for (ChannelBase* channel : channels_)
+    if (channel->pending(pe.id()) && channel->handleOne(pe)) {
+      pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+      outstanding_.done();  // the waiting task is still counted, so never the last unit
+      return true;
+    }
+  return false;
+}
+
 // Handles every message waiting for pe in the handled channels; true when it handled any.
 bool Runtime::handleMessages(Pe& pe, std::vector<TaskSpan>& spans) {
   bool any = false;

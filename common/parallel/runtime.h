@@ -25,7 +25,9 @@
 //
 // An exception thrown by a task, handler or set-up stops every PE at its next task boundary (a
 // set-up already running is not interrupted: the stage ends when it returns) and is rethrown (the first one, unchanged) by runStage; RunRecord::error names stage, PE and task.
-// P may exceed the core count: idle PEs block on a condition variable, they do not spin.
+// P may exceed the core count: idle PEs block on a condition variable, they do not spin. A PE
+// waiting inside a task for another PE's reply (await_reply.h) polls, serving the requests
+// addressed to it meanwhile, and yields its core between polls.
 // The PE threads live for the runtime's lifetime (started by the first stage): a stage costs a
 // wake-up and a barrier, not P thread creations (bench_runtime section 6).
 #pragma once
@@ -253,6 +255,10 @@ class Runtime {
   // what has arrived from other ranks into this rank's mailboxes (one thread at a time; the
   // others return at once). True when it did something; false on a runtime of one rank.
   bool pumpMessages() { return ranks_ > 1 && pumpRankStage(); }
+  // Inside a task on PE pe that waits for another PE: handles one message waiting for pe in
+  // any handled channel (the requests another waiting PE may need answered); true when it did.
+  // Part of the task's busy time, not a span of its own.
+  bool serveOne(Pe& pe);
 
  private:
   struct Doorbell;

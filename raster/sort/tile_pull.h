@@ -47,7 +47,7 @@ class TilePull {
     for (int p = 0; p < pes; ++p)
       if (p != pe.id()) requests_.send(pe, p, Request{tile, pe.id()});
     const std::string what = "'" + name_ + "': the bins of tile " + std::to_string(tile);
-    for (int got = 0; got < pes - 1; ++got) parts.push_back(par::awaitReply(pe, replies_, requests_, what));
+    for (int got = 0; got < pes - 1; ++got) parts.push_back(par::awaitReply(pe, replies_, what));
     return parts;
   }
 

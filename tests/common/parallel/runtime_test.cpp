@@ -252,12 +252,11 @@ TEST_CASE("Runtime: an exception in a set-up ends the stage and names the set-up
 TEST_CASE("Runtime: a task's span carries the time it waited inside, which its busy time leaves out and a replay does not repeat") {
   // PE 0's task waits until PE 1's task, after 40 ms of work begun once PE 0 waits, raises a flag.
   Runtime rt(2, "demand");
-  Channel<int> serving(rt, "serving", MessageKind::Requests, [](Pe&, int&&) {});
   std::atomic<bool> waiting{false}, raised{false};
   rt.runPinned("wait inside", TaskSet::uniform(2), {0, 1}, [&](Pe& pe, TaskId t) {
     if (t == 0) {
       waiting = true;
-      waitUntil(pe, serving, "the flag", [&] { return raised.load(); });
+      waitUntil(pe, "the flag", [&] { return raised.load(); });
     } else {
       while (!waiting) std::this_thread::yield();
       std::this_thread::sleep_for(std::chrono::milliseconds(40));
@@ -278,4 +277,54 @@ TEST_CASE("Runtime: a task's span carries the time it waited inside, which its b
   const pr::par::Workload w = pr::par::workloadFromRecord(r, "test");
   CHECK(w.stages[0].costs[0] < 0.01);
   CHECK(w.stages[0].costs[1] >= 0.04);
+}
+
+TEST_CASE("Runtime: PEs waiting inside tasks on different channels serve each other's requests") {
+  // PE 0 asks PE 1 on channel x and waits for the answer; PE 1 asks PE 0 on channel y and
+  // waits. Each answer comes from the other's handler, which runs only while that PE waits:
+  // serving one channel each, both would wait for ever.
+  Runtime rt(2, "demand");
+  Channel<int> xAnswers(rt, "x answers", MessageKind::Data), yAnswers(rt, "y answers", MessageKind::Data);
+  Channel<int> x(rt, "x", MessageKind::Requests, [&](Pe& pe, int&& v) { xAnswers.send(pe, 0, v + 1); });
+  Channel<int> y(rt, "y", MessageKind::Requests, [&](Pe& pe, int&& v) { yAnswers.send(pe, 1, v + 2); });
+  std::vector<int> got(2, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  rt.runPinned("ask each other", TaskSet::uniform(2), {0, 1}, [&](Pe& pe, TaskId t) {
+    Channel<int>& answers = t == 0 ? xAnswers : yAnswers;
+    (t == 0 ? x : y).send(pe, 1 - pe.id(), 10);
+    int v = 0;
+    waitUntil(pe, "an answer", [&] {
+      if (std::chrono::steady_clock::now() > deadline) throw std::runtime_error("no answer: a PE served one channel only");
+      return answers.tryReceive(pe, v);
+    });
+    got[pe.id()] = v;
+  });
+  CHECK(got == std::vector<int>{11, 12});
+  CHECK(rt.record().stages[0].pes[0].messagesHandled == 1);
+  CHECK(rt.record().stages[0].pes[1].messagesHandled == 1);
+}
+
+TEST_CASE("Runtime: a wait that polls a channel books the polls as send/receive time, not also as waiting") {
+  // PE 0 polls for a message PE 1 sends after 30 ms: its waiting and its Channel time together
+  // fit in its task's span.
+  Runtime rt(2, "demand");
+  Channel<int> late(rt, "late", MessageKind::Data);
+  std::atomic<bool> waiting{false};
+  rt.runPinned("poll", TaskSet::uniform(2), {0, 1}, [&](Pe& pe, TaskId t) {
+    if (t == 0) {
+      waiting = true;
+      int v = 0;
+      waitUntil(pe, "the late message", [&] { return late.tryReceive(pe, v); });
+    } else {
+      while (!waiting) std::this_thread::yield();
+      std::this_thread::sleep_for(std::chrono::milliseconds(30));
+      late.send(pe, 0, 1);
+    }
+  });
+  const RunRecord& r = rt.record();
+  const TaskSpan waiter = *std::find_if(r.timeline.begin(), r.timeline.end(), [](const TaskSpan& s) { return s.task == 0; });
+  const PeStageRecord& pe0 = r.stages[0].pes[0];
+  CHECK(waiter.waitSeconds > 0.0);
+  CHECK(pe0.sendReceiveSeconds > 0.0);
+  CHECK(waiter.waitSeconds + pe0.sendReceiveSeconds <= (waiter.end - waiter.start) + 1e-6);
 }
