@@ -274,6 +274,19 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
                                  : "; set-ups: " + seconds(total) + " split evenly over " + std::to_string(pes) +
                                        " PEs (assumes the data divides evenly)";
   }
+  if (pes > 1 && recordedPes > 1 && pes != recordedPes && r.rule != ReplayRule::Cells && r.rule != ReplayRule::Excluded) {
+    // How many messages a partitioned method sends follows its split at P', which the record
+    // does not hold at a grain fine enough to make again: the count stays the recorded one.
+    std::uint64_t messages = 0, bytes = 0;
+    for (std::uint32_t m : r.stage.messages) messages += m;
+    for (std::uint64_t b : r.stage.bytes) bytes += b;
+    for (const std::vector<PeLoad>* loads : {&r.handlers, &r.setups})
+      for (const PeLoad& load : *loads) messages += load.messagesSent, bytes += load.bytesSent;
+    if (messages > 0)
+      r.note += "; its " + std::to_string(messages) + " data messages (" + std::to_string(bytes) +
+                " bytes) held at the recorded count (the split that makes them is not recorded finely enough to make again at P = " +
+                std::to_string(pes) + ")";
+  }
   if (pes != 1 || recordedPes <= 1) return r;  // a cost table (0) says what its tasks send
   // On one PE every message would be to itself, which is no transfer (Runtime::countMessage):
   // the work stays, the data traffic goes.

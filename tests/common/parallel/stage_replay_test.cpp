@@ -316,3 +316,15 @@ TEST_CASE("StageReplay: work each PE does in full keeps its recorded mean at any
   CHECK(predict(w, "", at(1)).record.wallSeconds == doctest::Approx(2.0));
   CHECK(predict(w, "", at(2)).stages[0].rule == "as recorded");
 }
+
+TEST_CASE("StageReplay: at another P a stage's data messages are held at the recorded count, and the note says so") {
+  SimStage s = traceStage("demand");
+  s.messages = {2, 0, 1, 0};
+  s.bytes = {200, 0, 100, 0};
+  s.handlers = {{0.5, 3, 1, 50}, {}};
+  const StageReplay four = planReplay(s, 2, 4, "");
+  CHECK(four.stage.messages == std::vector<std::uint32_t>{2, 0, 1, 0});
+  CHECK(four.note.find("its 4 data messages (350 bytes) held at the recorded count") != std::string::npos);
+  CHECK(planReplay(s, 2, 2, "").note.find("held") == std::string::npos);  // as recorded
+  CHECK(planReplay(s, 2, 1, "").note.find("to itself on one PE") != std::string::npos);
+}
