@@ -168,8 +168,8 @@ void runSimulate(const SimulateArgs& args) {
     std::printf("set-ups: %.6f s of the PEs' recorded set-up work, each PE's before its first task\n", setupWork);
   if (gaps > 0.0) std::printf("controlling thread between stages: %.6f s, replayed serially\n", gaps);
   if (fromRecord && workload.recordedPes == 1)
-    std::printf("data messages: a P = 1 record has none to scale, so none are predicted at other P but the results of "
-                "cells (record at P > 1 to see a method's traffic)\n");
+    std::printf("data messages: a P = 1 record has none to scale, so none are predicted at other P except the results "
+                "of cells (record at P > 1 to see a method's traffic)\n");
   std::printf("schedule %s, grain %d; network %s (%s)\n",
               schedule.empty() ? ("as recorded per stage (run: " + workload.schedule + ")").c_str() : schedule.c_str(),
               params.grain, std::string(network.name).c_str(), std::string(network.description).c_str());

@@ -156,7 +156,8 @@ struct Wire<ItemReply<T>> {
 // requests", kind requests) to the item's owner, whose PE serves it in a message handler from
 // its own partition and sends the item back ("<name> items", kind data). The requesting PE
 // waits inside its task for the reply (booked as message waiting, not busy) and serves the
-// requests sent to it meanwhile, so PEs fetching from each other always make progress. An
+// messages of every handled channel sent to it meanwhile (await_reply.h), so PEs fetching from
+// each other always make progress. An
 // owner busy in a long task answers at its next task boundary, as a single-threaded PE of a
 // distributed-memory machine would.
 template <class T>
@@ -261,7 +262,7 @@ class DataManager {
     return nullptr;
   }
 
-  // Blocks (serving the requests sent to pe meanwhile, booked as waiting) until one of pe's
+  // Blocks (serving the messages sent to pe meanwhile, booked as waiting) until one of pe's
   // outstanding items has arrived and is usable; puts it in the cache, or holds it until the
   // next awaitArrival when it does not fit, and returns its id.
   ItemId awaitArrival(Pe& pe) {
@@ -336,7 +337,7 @@ class DataManager {
   inline static const std::string kWhat = "a data item";
   Reply awaitReply(Pe& pe) { return par::awaitReply(pe, items_, kWhat); }
 
-  // The simulated latency of a reply already received: waits (serving requests, booked as
+  // The simulated latency of a reply already received: waits (serving messages, booked as
   // waiting) until it is usable.
   void waitUntilReady(Pe& pe, const Reply& reply) {
     Runtime& rt = pe.runtime();

@@ -461,6 +461,9 @@ RunRecord parseRunRecord(const std::string& text, const std::string& origin) {
         c.pe < 0 || c.pe >= record.pes || c.cell < kCollectCell || c.cell >= record.stages[c.stage].cellCount ||
         !(c.seconds >= 0.0))
       throw InputError(origin + ": a \"cells\" entry names a PE, stage or cell the record does not have, or a negative time");
+    if (c.cell == kCollectCell && c.pe != record.stages[c.stage].cellCollector)
+      throw InputError(origin + ": a \"cells\" entry of the collector's storing is on PE " + std::to_string(c.pe) +
+                       ", not the stage's collector");
     record.cells.push_back(c);
   }
   // Optional: records written before counters existed have none.

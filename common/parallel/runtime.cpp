@@ -168,9 +168,10 @@ void Runtime::describeCells(std::string_view split, int cells, int collector) {
   stage.cellSplit = std::string(split);
   stage.cellCount = cells;
   stage.cellCollector = collector;
-  const int index = static_cast<int>(record_.stages.size()) - 1;
-  for (const CellSpan& c : record_.cells)
-    PR_CHECK(c.stage != index || c.cell < cells, "describeCells: cell " + std::to_string(c.cell) + " of " + std::to_string(cells));
+  for (std::size_t i = lastStageCells_; i < record_.cells.size(); ++i)
+    PR_CHECK(record_.cells[i].cell < cells && (record_.cells[i].cell != kCollectCell || record_.cells[i].pe == collector),
+             "describeCells: cell " + std::to_string(record_.cells[i].cell) + " of " + std::to_string(cells) + " on PE " +
+                 std::to_string(record_.cells[i].pe));
 }
 
 void Runtime::addCounter(std::string_view name, int pe, double value) {
@@ -312,13 +313,15 @@ std::optional<double> Runtime::timed(Pe& pe, TaskId task, std::vector<TaskSpan>&
 
 bool Runtime::serveOne(Pe& pe) {
   PR_CHECK(inStage_, "serveOne is called by a PE inside a task");
-  // channels_ changes only between stages, so a stage reads it without the lock.
-  for (ChannelBase* channel : channels_)
-    if (channel->pending(pe.id()) && channel->handleOne(pe)) {
-      pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
-      outstanding_.done();  // the waiting task is still counted, so never the last unit
-      return true;
-    }
+  // channels_ changes only between stages, so a stage reads it without the lock. Requests
+  // first: another PE may be blocked on the answer, where a result (a finished region) can wait.
+  for (const bool requests : {true, false})
+    for (ChannelBase* channel : channels_)
+      if ((channel->kind() == MessageKind::Requests) == requests && channel->pending(pe.id()) && channel->handleOne(pe)) {
+        pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
+        outstanding_.done();  // the waiting task is still counted, so never the last unit
+        return true;
+      }
   return false;
 }
 
@@ -540,6 +543,7 @@ void Runtime::runStage(std::string_view nameView, const TaskSet& tasks, Schedule
   pendingBroadcasts_.clear();
   record_.stages.push_back(std::move(sr));
   for (auto& s : spans_) record_.timeline.insert(record_.timeline.end(), s.begin(), s.end());
+  lastStageCells_ = record_.cells.size();
   for (auto& c : cells_) record_.cells.insert(record_.cells.end(), c.begin(), c.end());
   record_.wallSeconds = end - record_.stages.front().startSeconds;
 

@@ -202,7 +202,8 @@ class Runtime {
   // each cell's seconds and what the cell's result sends to the collector (kCollectCell: the
   // collector's storing of others' results), and after it describeCells names the rule, the
   // number of cells and the collector (-1: none), so the simulator can deal the cells again at
-  // another P (stage_replay.h). Kept with the timeline only.
+  // another P (stage_replay.h). The cells are kept with the timeline only (the split is named
+  // either way).
   void recordCell(const Pe& pe, int cell, double seconds, std::uint64_t resultBytes);
   void describeCells(std::string_view split, int cells, int collector);
 
@@ -256,8 +257,9 @@ class Runtime {
   // others return at once). True when it did something; false on a runtime of one rank.
   bool pumpMessages() { return ranks_ > 1 && pumpRankStage(); }
   // Inside a task on PE pe that waits for another PE: handles one message waiting for pe in
-  // any handled channel (the requests another waiting PE may need answered); true when it did.
-  // Part of the task's busy time, not a span of its own.
+  // any handled channel, requests first (another waiting PE may need the answer); true when it
+  // did. Part of the task's busy time, not a span of its own. A handler must not itself wait
+  // for a reply (it would serve, and so run handlers, inside a handler).
   bool serveOne(Pe& pe);
 
  private:
@@ -317,6 +319,7 @@ class Runtime {
   std::vector<std::unique_ptr<Doorbell>> bells_;
   std::vector<std::vector<TaskSpan>> spans_;
   std::vector<std::vector<CellSpan>> cells_;  // per PE, this stage's (recordCell)
+  std::size_t lastStageCells_ = 0;           // where the last stage's cells begin in record_.cells
   OutstandingWork outstanding_;
   std::atomic<bool> abort_{false};
   bool inStage_ = false;

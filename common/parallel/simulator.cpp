@@ -142,20 +142,20 @@ Workload workloadFromRecord(const RunRecord& record, const std::string& origin) 
       stage.cellCosts.assign(static_cast<std::size_t>(sr.cellCount), 0.0);
       stage.cellBytes.assign(stage.cellCosts.size(), 0);
     }
-    bool anyCell = false;
+    // (A stage with a split may have no cell: nothing drawn. Cells of a stage without a split,
+    // from a stage that failed before describing them, are not the record's: left out.)
     for (const CellSpan& c : record.cells) {
-      if (c.stage != static_cast<int>(s)) continue;
-      anyCell = true;
+      if (c.stage != static_cast<int>(s) || sr.cellSplit.empty()) continue;
+      PR_CHECK(c.cell >= kCollectCell && c.cell < sr.cellCount, "a cell outside its stage's count");
       if (c.cell == kCollectCell) {
         stage.collectInTaskSeconds += c.seconds;
         continue;
       }
       stage.cellCosts[c.cell] += c.seconds;
       stage.cellBytes[c.cell] = c.resultBytes;
-      if (c.pe != stage.cellCollector) stage.collectedCells += 1, stage.collectedBytes += c.resultBytes;
+      if (stage.cellCollector >= 0 && c.pe != stage.cellCollector)
+        stage.resultsToCollector += 1, stage.resultBytesToCollector += c.resultBytes;
     }
-    if (!stage.cellSplit.empty() && !anyCell)
-      throw InputError(origin + ": stage '" + sr.name + "' is made of cells but the record has none (record the run with its timeline)");
     w.stages.push_back(std::move(stage));
   }
   if (w.stages.empty()) throw InputError(origin + ": the run record has no stages");

@@ -94,15 +94,15 @@ struct SimStage {
   // start) and this stage's start: collating results, building the next stage's inputs.
   double gapBeforeSeconds = 0.0;
   // A stage made of cells (StageRecord::cellSplit, cell_split.h): the rule, each cell's
-  // measured seconds and result bytes (by cell index, every cell), the collector, and its
-  // storing of the results of cells on other PEs: seconds inside its tasks and in its message
-  // handlers, and those cells' count and bytes.
+  // measured seconds and result bytes (by cell index, every cell), the collector, its storing
+  // of the results of cells on other PEs inside its tasks (what it stored in its message
+  // handlers is in `handlers`), and how many results, of how many bytes, went to it.
   std::string cellSplit;
   int cellCollector = -1;
   std::vector<double> cellCosts;
   std::vector<std::uint64_t> cellBytes;
   double collectInTaskSeconds = 0.0;
-  std::uint64_t collectedCells = 0, collectedBytes = 0;
+  std::uint64_t resultsToCollector = 0, resultBytesToCollector = 0;
 };
 struct Workload {
   std::vector<SimStage> stages;

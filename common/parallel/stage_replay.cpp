@@ -74,7 +74,8 @@ std::string seconds(double s) {
   return text;
 }
 
-// The cells rule (stage_replay.h): the recorded cells dealt round-robin over `pes` owners.
+// The cells rule (stage_replay.h): the recorded cells dealt over `pes` owners by the stage's
+// split.
 StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay r) {
   r.rule = ReplayRule::Cells;
   const std::size_t cells = stage.cellCosts.size();
@@ -87,15 +88,15 @@ StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay
   std::vector<PeLoad> handlers = stage.handlers;
   if (recordedCollector >= 0 && static_cast<std::size_t>(recordedCollector) < handlers.size())
     collectSeconds += std::exchange(handlers[recordedCollector], PeLoad{}).seconds;
-  const double perByte = stage.collectedBytes > 0 ? collectSeconds / double(stage.collectedBytes) : 0.0;
+  const double perByte = stage.resultBytesToCollector > 0 ? collectSeconds / double(stage.resultBytesToCollector) : 0.0;
   r.handlers = perPeAt(handlers, recordedPes, pes);
   const int collector = recordedCollector < 0 ? -1 : recordedCollector < pes ? recordedCollector : 0;
 
   std::uint64_t taskMessages = 0, taskBytes = 0;
   for (std::uint32_t m : stage.messages) taskMessages += m;
   for (std::uint64_t b : stage.bytes) taskBytes += b;
-  const std::uint64_t otherMessages = taskMessages > stage.collectedCells ? taskMessages - stage.collectedCells : 0;
-  const std::uint64_t otherBytes = taskBytes > stage.collectedBytes ? taskBytes - stage.collectedBytes : 0;
+  const std::uint64_t otherMessages = taskMessages > stage.resultsToCollector ? taskMessages - stage.resultsToCollector : 0;
+  const std::uint64_t otherBytes = taskBytes > stage.resultBytesToCollector ? taskBytes - stage.resultBytesToCollector : 0;
 
   const std::size_t n = static_cast<std::size_t>(pes);
   r.stage.tasks = TaskSet::uniform(n);
@@ -130,7 +131,7 @@ StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay
   if (collector >= 0 && results > 0) {
     r.note += "; " + std::to_string(results) + " results (" + std::to_string(resultBytes) + " bytes) to PE " +
               std::to_string(collector);
-    r.note += stage.collectedBytes > 0 ? ", stored at the record's " + seconds(perByte * 1e6) + " per MB"
+    r.note += stage.resultBytesToCollector > 0 ? ", stored at the record's " + seconds(perByte * 1e6) + " per MB"
                                        : ", their storing not charged (the record has no result from another PE to time it by)";
   }
   return r;
@@ -192,10 +193,17 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
     const double mean = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0) / double(std::max<std::size_t>(n, 1));
     r.stage.tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
     r.stage.costs.assign(static_cast<std::size_t>(pes), mean);
+    std::uint64_t messages = 0, bytes = 0;  // any it sent: held at the recorded count
+    for (std::uint32_t m : stage.messages) messages += m;
+    for (std::uint64_t b : stage.bytes) bytes += b;
     r.stage.messages.assign(static_cast<std::size_t>(pes), 0);
     r.stage.bytes.assign(static_cast<std::size_t>(pes), 0);
     r.stage.owners.resize(static_cast<std::size_t>(pes));
-    for (int p = 0; p < pes; ++p) r.stage.owners[p] = p;
+    for (int p = 0; p < pes; ++p) {
+      r.stage.owners[p] = p;
+      r.stage.messages[p] = static_cast<std::uint32_t>(evenShare(messages, pes, p));
+      r.stage.bytes[p] = evenShare(bytes, pes, p);
+    }
     r.note = "one task per PE, each doing the work in full: the recorded mean, " + seconds(mean) + ", on each of " +
              std::to_string(pes) + " PEs (an upper bound where the work shrinks with the PE's share)";
     return r;

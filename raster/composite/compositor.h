@@ -106,6 +106,10 @@ class Compositor {
   // pr::InputError when the method cannot run with this PE count.
   virtual std::vector<Rect> composite(par::Runtime& runtime, std::vector<RegionFramebuffer>& buffers,
                                       std::vector<Rect>& drawn, bool sparse, std::span<const double> rowCost) = 0;
+  // Whether composite() with this rowCost cuts the screen's `height` rows into strips of equal
+  // height at any P (par::kStripCells), so the simulator can cut a record's rows again at
+  // another P; false where the regions follow the costs or the exchange pattern.
+  virtual bool cutsEqualStrips(std::span<const double> /*rowCost*/, int /*height*/) const { return false; }
 };
 
 // Factories, one per compositor file.

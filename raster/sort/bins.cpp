@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "common/parallel/cell_split.h"
 #include "common/parallel/runtime.h"
 #include "raster/stages/setup.h"
 
@@ -53,20 +54,24 @@ void RegionDrawer::draw(par::Pe& pe, const ShadingContext& ctx, std::span<const 
   // seconds (drawing and delivering it; the assembler's storing of others' regions meanwhile
   // apart, recorded as the collector's work).
   par::Runtime& rt = pe.runtime();
-  const bool cells = grid.roundRobin();
+  const bool recordCells = grid.roundRobin();  // describeTileCells names them
   const double served0 = frame.assembles(pe) ? frame.servedSeconds() : 0.0;
   for (size_t i = 0; i < regions.size(); ++i) {
     const std::span<const ScreenTriangle> bin(storage_.get() + start_[i], start_[i + 1] - start_[i]);
     const Rect& rect = grid.region(regions[i]);
     const double served = frame.assembles(pe) ? frame.servedSeconds() : 0.0;
-    const double t0 = cells ? rt.now() : 0.0;
+    const double t0 = recordCells ? rt.now() : 0.0;
     drawOne(pe, ctx, bin, rect, frame);
-    if (cells) {
+    if (recordCells) {
       const double storing = frame.assembles(pe) ? frame.servedSeconds() - served : 0.0;
       rt.recordCell(pe, regions[i], rt.now() - t0 - storing, regionMessageBytes(rect));
     }
   }
-  if (cells && frame.assembles(pe)) rt.recordCell(pe, par::kCollectCell, frame.servedSeconds() - served0, 0);
+  if (recordCells && frame.assembles(pe)) rt.recordCell(pe, par::kCollectCell, frame.servedSeconds() - served0, 0);
+}
+
+void describeTileCells(par::Runtime& runtime, const RegionGrid& grid) {
+  if (grid.roundRobin()) runtime.describeCells(par::kRoundRobinCells, grid.regionCount(), kAssemblerPe);
 }
 
 void RegionDrawer::drawOne(par::Pe& pe, const ShadingContext& ctx, std::span<const ScreenTriangle> tris,

@@ -31,7 +31,9 @@ void ownersOf(const RegionGrid& grid, const Rect& bounds, std::vector<char>& scr
 inline constexpr long long kScratchTilePixels = 128 * 128;
 class RegionDrawer {
  public:
-  // Draws regions (indices into grid) from the triangles of every list in lists.
+  // Draws regions (indices into grid) from the triangles of every list in lists. On a grid of
+  // tiles dealt round-robin each tile is a cell of the stage (Runtime::recordCell), which the
+  // stage's caller then names with describeTileCells.
   void draw(par::Pe& pe, const ShadingContext& ctx, std::span<const std::vector<ScreenTriangle>> lists,
             const RegionGrid& grid, std::span<const int> regions, FrameAssembly& frame);
 
@@ -59,6 +61,10 @@ class RegionDrawer {
   RegionFramebuffer scratch_;
   ShadeCounters shade_;
 };
+
+// After a stage whose PEs drew with RegionDrawer::draw on grid: names its tiles as the stage's
+// cells (par::kRoundRobinCells, collected by the assembler) when draw recorded them.
+void describeTileCells(par::Runtime& runtime, const RegionGrid& grid);
 
 
 }  // namespace pr::raster

@@ -23,7 +23,6 @@
 #include <optional>
 #include <span>
 
-#include "common/parallel/cell_split.h"
 #include "common/parallel/channel.h"
 #include "common/parallel/per_pe.h"
 #include "common/scene/poisoned_view.h"
@@ -66,8 +65,8 @@ std::vector<Rect> boundsOfPieces(std::span<const uint32_t> ids, std::span<const 
   std::vector<Rect> bounds(ids.size());
   size_t k = 0;
   for (const ScreenTriangle& t : pieces) {
-    while (ids[k] != t.primitive) ++k;
-    PR_DCHECK(k < ids.size(), "sort-first: a piece of a primitive outside the list");
+    while (k < ids.size() && ids[k] != t.primitive) ++k;
+    PR_CHECK(k < ids.size(), "sort-first: a piece of a primitive outside the list");
     grow(bounds[k], pixelBounds(t));
   }
   return bounds;
@@ -224,7 +223,7 @@ class SortFirst : public SortPoint {
       next[p] = merged(unseen[p], mine, boundsOfPieces(mine, tris));
       drawers_[p].draw(pe, shadingOf(p, ctx), std::span(&tris, 1), grid, grid.regionsOf(p), frame);
     });
-    if (grid.roundRobin()) rt.describeCells(par::kRoundRobinCells, grid.regionCount(), kAssemblerPe);
+    describeTileCells(rt, grid);
 
     held_ = std::move(next);
     previous_.emplace(Previous{f.view, grid});

@@ -104,7 +104,8 @@ class SortLast : public SortPoint {
     // the regions are strips of equal height (direct-send's first frame), each screen row is a
     // cell the simulator can cut into strips again at another P: its share of the PE's measured
     // time in proportion to its work (its covered pixels and recomputed triangles).
-    const bool rowCells = equalStrips(regions, f.view.width, f.view.height);
+    const bool rowCells = compositor->cutsEqualStrips(rowCost_, f.view.height);
+    PR_CHECK(!rowCells || equalStrips(regions, f.view.width, f.view.height), "sort-last: strip cells on other regions");
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
       const double t0 = rt.now();
       PeFrame& state = pe_[pe.id()];

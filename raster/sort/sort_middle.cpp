@@ -5,7 +5,6 @@
 // redistributed PDI is the 80-byte ScreenTriangle; the scene is replicated (world model).
 #include <algorithm>
 
-#include "common/parallel/cell_split.h"
 #include "common/parallel/channel.h"
 #include "common/parallel/per_pe.h"
 #include "raster/frame_assembly.h"
@@ -116,7 +115,7 @@ class SortMiddle : public SortPoint {
       const int p = pe.id();
       drawers_[p].draw(pe, ctx, inbox[p], grid, grid.regionsOf(p), frame);
     });
-    if (grid.roundRobin()) rt.describeCells(par::kRoundRobinCells, grid.regionCount(), kAssemblerPe);
+    describeTileCells(rt, grid);
     // Each rank measured its own PEs: the busy times summed across ranks are every PE's.
     std::vector<double> busy;
     for (const par::PeStageRecord& pe : rt.record().stages.back().pes) busy.push_back(pe.busySeconds);

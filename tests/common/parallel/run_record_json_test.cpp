@@ -229,8 +229,8 @@ TEST_CASE("RunRecord: a stage's cells come from recordCell, survive JSON, and ar
   const Workload w = workloadFromRecord(b, "test");
   CHECK(w.stages[0].cellCosts.size() == 5);
   CHECK(w.stages[0].cellCosts[4] == doctest::Approx(0.005));
-  CHECK(w.stages[0].collectedCells == 2);
-  CHECK(w.stages[0].collectedBytes == 200 + 400);
+  CHECK(w.stages[0].resultsToCollector == 2);
+  CHECK(w.stages[0].resultBytesToCollector == 200 + 400);
   CHECK(w.stages[0].collectInTaskSeconds == doctest::Approx(0.002));
   const std::string head = R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]]}],"timeline":[],"cells":)";
   CHECK_THROWS_AS(runRecordFromJsonText(head + "[[0,0,0,0.1,10]]}", "no split"), pr::InputError);
@@ -241,4 +241,11 @@ TEST_CASE("RunRecord: a stage's cells come from recordCell, survive JSON, and ar
   const std::string strips = split + R"("strips","cellCount":2,"cellCollector":-1}],"timeline":[],"cells":)";
   CHECK(runRecordFromJsonText(strips + "[[0,0,1,0.1,0]]}", "good").cells.size() == 1);
   CHECK_THROWS_AS(runRecordFromJsonText(strips + "[[0,0,2,0.1,0]]}", "bad"), pr::InputError);
+  // The collector's storing on a stage without a collector would be time nobody is charged.
+  CHECK_THROWS_AS(runRecordFromJsonText(strips + "[[0,0,-1,0.1,0]]}", "bad"), pr::InputError);
+  // A stage made of cells may have none (nothing drawn): the simulator reads it.
+  const RunRecord empty = runRecordFromJsonText(
+      R"({"pes":1,"stages":[{"name":"s","wallSeconds":1,"tasks":[[1,0,0]],"owners":[0],"kind":"each PE","cellSplit":"strips","cellCount":2,"cellCollector":-1}],"timeline":[[0,0,0,0,0.5,0,0,0]]})",
+      "empty");
+  CHECK(workloadFromRecord(empty, "empty").stages[0].cellCosts == std::vector<double>{0.0, 0.0});
 }

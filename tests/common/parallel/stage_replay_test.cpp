@@ -267,8 +267,8 @@ TEST_CASE("StageReplay: the collector stores other PEs' results at the recorded 
   s.messages = {0, 2};
   s.bytes = {0, 2000};
   s.collectInTaskSeconds = 0.01;
-  s.collectedCells = 2;
-  s.collectedBytes = 2000;
+  s.resultsToCollector = 2;
+  s.resultBytesToCollector = 2000;
   s.handlers = {{0.01, 2, 0, 0}, {}};
   const Workload w = recordedWorkload({s}, 2);
   // P = 4: one tile per PE; PE 0 stores 3 results, 0.03 s; the rest 0.3 / 4 s each.

@@ -61,11 +61,11 @@ TEST_CASE("ScreenCells: a draw stage on round-robin tiles records each tile once
     CHECK(collects == 1);
     // The simulator reads tiles 1 and 2 as the results stored by the assembler.
     const par::Workload w = par::workloadFromRecord(rt.record(), "test");
-    CHECK(w.stages[static_cast<std::size_t>(index)].collectedCells == 2);
+    CHECK(w.stages[static_cast<std::size_t>(index)].resultsToCollector == 2);
   }
 }
 
-TEST_CASE("ScreenCells: strips are no cells, nor tiles dealt by shares learnt from a frame") {
+TEST_CASE("ScreenCells: the strips of the sort points that deliver regions are no cells") {
   const scene::Scene s = test::threeTriangles();
   const FrameView view = test::tinyView();
   SortOptions strips;
@@ -74,21 +74,6 @@ TEST_CASE("ScreenCells: strips are no cells, nor tiles dealt by shares learnt fr
   renderParallel(s, view, "sort-middle", strips, rt);
   CHECK(rt.record().cells.empty());
   for (const par::StageRecord& stage : rt.record().stages) CHECK(stage.cellSplit.empty());
-  // Sort-middle's second frame deals by the shares the first one learnt: unless they came out
-  // equal, that frame's rasterize stage has no cells.
-  SortOptions tiles;
-  tiles.regions = RegionStrategy::StaticTiles;
-  tiles.tileSizePx = 4;
-  par::Runtime two(2, "demand");
-  std::unique_ptr<SortPoint> sm = makeSortPoint("sort-middle");
-  renderFrame(*sm, s, view, tiles, two);
-  renderFrame(*sm, s, view, tiles, two);
-  const par::RunRecord& r = two.record();
-  const par::StageRecord& second = r.stages.back();
-  REQUIRE(second.name == "sort-middle rasterize");
-  bool cellsInSecond = false;
-  for (const par::CellSpan& c : r.cells) cellsInSecond = cellsInSecond || c.stage == static_cast<int>(r.stages.size()) - 1;
-  CHECK(cellsInSecond == !second.cellSplit.empty());
 }
 
 TEST_CASE("ScreenCells: sort-last shades rows as strip cells on direct-send's equal strips, and clears in full") {
@@ -113,14 +98,31 @@ TEST_CASE("ScreenCells: sort-last shades rows as strip cells on direct-send's eq
   }
   CHECK(rows > 0);
   CHECK(rows <= 16);
+  // No collector: no row's result counts as sent anywhere.
+  CHECK(par::workloadFromRecord(rt.record(), "test").stages[static_cast<std::size_t>(index)].resultsToCollector == 0);
   int clear = -1;
   REQUIRE(stageNamed(rt.record(), "sort-last clear", clear) != nullptr);
   CHECK(rt.record().stages[static_cast<std::size_t>(clear)].kind == par::kEachPeInFullStage);
-  // Binary swap's halves are no strips: no cells.
+  // Binary swap's halves are no strips, even at P = 1 where its one region is the screen.
   options.compositor = "binary-swap";
-  par::Runtime four(4, "demand");
-  renderParallel(s, view, "sort-last", options, four);
-  CHECK(four.record().cells.empty());
+  for (int pes : {1, 4}) {
+    CAPTURE(pes);
+    par::Runtime swap(pes, "demand");
+    renderParallel(s, view, "sort-last", options, swap);
+    CHECK(swap.record().cells.empty());
+  }
+  // Direct-send's second frame cuts its strips at the first frame's shading work: no cells.
+  options.compositor = "direct-send";
+  par::Runtime two(2, "demand");
+  std::unique_ptr<SortPoint> sl = makeSortPoint("sort-last");
+  renderFrame(*sl, s, view, options, two);
+  const std::size_t firstFrameCells = two.record().cells.size();
+  CHECK(firstFrameCells > 0);
+  renderFrame(*sl, s, view, options, two);
+  CHECK(two.record().cells.size() == firstFrameCells);
+  int second = -1;
+  REQUIRE(stageNamed(two.record(), "sort-last shade", second) != nullptr);
+  CHECK(two.record().stages[static_cast<std::size_t>(second)].cellSplit.empty());
 }
 
 }  // namespace
