@@ -74,12 +74,10 @@ void FrameAssembly::store(RegionFramebuffer&& region) {
 
 void FrameAssembly::serve(par::Pe& pe) {
   if (!assembles(pe)) return;
-  // As the runtime does between tasks (and TilePull inside one): a handled message is done;
-  // the task calling this is still outstanding, so this is never the stage's last unit.
+  // As a PE waiting inside a task does (Runtime::serveOne): the regions that have arrived, and
+  // any request another PE waits on.
   const double t0 = runtime_.now();
-  while (regions_.handleOne(pe)) {
-    pe.counters().messagesHandled.fetch_add(1, std::memory_order_relaxed);
-    runtime_.outstanding().done();
+  while (runtime_.serveOne(pe)) {
   }
   servedSeconds_ += runtime_.now() - t0;
 }

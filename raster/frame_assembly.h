@@ -86,7 +86,8 @@ class FrameAssembly {
   // full-screen buffer); nothing when that part is empty.
   void deliver(par::Pe& pe, const RegionFramebuffer& src, const Rect& within);
 
-  // On the assembler inside one of its tasks: stores the region messages that have arrived.
+  // On the assembler inside one of its tasks: stores the region messages that have arrived (and
+  // answers any other message waiting for it, Runtime::serveOne).
   // The runtime hands messages to their handler between tasks only, so an assembler drawing
   // all its regions in one task calls this between them; otherwise every other PE's regions
   // would stay in flight (and their buffers out of the pool, out of cache) until it is done.

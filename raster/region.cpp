@@ -40,11 +40,17 @@ std::vector<Rect> stripRegions(int width, int height, int count) {
   return strips;
 }
 
-std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost) {
-  PR_CHECK(width >= 0 && height >= 0 && count > 0, "weightedStripRegions: bad size");
+bool cutsByRowCost(std::span<const double> rowCost, int height) {
   double total = 0.0;
   for (double c : rowCost) total += c;
-  if (rowCost.size() != size_t(height) || !(total > 0.0)) return stripRegions(width, height, count);
+  return rowCost.size() == size_t(height) && total > 0.0;
+}
+
+std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost) {
+  PR_CHECK(width >= 0 && height >= 0 && count > 0, "weightedStripRegions: bad size");
+  if (!cutsByRowCost(rowCost, height)) return stripRegions(width, height, count);
+  double total = 0.0;
+  for (double c : rowCost) total += c;
   count = std::max(1, std::min(count, height));
   std::vector<Rect> strips;
   double sum = 0.0;

@@ -39,7 +39,9 @@ std::vector<Rect> stripRegions(int width, int height, int count);
 // count horizontal strips, top to bottom, of (nearly) equal total rowCost (one entry per row,
 // >= 0): each strip ends at the first row where the running sum reaches its share, and has at
 // least one row. Equal heights (stripRegions) when rowCost does not have `height` entries or
-// sums to 0.
+// sums to 0 (cutsByRowCost false).
 std::vector<Rect> weightedStripRegions(int width, int height, int count, std::span<const double> rowCost);
+// Whether weightedStripRegions cuts by rowCost, not into strips of equal height.
+bool cutsByRowCost(std::span<const double> rowCost, int height);
 
 }  // namespace pr::raster

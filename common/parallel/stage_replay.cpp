@@ -74,6 +74,30 @@ std::string seconds(double s) {
   return text;
 }
 
+// The data messages and bytes a stage's tasks sent, summed.
+std::pair<std::uint64_t, std::uint64_t> taskTraffic(const SimStage& stage) {
+  std::uint64_t messages = 0, bytes = 0;
+  for (std::uint32_t m : stage.messages) messages += m;
+  for (std::uint64_t b : stage.bytes) bytes += b;
+  return {messages, bytes};
+}
+
+// out as one task per PE at `pes` PEs (PE p's task on PE p), each of `each` seconds, with
+// `messages` data messages of `bytes` in all split evenly over them.
+void onePerPe(int pes, double each, std::uint64_t messages, std::uint64_t bytes, SimStage& out) {
+  const std::size_t n = static_cast<std::size_t>(pes);
+  out.tasks = TaskSet::uniform(n);
+  out.costs.assign(n, each);
+  out.messages.resize(n);
+  out.bytes.resize(n);
+  out.owners.resize(n);
+  for (int p = 0; p < pes; ++p) {
+    out.owners[p] = p;
+    out.messages[p] = static_cast<std::uint32_t>(evenShare(messages, pes, p));
+    out.bytes[p] = evenShare(bytes, pes, p);
+  }
+}
+
 // The cells rule (stage_replay.h): the recorded cells dealt over `pes` owners by the stage's
 // split.
 StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay r) {
@@ -92,18 +116,11 @@ StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay
   r.handlers = perPeAt(handlers, recordedPes, pes);
   const int collector = recordedCollector < 0 ? -1 : recordedCollector < pes ? recordedCollector : 0;
 
-  std::uint64_t taskMessages = 0, taskBytes = 0;
-  for (std::uint32_t m : stage.messages) taskMessages += m;
-  for (std::uint64_t b : stage.bytes) taskBytes += b;
+  // The tasks' other messages (not results to the collector) divide among the owners.
+  const auto [taskMessages, taskBytes] = taskTraffic(stage);
   const std::uint64_t otherMessages = taskMessages > stage.resultsToCollector ? taskMessages - stage.resultsToCollector : 0;
   const std::uint64_t otherBytes = taskBytes > stage.resultBytesToCollector ? taskBytes - stage.resultBytesToCollector : 0;
-
-  const std::size_t n = static_cast<std::size_t>(pes);
-  r.stage.tasks = TaskSet::uniform(n);
-  r.stage.costs.assign(n, rest / pes);
-  r.stage.messages.assign(n, 0);
-  r.stage.bytes.assign(n, 0);
-  r.stage.owners.resize(n);
+  onePerPe(pes, rest / pes, otherMessages, otherBytes, r.stage);
   std::uint64_t results = 0, resultBytes = 0;
   double largest = 0.0;
   for (std::size_t c = 0; c < cells; ++c) {
@@ -118,11 +135,6 @@ StageReplay cellsAt(const SimStage& stage, int recordedPes, int pes, StageReplay
     }
   }
   if (collector >= 0) r.stage.costs[collector] += perByte * double(resultBytes);
-  for (int p = 0; p < pes; ++p) {
-    r.stage.owners[p] = p;
-    r.stage.messages[p] += static_cast<std::uint32_t>(evenShare(otherMessages, pes, p));
-    r.stage.bytes[p] += evenShare(otherBytes, pes, p);
-  }
   r.note = std::to_string(cells) + " cells (" + seconds(inCells) + ", the largest " + seconds(largest) + ") dealt " +
            (stage.cellSplit == kStripCells ? std::string("in strips") : stage.cellSplit) + " over " + std::to_string(pes) +
            " owners; " + seconds(rest) +
@@ -191,19 +203,8 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
     // Every PE does the work whole at any P: P' tasks of the recorded mean.
     r.rule = ReplayRule::EachPeInFull;
     const double mean = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0) / double(std::max<std::size_t>(n, 1));
-    r.stage.tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
-    r.stage.costs.assign(static_cast<std::size_t>(pes), mean);
-    std::uint64_t messages = 0, bytes = 0;  // any it sent: held at the recorded count
-    for (std::uint32_t m : stage.messages) messages += m;
-    for (std::uint64_t b : stage.bytes) bytes += b;
-    r.stage.messages.assign(static_cast<std::size_t>(pes), 0);
-    r.stage.bytes.assign(static_cast<std::size_t>(pes), 0);
-    r.stage.owners.resize(static_cast<std::size_t>(pes));
-    for (int p = 0; p < pes; ++p) {
-      r.stage.owners[p] = p;
-      r.stage.messages[p] = static_cast<std::uint32_t>(evenShare(messages, pes, p));
-      r.stage.bytes[p] = evenShare(bytes, pes, p);
-    }
+    const auto [messages, bytes] = taskTraffic(stage);  // any it sent: held at the recorded count
+    onePerPe(pes, mean, messages, bytes, r.stage);
     r.note = "one task per PE, each doing the work in full: the recorded mean, " + seconds(mean) + ", on each of " +
              std::to_string(pes) + " PEs (an upper bound where the work shrinks with the PE's share)";
     return r;
@@ -227,19 +228,8 @@ StageReplay planRule(const SimStage& stage, int recordedPes, int pes, std::strin
     // P' tasks of total/P' each: the method's split of its data at P' is assumed even.
     r.rule = ReplayRule::EachPe;
     const double total = std::accumulate(stage.costs.begin(), stage.costs.end(), 0.0);
-    std::uint64_t messages = 0, bytes = 0;
-    for (std::size_t t = 0; t < stage.messages.size(); ++t) messages += stage.messages[t];
-    for (std::size_t t = 0; t < stage.bytes.size(); ++t) bytes += stage.bytes[t];
-    r.stage.tasks = TaskSet::uniform(static_cast<std::size_t>(pes));
-    r.stage.costs.assign(static_cast<std::size_t>(pes), total / pes);
-    r.stage.messages.assign(static_cast<std::size_t>(pes), 0);
-    r.stage.bytes.assign(static_cast<std::size_t>(pes), 0);
-    r.stage.owners.resize(static_cast<std::size_t>(pes));
-    for (int p = 0; p < pes; ++p) {
-      r.stage.owners[p] = p;
-      r.stage.messages[p] = static_cast<std::uint32_t>(evenShare(messages, pes, p));
-      r.stage.bytes[p] = evenShare(bytes, pes, p);
-    }
+    const auto [messages, bytes] = taskTraffic(stage);
+    onePerPe(pes, total / pes, messages, bytes, r.stage);
     r.note = "one task per PE: " + seconds(total) + " of work split evenly over " + std::to_string(pes) +
              " owners (assumes the data divides evenly)";
     return r;
@@ -285,9 +275,7 @@ StageReplay planReplay(const SimStage& stage, int recordedPes, int pes, std::str
   if (pes > 1 && recordedPes > 1 && pes != recordedPes && r.rule != ReplayRule::Cells && r.rule != ReplayRule::Excluded) {
     // How many messages a partitioned method sends follows its split at P', which the record
     // does not hold at a grain fine enough to make again: the count stays the recorded one.
-    std::uint64_t messages = 0, bytes = 0;
-    for (std::uint32_t m : r.stage.messages) messages += m;
-    for (std::uint64_t b : r.stage.bytes) bytes += b;
+    auto [messages, bytes] = taskTraffic(r.stage);
     for (const std::vector<PeLoad>* loads : {&r.handlers, &r.setups})
       for (const PeLoad& load : *loads) messages += load.messagesSent, bytes += load.bytesSent;
     if (messages > 0)

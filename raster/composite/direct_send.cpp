@@ -59,11 +59,8 @@ namespace {
 class DirectSend : public Compositor {
  public:
   std::string_view name() const override { return "direct-send"; }
-  // weightedStripRegions cuts equal strips when it has no costs to cut by.
   bool cutsEqualStrips(std::span<const double> rowCost, int height) const override {
-    double total = 0.0;
-    for (double c : rowCost) total += c;
-    return rowCost.size() != size_t(height) || !(total > 0.0);
+    return !cutsByRowCost(rowCost, height);
   }
 
   std::vector<Rect> composite(par::Runtime& rt, std::vector<RegionFramebuffer>& buffers, std::vector<Rect>& drawn,

@@ -105,7 +105,6 @@ class SortLast : public SortPoint {
     // cell the simulator can cut into strips again at another P: its share of the PE's measured
     // time in proportion to its work (its covered pixels and recomputed triangles).
     const bool rowCells = compositor->cutsEqualStrips(rowCost_, f.view.height);
-    PR_CHECK(!rowCells || equalStrips(regions, f.view.width, f.view.height), "sort-last: strip cells on other regions");
     rt.runOnEachPe("sort-last shade", [&](par::Pe& pe) {
       const double t0 = rt.now();
       PeFrame& state = pe_[pe.id()];
@@ -184,15 +183,6 @@ class SortLast : public SortPoint {
       }
       rowCost[size_t(y)] = double(covered) + kRecomputedTriangleCost * double(recomputed);
     }
-  }
-
-  // Whether the compositor's regions are the strips of equal height stripRegions cuts (PEs
-  // beyond the screen's rows owning nothing): the rule par::kStripCells deals rows by.
-  static bool equalStrips(const std::vector<Rect>& regions, int width, int height) {
-    const std::vector<Rect> strips = stripRegions(width, height, static_cast<int>(regions.size()));
-    for (size_t p = 0; p < regions.size(); ++p)
-      if (regions[p] != (p < strips.size() ? strips[p] : Rect{})) return false;
-    return true;
   }
 
   // The rows of `visible` as cells: the PE's measured seconds shared out by each row's work.
